@@ -1,0 +1,1 @@
+// Placeholder translation unit until the backbone library's first sources land; delete then.
