@@ -1,0 +1,128 @@
+// MeshRenderer: draws lit/unlit, coloured/textured triangle meshes into a
+// RenderTarget with one GL 3.3 core shader program. GPU-resident resources:
+// upload once, get a handle, draw many handles per frame, delete handles.
+//
+// Contract:
+// - create()/every method needs the renderer's context current on the calling
+//   thread (see offscreen_context.h); destroy the renderer before the context.
+// - Meshes are IndexedMesh (validated on upload: kInvalidArgument names the
+//   bad element). Missing normals are computed; missing uvs are (0,0);
+//   missing colours are white. Optional per-vertex texture layers select the
+//   layer of an array texture (for batching, see mesh_batch.h).
+// - Textures are always 2D array textures; uploadTexture() makes a 1-layer
+//   one. uv (0,0) is the image's BOTTOM-left as in OpenGL/OBJ: RgbaImage rows
+//   are top-down, so the upload flips them (v = 1 is the image's top row).
+// - Batching: one draw call per DrawItem. To draw many textured objects in one
+//   call, put their textures in layers of one array texture and merge their
+//   triangles with MeshBatch (world space, per-vertex layer) into one mesh.
+// - Handles are plain ids; a deleted or unknown handle is kNotFound at draw
+//   time. Handle 0 means "none" (e.g. an untextured material).
+// - Errors: invalid input is kInvalidArgument; GL errors are kInternal, GL
+//   out-of-memory is kResourceExhausted; the message names the GL call.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec4.hpp>
+#include <memory>
+#include <vector>
+
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/render/camera.h"
+#include "thinlod/common/render/offscreen_context.h"
+#include "thinlod/common/render/render_target.h"
+#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::render {
+
+struct MeshHandle {
+  std::uint32_t id = 0;
+  bool valid() const { return id != 0; }
+};
+struct TextureHandle {
+  std::uint32_t id = 0;
+  bool valid() const { return id != 0; }
+};
+
+enum class AlphaMode { kOpaque, kMask, kBlend };  // kMask discards alpha < alphaCutoff
+
+struct Material {
+  glm::vec4 diffuse{0.8f, 0.8f, 0.8f, 1.0f};  // multiplies texture and vertex colours
+  glm::vec3 specular{0.0f};                   // Blinn-Phong, 0 = none
+  float shininess = 32.0f;
+  bool lit = true;               // false: colour = diffuse * texture * vertex colour
+  bool useVertexColors = false;  // multiply by the mesh's per-vertex colours
+  TextureHandle texture;         // none: untextured
+  int textureLayer = 0;          // used when the mesh has no per-vertex layers
+  AlphaMode alphaMode = AlphaMode::kOpaque;
+  float alphaCutoff = 0.5f;
+  bool doubleSided = true;  // false: back faces are culled
+};
+
+struct DrawItem {
+  MeshHandle mesh;
+  glm::mat4 model{1.0f};  // object -> world
+  Material material;
+};
+
+struct TextureOptions {
+  bool linearFilter = true;  // false: nearest (pixel-exact tests)
+  bool mipmaps = false;
+  bool clampToEdge = true;  // false: repeat
+};
+
+struct RenderStats {
+  std::size_t drawCalls = 0;
+  std::size_t triangles = 0;
+  std::size_t textureBinds = 0;
+};
+
+class MeshRenderer {
+ public:
+  static Result<std::unique_ptr<MeshRenderer>> create(OffscreenContext& context);
+  ~MeshRenderer();
+  MeshRenderer(const MeshRenderer&) = delete;
+  MeshRenderer& operator=(const MeshRenderer&) = delete;
+
+  // textureLayers: empty, or one layer index per vertex.
+  Result<MeshHandle> uploadMesh(const IndexedMesh& mesh,
+                                const std::vector<std::uint16_t>& textureLayers = {});
+  // Replaces the contents of an existing mesh (e.g. a batch rebuilt each frame).
+  Status updateMesh(MeshHandle handle, const IndexedMesh& mesh,
+                    const std::vector<std::uint16_t>& textureLayers = {});
+  void deleteMesh(MeshHandle handle);
+
+  Result<TextureHandle> uploadTexture(const RgbaImage& image, const TextureOptions& options = {});
+  // An array texture of `layers` layers of width x height, initially transparent black.
+  Result<TextureHandle> createTextureArray(int width, int height, int layers,
+                                           const TextureOptions& options = {});
+  // Writes `image` into `layer` at the layer's bottom-left-in-uv corner: the
+  // image may be smaller than the layer; it then covers uv [0, w/W] x [0, h/H].
+  Status setTextureLayer(TextureHandle texture, int layer, const RgbaImage& image);
+  void deleteTexture(TextureHandle handle);
+
+  // Binds the target, sets the viewport and clears colour (RGBA in [0,1]) and depth.
+  Status beginFrame(RenderTarget& target, const glm::vec4& clearColor);
+  // Draws opaque and masked items in order, then blended items in order
+  // (no sorting: pass blended items back to front). Needs a prior beginFrame.
+  Status draw(const DrawItem* items, std::size_t count, const Camera& camera,
+              const Lighting& lighting);
+  Status draw(const std::vector<DrawItem>& items, const Camera& camera, const Lighting& lighting) {
+    return draw(items.data(), items.size(), camera, lighting);
+  }
+  // Waits for the GPU (for timing); readback already synchronises.
+  Status finish();
+
+  const RenderStats& stats() const { return stats_; }  // since the last beginFrame
+  OffscreenContext& context() const { return *context_; }
+
+ private:
+  struct Impl;
+  explicit MeshRenderer(OffscreenContext& context);
+  OffscreenContext* context_;
+  std::unique_ptr<Impl> impl_;
+  RenderStats stats_;
+};
+
+}  // namespace thinlod::render

@@ -1,0 +1,39 @@
+// RgbaImage: a plain 8-bit RGBA raster exchanged between the renderer, the
+// impostor builder, the encoders and the frontend. No GL types here.
+//
+// Contract:
+// - pixels.size() == width * height * 4; rows are stored top-down (row 0 is
+//   the top of the picture), 4 bytes per pixel in R, G, B, A order.
+// - Colours are non-premultiplied; alpha 0 means "no surface here".
+// - Value type: copy/move freely, no thread affinity.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace thinlod::render {
+
+struct RgbaImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;  // top-down rows, RGBA8
+
+  RgbaImage() = default;
+  RgbaImage(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 4, 0) {}
+
+  bool empty() const { return width <= 0 || height <= 0; }
+  bool consistent() const {
+    return width >= 0 && height >= 0 &&
+           pixels.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4;
+  }
+  // Pointer to the 4 bytes of pixel (x, y), y counted from the top. Asserts nothing: caller checks.
+  std::uint8_t* at(int x, int y) {
+    return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+  }
+  const std::uint8_t* at(int x, int y) const {
+    return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+  }
+};
+
+}  // namespace thinlod::render
