@@ -1,0 +1,92 @@
+// Analytic primitives (VRML Sphere, Cylinder, Box, Cone) tessellated to a
+// triangle budget, with relative accuracy curves derived from geometry
+// (Pasman & Jansen 2002, section 3.2).
+//
+// Contract:
+// - Shapes are centred at the origin, axis +y, as in VRML97: cylinder and
+//   cone span y in [-height/2, height/2], the cone's apex at +height/2.
+//   Units are metres. Triangles are counter-clockwise seen from outside;
+//   every vertex carries an analytic unit normal and a uv in [0,1]^2.
+// - tessellationError() is the exact symmetric Hausdorff distance between
+//   the tessellation and the true closed surface (metres): sphere
+//   R - min over faces of dist(centre, face); cylinder and cone the rim
+//   sagitta R (1 - cos(pi/n)); box 0. Diameter = bbox diagonal of the true
+//   shape; relative accuracy a = diameter / error, capped at
+//   kExactRelativeAccuracy (the box, and errors below float precision).
+// - The accuracy curve is AccuracyCurve::fitConservative over the exact
+//   (a, triangles) points of every tessellation up to maxTriangles, so it
+//   never promises more accuracy than a tessellation of that cost has:
+//   tessellate(shape, chooseTessellation(shape, r(a))) reaches accuracy >= a
+//   with at most r(a) triangles.
+// - Invalid shapes (non-finite or non-positive sizes, no parts) are rejected
+//   by validatePrimitive(); other functions assert it.
+// - Pure functions, no I/O, thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+
+#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod {
+
+// Distortion 1e-6 of the diameter: below float precision of positions.
+inline constexpr double kExactRelativeAccuracy = 1e6;
+
+enum class PrimitiveKind : std::uint8_t { kSphere, kCylinder, kBox, kCone };
+const char* primitiveKindName(PrimitiveKind kind);
+
+struct PrimitiveShape {
+  PrimitiveKind kind = PrimitiveKind::kSphere;
+  float radius = 1.0f;  // sphere, cylinder, cone (VRML bottomRadius)
+  float height = 2.0f;  // cylinder, cone
+  glm::vec3 boxSize{2.0f, 2.0f, 2.0f};
+  bool side = true;    // cylinder, cone
+  bool top = true;     // cylinder
+  bool bottom = true;  // cylinder, cone
+
+  static PrimitiveShape sphere(float radius);
+  static PrimitiveShape cylinder(float radius, float height);
+  static PrimitiveShape cone(float bottomRadius, float height);
+  static PrimitiveShape box(const glm::vec3& size);
+};
+
+// Sphere: `segments` around the axis (>= 3) x `rings` latitude bands (>= 2),
+// 2 * segments * (rings - 1) triangles. Cylinder/cone: `segments` (>= 3);
+// rings unused. Box: both unused (12 triangles).
+struct TessellationParams {
+  int segments = 3;
+  int rings = 2;
+};
+
+Status validatePrimitive(const PrimitiveShape& shape);
+Bounds primitiveBounds(const PrimitiveShape& shape);
+double primitiveDiameter(const PrimitiveShape& shape);
+
+int tessellationTriangles(const PrimitiveShape& shape, const TessellationParams& params);
+double tessellationError(const PrimitiveShape& shape, const TessellationParams& params);
+double tessellationAccuracy(const PrimitiveShape& shape, const TessellationParams& params);
+
+// Smallest-error tessellation with at most maxTriangles triangles (the
+// coarsest one when maxTriangles is below it). The sphere keeps
+// rings <= segments <= 4 rings.
+TessellationParams chooseTessellation(const PrimitiveShape& shape, int maxTriangles);
+// Cheapest tessellation whose accuracy is >= relativeAccuracy; an error
+// (kResourceExhausted) when that needs more than maxTriangles.
+Result<TessellationParams> tessellationForAccuracy(const PrimitiveShape& shape,
+                                                   double relativeAccuracy, int maxTriangles);
+
+IndexedMesh tessellate(const PrimitiveShape& shape, const TessellationParams& params);
+
+struct PrimitiveCurveOptions {
+  int maxTriangles = 16384;  // top of the ladder of tessellations
+  int maxSegments = 16;      // curve segments for fitConservative
+};
+// Relative accuracy curve, resources in triangles. Box: a point curve at
+// (kExactRelativeAccuracy, 12).
+Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& shape,
+                                             const PrimitiveCurveOptions& options = {});
+
+}  // namespace thinlod
