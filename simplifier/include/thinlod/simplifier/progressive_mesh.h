@@ -1,18 +1,32 @@
-// ProgressiveMesh: QEM (Garland-Heckbert) edge collapses recorded once, any
-// resolution extracted later in time linear in the output.
+// ProgressiveMesh: QEM (Garland-Heckbert) half-edge collapses recorded once as
+// a totally ordered mesh (Gobbetti-Bouvier TOM); any resolution is extracted
+// later in time linear in the output, without re-simplifying.
 //
-// Contract (seed; the owner refines it):
-// - build() simplifies all the way down once and records the collapse order
-//   (a totally ordered mesh: vertices renumbered by removal order, each face
-//   tagged with the collapse that removes it).
-// - extract(n) returns a mesh with at most n triangles (exactly n when the
-//   collapse order passes through n; otherwise the next lower count) without
-//   re-simplifying. extractInto() reuses the caller's buffers.
-// - Pure: no I/O, no logging. Thread-safe for concurrent const use.
+// Contract:
+// - build() validates the input (NaN/Inf, indices: kInvalidArgument naming the
+//   element), welds vertices closer than weldEpsilon * bbox diagonal, drops
+//   degenerate and duplicate triangles and unreferenced vertices (error when no
+//   triangle is left), then collapses down to stopAtTriangles (0: as far as the
+//   topology rules allow) and stores the collapse order.
+// - Collapses keep original vertex positions (vertex substitution), keep
+//   boundary vertices on the boundary, reject face flips (preventFlips), never
+//   create a non-manifold edge or close a hole, and never move a vertex that
+//   lies on a non-manifold edge of the input.
+// - extract(n): the state after the first collapse that leaves at most n
+//   triangles; exactly n when the order passes through n, else the next lower
+//   count (a collapse removes >= 1 triangle). n >= maxTriangles(): the cleaned
+//   input; n < minTriangles(): the coarsest state. Output vertices are the
+//   active vertices only, in TOM order (coarse first); attributes (normals,
+//   uvs, colors) are the input's values of the surviving vertices.
+// - Pure: no I/O, no logging, no globals. Immutable after build: concurrent
+//   const calls are safe. extractInto() reuses the caller's buffers.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
@@ -21,24 +35,61 @@
 namespace thinlod::simplifier {
 
 struct BuildOptions {
-  bool preserveBoundaries = true;  // weight boundary edges with perpendicular planes
-  bool preventFlips = true;        // reject collapses that flip a face normal
-  float attributeWeight = 0.0f;    // > 0: attribute-aware quadrics (uv/color)
+  bool preserveBoundaries = true;   // add perpendicular penalty planes on boundary edges
+  float boundaryWeight = 10.0f;     // weight of those planes relative to face planes
+  bool preventFlips = true;         // reject collapses that flip a face normal
+  float attributeWeight = 0.0f;     // > 0: penalise uv/color differences (normalised units)
+  float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
+  std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
 };
 
 class ProgressiveMesh {
  public:
-  static Result<ProgressiveMesh> build(const IndexedMesh& mesh, const BuildOptions& options);
+  ProgressiveMesh() = default;  // empty: no triangles at any resolution
+
+  static Result<ProgressiveMesh> build(const IndexedMesh& mesh, const BuildOptions& options = {});
 
   std::size_t maxTriangles() const;  // the input's triangle count (after cleanup)
   std::size_t minTriangles() const;  // where simplification stopped
+  std::size_t vertexCount() const { return positions_.size(); }  // after welding
+  std::size_t collapseCount() const { return levels_.empty() ? 0 : levels_.size() - 1; }
+  // The triangle / vertex count extract(targetTriangles) returns.
+  std::size_t triangleCountAt(std::size_t targetTriangles) const;
+  std::size_t vertexCountAt(std::size_t targetTriangles) const;
+
   IndexedMesh extract(std::size_t targetTriangles) const;
   void extractInto(std::size_t targetTriangles, IndexedMesh& out) const;
-  // The QEM error (squared distance units) of the collapse that reaches n triangles.
+
+  // Largest QEM collapse cost among the collapses that reach targetTriangles
+  // (monotone in n; 0 at full resolution). Units: squared mesh units, face
+  // planes weighted by area / mean face area.
   double quadricErrorAt(std::size_t targetTriangles) const;
+  std::size_t memoryBytes() const;  // heap bytes held by this object
 
  private:
-  // Owner defines the storage.
+  // One state of the collapse order: after `collapse` collapses, the first
+  // activeVertices vertices and the first activeTriangles triangles are live.
+  struct Level {
+    std::uint32_t activeVertices = 0;
+    std::uint32_t activeTriangles = 0;
+    float maxCost = 0.0f;
+  };
+  static constexpr std::uint32_t kNoParent = 0xffffffffu;
+
+  std::size_t levelFor(std::size_t targetTriangles) const;
+
+  // TOM storage: everything sorted so that one resolution is a prefix.
+  std::vector<glm::vec3> positions_;  // vertex i removed after vertex i + 1
+  std::vector<glm::vec3> normals_;    // empty or per vertex
+  std::vector<glm::vec2> uvs_;
+  std::vector<std::array<std::uint8_t, 4>> colors_;
+  // parent_[v] < v: the vertex v was substituted by; kNoParent when v never
+  // was (it survives, or it was dropped once no triangle used it).
+  std::vector<std::uint32_t> parent_;
+  // 3 corners per triangle, in input (level 0) vertex numbering, triangles
+  // sorted by the collapse that removes them (last removed first).
+  std::vector<std::uint32_t> indices_;
+  std::vector<Level> levels_;  // levels_[c]: after c collapses
 };
 
 }  // namespace thinlod::simplifier

@@ -1,0 +1,45 @@
+// Private: the QEM half-edge collapse loop. Greedy by collapse cost with an
+// indexed binary heap over vertices (each vertex keyed by its cheapest
+// outgoing collapse, validity checked lazily when it reaches the top), on a
+// vertex -> triangle adjacency of flat arrays. Pure; the input is a CleanMesh
+// (no repeated corners, no duplicate triangles).
+#pragma once
+
+#include <cstdint>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <vector>
+
+#include "qem_cleanup.h"
+#include "thinlod/simplifier/progressive_mesh.h"
+
+namespace thinlod::simplifier::qem {
+
+inline constexpr std::uint32_t kNone = 0xffffffffu;
+
+// The collapse order, in CleanMesh numbering. Steps are 1-based: step s is
+// the s-th collapse; "step 0" is the input.
+struct CollapseRecord {
+  // Every vertex removal in order: collapsed vertices (parent = the vertex
+  // that substituted them) and vertices left without triangles (parent kNone).
+  std::vector<std::uint32_t> removedVertex;
+  std::vector<std::uint32_t> removedParent;
+  // Per step s >= 1 (index s - 1): removals so far, triangles left, cost.
+  std::vector<std::uint32_t> removalsAfterStep;
+  std::vector<std::uint32_t> trianglesAfterStep;
+  std::vector<float> costOfStep;
+  // Per triangle: the step that removed it, 0 when it survives.
+  std::vector<std::uint32_t> triangleRemovedAtStep;
+};
+
+// Optional per-vertex attributes for attribute-aware costs (dimension 0..6
+// floats per vertex, each roughly in [0, 1]).
+struct VertexAttributes {
+  std::size_t dimension = 0;
+  std::vector<float> values;  // dimension floats per clean vertex
+};
+
+CollapseRecord runCollapses(const CleanMesh& mesh, const VertexAttributes& attributes,
+                            const BuildOptions& options);
+
+}  // namespace thinlod::simplifier::qem
