@@ -56,8 +56,14 @@ class OffscreenContext {
   // Internal: the entry-point table of this context (only src/render uses it).
   const GlFunctions& gl() const { return *gl_; }
 
+  using GlProc = void (*)();
+  using GlProcLoader = GlProc (*)(const char* name);
+
  protected:
   OffscreenContext();
+  // Back-ends call this once their context is current: loads the GL table
+  // through `loader`, checks the GL version (>= 3.3) and queries strings/limits.
+  Status initializeGl(GlProcLoader loader);
   int width_ = 0;
   int height_ = 0;
   std::string renderer_;

@@ -1,0 +1,587 @@
+#include "thinlod/common/render/mesh_renderer.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+#include <limits>
+#include <string>
+#include <unordered_map>
+
+#include "render/gl_functions.h"
+#include "render/shaders.h"
+
+namespace thinlod::render {
+namespace {
+
+// Interleaved vertex: one buffer, one VAO per mesh. 40 bytes.
+struct GpuVertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+  std::uint8_t color[4];
+  std::uint16_t layer;
+  std::uint16_t padding;
+};
+static_assert(sizeof(GpuVertex) == 40, "GpuVertex layout");
+
+struct MeshRecord {
+  GLuint vertexArray = 0;
+  GLuint vertexBuffer = 0;
+  GLuint indexBuffer = 0;
+  GLsizei indexCount = 0;
+  bool hasLayers = false;
+};
+
+struct TextureRecord {
+  GLuint texture = 0;
+  int width = 0;
+  int height = 0;
+  int layers = 0;
+  TextureOptions options;
+};
+
+Status notCurrent(const char* what) {
+  return Status(ErrorCode::kUnavailable,
+                std::string(what) + ": the renderer's GL context is not current on this thread");
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool finite(const glm::vec4& v) { return finite(glm::vec3(v)) && std::isfinite(v.w); }
+bool finite(const glm::mat4& m) {
+  return finite(m[0]) && finite(m[1]) && finite(m[2]) && finite(m[3]);
+}
+
+Status compileShader(const GlFunctions& gl, GLenum type, const char* source, GLuint& shader) {
+  shader = gl.glCreateShader(type);
+  gl.glShaderSource(shader, 1, &source, nullptr);
+  gl.glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  gl.glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok == GL_TRUE) return Status();
+  char log[2048] = {0};
+  gl.glGetShaderInfoLog(shader, sizeof(log) - 1, nullptr, log);
+  return Status(ErrorCode::kInternal,
+                std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") +
+                    " shader failed to compile: " + log);
+}
+
+}  // namespace
+
+struct MeshRenderer::Impl {
+  GLuint program = 0;
+  struct {
+    GLint model, viewProjection, normalMatrix, diffuse, specular, shininess, lit, useVertexColors,
+        textured, useVertexLayer, layer, alphaMode, alphaCutoff, texture, ambient, lightCount,
+        lightType, lightVector, lightColor, lightAttenuation, eyePosition;
+  } uniform{};
+  std::unordered_map<std::uint32_t, MeshRecord> meshes;
+  std::unordered_map<std::uint32_t, TextureRecord> textures;
+  std::uint32_t nextId = 1;
+  RenderTarget* target = nullptr;
+  GLint maxTextureSize = 0;
+  GLint maxTextureLayers = 0;
+  std::vector<GpuVertex> vertexScratch;
+  std::vector<std::uint8_t> pixelScratch;
+
+  std::uint32_t newId() {
+    // Ids are never reused while the renderer lives, so a stale handle is kNotFound.
+    return nextId++;
+  }
+};
+
+MeshRenderer::MeshRenderer(OffscreenContext& context)
+    : context_(&context), impl_(std::make_unique<Impl>()) {}
+
+MeshRenderer::~MeshRenderer() {
+  if (!context_->isCurrent()) return;  // deleting in another context would be worse than leaking
+  const GlFunctions& gl = context_->gl();
+  for (auto& entry : impl_->meshes) {
+    gl.glDeleteVertexArrays(1, &entry.second.vertexArray);
+    gl.glDeleteBuffers(1, &entry.second.vertexBuffer);
+    gl.glDeleteBuffers(1, &entry.second.indexBuffer);
+  }
+  for (auto& entry : impl_->textures) gl.glDeleteTextures(1, &entry.second.texture);
+  if (impl_->program != 0) gl.glDeleteProgram(impl_->program);
+}
+
+Result<std::unique_ptr<MeshRenderer>> MeshRenderer::create(OffscreenContext& context) {
+  if (!context.isCurrent()) return notCurrent("MeshRenderer::create");
+  std::unique_ptr<MeshRenderer> renderer(new MeshRenderer(context));
+  const GlFunctions& gl = context.gl();
+  THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "before MeshRenderer::create"));
+  GLuint vertexShader = 0;
+  GLuint fragmentShader = 0;
+  Status vertexStatus = compileShader(gl, GL_VERTEX_SHADER, kMeshVertexShader, vertexShader);
+  Status fragmentStatus =
+      compileShader(gl, GL_FRAGMENT_SHADER, kMeshFragmentShader, fragmentShader);
+  Impl& impl = *renderer->impl_;
+  impl.program = gl.glCreateProgram();
+  gl.glAttachShader(impl.program, vertexShader);
+  gl.glAttachShader(impl.program, fragmentShader);
+  if (vertexStatus.ok() && fragmentStatus.ok()) gl.glLinkProgram(impl.program);
+  gl.glDeleteShader(vertexShader);  // flagged; freed with the program
+  gl.glDeleteShader(fragmentShader);
+  THINLOD_RETURN_IF_ERROR(vertexStatus);
+  THINLOD_RETURN_IF_ERROR(fragmentStatus);
+  GLint linked = GL_FALSE;
+  gl.glGetProgramiv(impl.program, GL_LINK_STATUS, &linked);
+  if (linked != GL_TRUE) {
+    char log[2048] = {0};
+    gl.glGetProgramInfoLog(impl.program, sizeof(log) - 1, nullptr, log);
+    return Status(ErrorCode::kInternal, std::string("mesh shader program failed to link: ") + log);
+  }
+  auto location = [&](const char* name) { return gl.glGetUniformLocation(impl.program, name); };
+  auto& u = impl.uniform;
+  u.model = location("uModel");
+  u.viewProjection = location("uViewProjection");
+  u.normalMatrix = location("uNormalMatrix");
+  u.diffuse = location("uDiffuse");
+  u.specular = location("uSpecular");
+  u.shininess = location("uShininess");
+  u.lit = location("uLit");
+  u.useVertexColors = location("uUseVertexColors");
+  u.textured = location("uTextured");
+  u.useVertexLayer = location("uUseVertexLayer");
+  u.layer = location("uLayer");
+  u.alphaMode = location("uAlphaMode");
+  u.alphaCutoff = location("uAlphaCutoff");
+  u.texture = location("uTexture");
+  u.ambient = location("uAmbient");
+  u.lightCount = location("uLightCount");
+  u.lightType = location("uLightType");
+  u.lightVector = location("uLightVector");
+  u.lightColor = location("uLightColor");
+  u.lightAttenuation = location("uLightAttenuation");
+  u.eyePosition = location("uEyePosition");
+  gl.glGetIntegerv(GL_MAX_TEXTURE_SIZE, &impl.maxTextureSize);
+  gl.glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &impl.maxTextureLayers);
+  gl.glUseProgram(impl.program);
+  gl.glUniform1i(u.texture, 0);
+  gl.glUseProgram(0);
+  THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "MeshRenderer::create"));
+  return renderer;
+}
+
+// ---------------------------------------------------------------- meshes
+
+namespace {
+
+Status validateUpload(const IndexedMesh& mesh, const std::vector<std::uint16_t>& layers) {
+  THINLOD_RETURN_IF_ERROR(mesh.validate("uploaded mesh"));
+  if (!layers.empty() && layers.size() != mesh.vertexCount()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "uploaded mesh: " + std::to_string(layers.size()) + " texture layers for " +
+                      std::to_string(mesh.vertexCount()) + " vertices");
+  }
+  if (mesh.indices.size() > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max())) {
+    return Status(ErrorCode::kResourceExhausted, "uploaded mesh: too many indices for one draw");
+  }
+  return Status();
+}
+
+void buildVertices(const IndexedMesh& mesh, const std::vector<std::uint16_t>& layers,
+                   std::vector<GpuVertex>& out) {
+  IndexedMesh withNormals;
+  const std::vector<glm::vec3>* normals = &mesh.normals;
+  if (mesh.normals.empty()) {
+    withNormals.positions = mesh.positions;
+    withNormals.indices = mesh.indices;
+    withNormals.computeNormals();
+    normals = &withNormals.normals;
+  }
+  out.resize(mesh.vertexCount());
+  for (std::size_t v = 0; v < mesh.vertexCount(); ++v) {
+    GpuVertex& g = out[v];
+    std::memcpy(g.position, &mesh.positions[v], sizeof(g.position));
+    std::memcpy(g.normal, &(*normals)[v], sizeof(g.normal));
+    const glm::vec2 uv = mesh.uvs.empty() ? glm::vec2(0.0f) : mesh.uvs[v];
+    g.uv[0] = uv.x;
+    g.uv[1] = uv.y;
+    for (int c = 0; c < 4; ++c) g.color[c] = mesh.colors.empty() ? 255 : mesh.colors[v][c];
+    g.layer = layers.empty() ? 0 : layers[v];
+    g.padding = 0;
+  }
+}
+
+void fillBuffers(const GlFunctions& gl, MeshRecord& record, const std::vector<GpuVertex>& vertices,
+                 const std::vector<std::uint32_t>& indices) {
+  gl.glBindVertexArray(record.vertexArray);
+  gl.glBindBuffer(GL_ARRAY_BUFFER, record.vertexBuffer);
+  gl.glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(GpuVertex)),
+                  vertices.data(), GL_STATIC_DRAW);
+  gl.glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, record.indexBuffer);
+  gl.glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                  static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(),
+                  GL_STATIC_DRAW);
+  auto offset = [](std::size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  const GLsizei stride = sizeof(GpuVertex);
+  gl.glEnableVertexAttribArray(kAttributePosition);
+  gl.glVertexAttribPointer(kAttributePosition, 3, GL_FLOAT, GL_FALSE, stride,
+                           offset(offsetof(GpuVertex, position)));
+  gl.glEnableVertexAttribArray(kAttributeNormal);
+  gl.glVertexAttribPointer(kAttributeNormal, 3, GL_FLOAT, GL_FALSE, stride,
+                           offset(offsetof(GpuVertex, normal)));
+  gl.glEnableVertexAttribArray(kAttributeUv);
+  gl.glVertexAttribPointer(kAttributeUv, 2, GL_FLOAT, GL_FALSE, stride,
+                           offset(offsetof(GpuVertex, uv)));
+  gl.glEnableVertexAttribArray(kAttributeColor);
+  gl.glVertexAttribPointer(kAttributeColor, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride,
+                           offset(offsetof(GpuVertex, color)));
+  gl.glEnableVertexAttribArray(kAttributeLayer);
+  gl.glVertexAttribPointer(kAttributeLayer, 1, GL_UNSIGNED_SHORT, GL_FALSE, stride,
+                           offset(offsetof(GpuVertex, layer)));
+  gl.glBindVertexArray(0);
+  record.indexCount = static_cast<GLsizei>(indices.size());
+}
+
+}  // namespace
+
+Result<MeshHandle> MeshRenderer::uploadMesh(const IndexedMesh& mesh,
+                                            const std::vector<std::uint16_t>& textureLayers) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::uploadMesh");
+  THINLOD_RETURN_IF_ERROR(validateUpload(mesh, textureLayers));
+  const GlFunctions& gl = context_->gl();
+  MeshRecord record;
+  gl.glGenVertexArrays(1, &record.vertexArray);
+  gl.glGenBuffers(1, &record.vertexBuffer);
+  gl.glGenBuffers(1, &record.indexBuffer);
+  buildVertices(mesh, textureLayers, impl_->vertexScratch);
+  fillBuffers(gl, record, impl_->vertexScratch, mesh.indices);
+  record.hasLayers = !textureLayers.empty();
+  Status status = checkGlErrors(gl, "MeshRenderer::uploadMesh");
+  if (!status.ok()) {
+    gl.glDeleteVertexArrays(1, &record.vertexArray);
+    gl.glDeleteBuffers(1, &record.vertexBuffer);
+    gl.glDeleteBuffers(1, &record.indexBuffer);
+    return status;
+  }
+  const std::uint32_t id = impl_->newId();
+  impl_->meshes.emplace(id, record);
+  return MeshHandle{id};
+}
+
+Status MeshRenderer::updateMesh(MeshHandle handle, const IndexedMesh& mesh,
+                                const std::vector<std::uint16_t>& textureLayers) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::updateMesh");
+  auto it = impl_->meshes.find(handle.id);
+  if (it == impl_->meshes.end()) {
+    return Status(ErrorCode::kNotFound, "updateMesh: no mesh " + std::to_string(handle.id));
+  }
+  THINLOD_RETURN_IF_ERROR(validateUpload(mesh, textureLayers));
+  const GlFunctions& gl = context_->gl();
+  buildVertices(mesh, textureLayers, impl_->vertexScratch);
+  fillBuffers(gl, it->second, impl_->vertexScratch, mesh.indices);
+  it->second.hasLayers = !textureLayers.empty();
+  return checkGlErrors(gl, "MeshRenderer::updateMesh");
+}
+
+void MeshRenderer::deleteMesh(MeshHandle handle) {
+  auto it = impl_->meshes.find(handle.id);
+  if (it == impl_->meshes.end() || !context_->isCurrent()) return;
+  const GlFunctions& gl = context_->gl();
+  gl.glDeleteVertexArrays(1, &it->second.vertexArray);
+  gl.glDeleteBuffers(1, &it->second.vertexBuffer);
+  gl.glDeleteBuffers(1, &it->second.indexBuffer);
+  impl_->meshes.erase(it);
+}
+
+// ---------------------------------------------------------------- textures
+
+Result<TextureHandle> MeshRenderer::createTextureArray(int width, int height, int layers,
+                                                       const TextureOptions& options) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::createTextureArray");
+  if (width < 1 || height < 1 || layers < 1 || width > impl_->maxTextureSize ||
+      height > impl_->maxTextureSize || layers > impl_->maxTextureLayers ||
+      static_cast<long long>(width) * height * layers > (1LL << 28)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "texture array " + std::to_string(width) + "x" + std::to_string(height) + "x" +
+                      std::to_string(layers) + " out of range (edge 1.." +
+                      std::to_string(impl_->maxTextureSize) + ", layers 1.." +
+                      std::to_string(impl_->maxTextureLayers) + ", at most 2^28 texels)");
+  }
+  const GlFunctions& gl = context_->gl();
+  TextureRecord record;
+  record.width = width;
+  record.height = height;
+  record.layers = layers;
+  record.options = options;
+  gl.glGenTextures(1, &record.texture);
+  gl.glActiveTexture(GL_TEXTURE0);
+  gl.glBindTexture(GL_TEXTURE_2D_ARRAY, record.texture);
+  gl.glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, width, height, layers, 0, GL_RGBA,
+                  GL_UNSIGNED_BYTE, nullptr);
+  // GL leaves new storage undefined; the contract promises transparent black.
+  impl_->pixelScratch.assign(static_cast<std::size_t>(width) * height * 4, 0);
+  gl.glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  for (int layer = 0; layer < layers; ++layer) {
+    gl.glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, width, height, 1, GL_RGBA,
+                       GL_UNSIGNED_BYTE, impl_->pixelScratch.data());
+  }
+  const GLint minFilter =
+      options.mipmaps ? (options.linearFilter ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_NEAREST)
+                      : (options.linearFilter ? GL_LINEAR : GL_NEAREST);
+  gl.glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, minFilter);
+  gl.glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER,
+                     options.linearFilter ? GL_LINEAR : GL_NEAREST);
+  const GLint wrap = options.clampToEdge ? GL_CLAMP_TO_EDGE : GL_REPEAT;
+  gl.glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, wrap);
+  gl.glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, wrap);
+  if (options.mipmaps) gl.glGenerateMipmap(GL_TEXTURE_2D_ARRAY);
+  gl.glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  Status status = checkGlErrors(gl, "MeshRenderer::createTextureArray");
+  if (!status.ok()) {
+    gl.glDeleteTextures(1, &record.texture);
+    return status;
+  }
+  const std::uint32_t id = impl_->newId();
+  impl_->textures.emplace(id, record);
+  return TextureHandle{id};
+}
+
+Result<TextureHandle> MeshRenderer::uploadTexture(const RgbaImage& image,
+                                                  const TextureOptions& options) {
+  if (!image.consistent() || image.empty()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "uploadTexture: image " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height) + " with " +
+                      std::to_string(image.pixels.size()) + " bytes is empty or inconsistent");
+  }
+  auto texture = createTextureArray(image.width, image.height, 1, options);
+  if (!texture.ok()) return texture.status();
+  Status status = setTextureLayer(*texture, 0, image);
+  if (!status.ok()) {
+    deleteTexture(*texture);
+    return status;
+  }
+  return texture;
+}
+
+Status MeshRenderer::setTextureLayer(TextureHandle handle, int layer, const RgbaImage& image) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::setTextureLayer");
+  auto it = impl_->textures.find(handle.id);
+  if (it == impl_->textures.end()) {
+    return Status(ErrorCode::kNotFound, "setTextureLayer: no texture " + std::to_string(handle.id));
+  }
+  const TextureRecord& record = it->second;
+  if (layer < 0 || layer >= record.layers) {
+    return Status(ErrorCode::kInvalidArgument, "setTextureLayer: layer " + std::to_string(layer) +
+                                                   " outside 0.." +
+                                                   std::to_string(record.layers - 1));
+  }
+  if (!image.consistent() || image.empty() || image.width > record.width ||
+      image.height > record.height) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "setTextureLayer: image " + std::to_string(image.width) + "x" +
+                      std::to_string(image.height) + " is empty, inconsistent or larger than the " +
+                      std::to_string(record.width) + "x" + std::to_string(record.height) +
+                      " layer");
+  }
+  // GL texture row 0 is v = 0 (bottom); RgbaImage row 0 is the top: flip while copying.
+  const std::size_t rowBytes = static_cast<std::size_t>(image.width) * 4;
+  impl_->pixelScratch.resize(rowBytes * image.height);
+  for (int y = 0; y < image.height; ++y) {
+    std::memcpy(impl_->pixelScratch.data() + static_cast<std::size_t>(y) * rowBytes,
+                image.pixels.data() + static_cast<std::size_t>(image.height - 1 - y) * rowBytes,
+                rowBytes);
+  }
+  const GlFunctions& gl = context_->gl();
+  gl.glActiveTexture(GL_TEXTURE0);
+  gl.glBindTexture(GL_TEXTURE_2D_ARRAY, record.texture);
+  gl.glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  gl.glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, image.width, image.height, 1, GL_RGBA,
+                     GL_UNSIGNED_BYTE, impl_->pixelScratch.data());
+  if (record.options.mipmaps) gl.glGenerateMipmap(GL_TEXTURE_2D_ARRAY);
+  gl.glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  return checkGlErrors(gl, "MeshRenderer::setTextureLayer");
+}
+
+void MeshRenderer::deleteTexture(TextureHandle handle) {
+  auto it = impl_->textures.find(handle.id);
+  if (it == impl_->textures.end() || !context_->isCurrent()) return;
+  context_->gl().glDeleteTextures(1, &it->second.texture);
+  impl_->textures.erase(it);
+}
+
+// ---------------------------------------------------------------- drawing
+
+Status MeshRenderer::beginFrame(RenderTarget& target, const glm::vec4& clearColor) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::beginFrame");
+  if (&target.context() != context_) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "beginFrame: the render target belongs to another context");
+  }
+  if (!finite(clearColor)) {
+    return Status(ErrorCode::kInvalidArgument, "beginFrame: clear colour is not finite");
+  }
+  stats_ = RenderStats();
+  impl_->target = &target;
+  return target.clear(clearColor.r, clearColor.g, clearColor.b, clearColor.a);
+}
+
+Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera& camera,
+                          const Lighting& lighting) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::draw");
+  if (impl_->target == nullptr) {
+    return Status(ErrorCode::kInvalidArgument, "draw: call beginFrame first");
+  }
+  if (count > 0 && items == nullptr) {
+    return Status(ErrorCode::kInvalidArgument, "draw: null item array");
+  }
+  if (!finite(camera.view) || !finite(camera.projection)) {
+    return Status(ErrorCode::kInvalidArgument, "draw: camera matrices are not finite");
+  }
+  if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
+    return Status(ErrorCode::kInvalidArgument, "draw: " + std::to_string(lighting.lights.size()) +
+                                                   " lights, at most " +
+                                                   std::to_string(kMaxLights));
+  }
+  if (!finite(lighting.ambient)) {
+    return Status(ErrorCode::kInvalidArgument, "draw: ambient light is not finite");
+  }
+  for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
+    const Light& light = lighting.lights[i];
+    if (!finite(light.vector) || !finite(light.color) || !std::isfinite(light.attenuation) ||
+        light.attenuation < 0.0f ||
+        (light.type == Light::Type::kDirectional && glm::length(light.vector) == 0.0f)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "draw: light " + std::to_string(i) +
+                        " has a non-finite or zero vector, colour or attenuation");
+    }
+  }
+  // Validate every item before drawing any, so a bad list draws nothing.
+  for (std::size_t i = 0; i < count; ++i) {
+    const DrawItem& item = items[i];
+    const std::string name = "draw: item " + std::to_string(i);
+    auto mesh = impl_->meshes.find(item.mesh.id);
+    if (mesh == impl_->meshes.end()) {
+      return Status(ErrorCode::kNotFound, name + ": no mesh " + std::to_string(item.mesh.id));
+    }
+    const Material& m = item.material;
+    if (!finite(item.model) || !finite(m.diffuse) || !finite(m.specular) ||
+        !std::isfinite(m.shininess) || !std::isfinite(m.alphaCutoff)) {
+      return Status(ErrorCode::kInvalidArgument, name + ": non-finite model matrix or material");
+    }
+    if (m.texture.valid()) {
+      auto texture = impl_->textures.find(m.texture.id);
+      if (texture == impl_->textures.end()) {
+        return Status(ErrorCode::kNotFound, name + ": no texture " + std::to_string(m.texture.id));
+      }
+      if (!mesh->second.hasLayers &&
+          (m.textureLayer < 0 || m.textureLayer >= texture->second.layers)) {
+        return Status(ErrorCode::kInvalidArgument,
+                      name + ": texture layer " + std::to_string(m.textureLayer) + " outside 0.." +
+                          std::to_string(texture->second.layers - 1));
+      }
+    }
+  }
+
+  const GlFunctions& gl = context_->gl();
+  const auto& u = impl_->uniform;
+  THINLOD_RETURN_IF_ERROR(impl_->target->bind());
+  gl.glUseProgram(impl_->program);
+  const glm::mat4 viewProjection = camera.projection * camera.view;
+  gl.glUniformMatrix4fv(u.viewProjection, 1, GL_FALSE, glm::value_ptr(viewProjection));
+  const glm::vec3 eye = glm::vec3(glm::inverse(camera.view)[3]);
+  gl.glUniform3fv(u.eyePosition, 1, glm::value_ptr(eye));
+  gl.glUniform3fv(u.ambient, 1, glm::value_ptr(lighting.ambient));
+  GLint lightTypes[kMaxLights] = {0};
+  float lightVectors[kMaxLights * 3] = {0};
+  float lightColors[kMaxLights * 3] = {0};
+  float lightAttenuations[kMaxLights] = {0};
+  const int lightCount = static_cast<int>(lighting.lights.size());
+  for (int i = 0; i < lightCount; ++i) {
+    const Light& light = lighting.lights[i];
+    lightTypes[i] = light.type == Light::Type::kDirectional ? 0 : 1;
+    for (int c = 0; c < 3; ++c) {
+      lightVectors[i * 3 + c] = light.vector[c];
+      lightColors[i * 3 + c] = light.color[c];
+    }
+    lightAttenuations[i] = light.attenuation;
+  }
+  gl.glUniform1i(u.lightCount, lightCount);
+  gl.glUniform1iv(u.lightType, kMaxLights, lightTypes);
+  gl.glUniform3fv(u.lightVector, kMaxLights, lightVectors);
+  gl.glUniform3fv(u.lightColor, kMaxLights, lightColors);
+  gl.glUniform1fv(u.lightAttenuation, kMaxLights, lightAttenuations);
+
+  gl.glEnable(GL_DEPTH_TEST);
+  gl.glDepthFunc(GL_LEQUAL);
+  gl.glFrontFace(GL_CCW);
+  gl.glCullFace(GL_BACK);
+  gl.glActiveTexture(GL_TEXTURE0);
+  GLuint boundTexture = 0;
+  gl.glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+
+  // Pass 0: opaque and masked items, depth writes on. Pass 1: blended items,
+  // depth test on but no depth writes so later blended items still show.
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool blendPass = pass == 1;
+    if (blendPass) {
+      gl.glEnable(GL_BLEND);
+      gl.glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+      gl.glDepthMask(GL_FALSE);
+    } else {
+      gl.glDisable(GL_BLEND);
+      gl.glDepthMask(GL_TRUE);
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const DrawItem& item = items[i];
+      const Material& m = item.material;
+      if ((m.alphaMode == AlphaMode::kBlend) != blendPass) continue;
+      const MeshRecord& mesh = impl_->meshes.find(item.mesh.id)->second;
+      if (mesh.indexCount == 0) continue;
+      if (m.doubleSided) {
+        gl.glDisable(GL_CULL_FACE);
+      } else {
+        gl.glEnable(GL_CULL_FACE);
+      }
+      gl.glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
+      const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(item.model)));
+      gl.glUniformMatrix3fv(u.normalMatrix, 1, GL_FALSE, glm::value_ptr(normalMatrix));
+      gl.glUniform4fv(u.diffuse, 1, glm::value_ptr(m.diffuse));
+      gl.glUniform3fv(u.specular, 1, glm::value_ptr(m.specular));
+      gl.glUniform1f(u.shininess, m.shininess);
+      gl.glUniform1i(u.lit, m.lit ? 1 : 0);
+      gl.glUniform1i(u.useVertexColors, m.useVertexColors ? 1 : 0);
+      gl.glUniform1i(u.alphaMode, m.alphaMode == AlphaMode::kOpaque ? 0
+                                  : m.alphaMode == AlphaMode::kMask ? 1
+                                                                    : 2);
+      gl.glUniform1f(u.alphaCutoff, m.alphaCutoff);
+      const bool textured = m.texture.valid();
+      gl.glUniform1i(u.textured, textured ? 1 : 0);
+      if (textured) {
+        const GLuint texture = impl_->textures.find(m.texture.id)->second.texture;
+        if (texture != boundTexture) {
+          gl.glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
+          boundTexture = texture;
+          ++stats_.textureBinds;
+        }
+        gl.glUniform1i(u.useVertexLayer, mesh.hasLayers ? 1 : 0);
+        gl.glUniform1f(u.layer, static_cast<float>(m.textureLayer));
+      }
+      gl.glBindVertexArray(mesh.vertexArray);
+      gl.glDrawElements(GL_TRIANGLES, mesh.indexCount, GL_UNSIGNED_INT, nullptr);
+      ++stats_.drawCalls;
+      stats_.triangles += static_cast<std::size_t>(mesh.indexCount) / 3;
+    }
+  }
+  gl.glBindVertexArray(0);
+  gl.glDisable(GL_BLEND);
+  gl.glDepthMask(GL_TRUE);
+  gl.glUseProgram(0);
+  return checkGlErrors(gl, "MeshRenderer::draw");
+}
+
+Status MeshRenderer::finish() {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::finish");
+  context_->gl().glFinish();
+  return checkGlErrors(context_->gl(), "glFinish");
+}
+
+}  // namespace thinlod::render
