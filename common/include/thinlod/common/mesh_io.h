@@ -15,8 +15,9 @@
 //   are added on duplicated vertices and counted in nonManifoldTriangles;
 //   faces with repeated vertices are dropped and counted; both also produce
 //   a human-readable line in `warnings`.
-// - Normals: taken from the file when present, else computed (area-weighted)
-//   unless options say otherwise. Colours and uvs only when the file has them.
+// - Normals: unit length; taken from the file when present (normalised; all
+//   recomputed if one is zero), else computed (area-weighted) unless options
+//   say otherwise. Colours and uvs only when the file has them.
 // - Thread-safe: calls are serialised internally (OpenMesh's reader
 //   singletons and error stream are process-global).
 #pragma once

@@ -1,0 +1,524 @@
+#include "mesh/mesh_precheck.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+namespace thinlod::mesh_detail {
+namespace {
+
+// Splits `bytes` into lines (\n, \r\n or \r) and lines into tokens.
+class LineScanner {
+ public:
+  explicit LineScanner(std::string_view bytes) : bytes_(bytes) {}
+
+  // Next line; false at the end. lineNumber() is 1-based.
+  bool next(std::string_view* line) {
+    if (pos_ >= bytes_.size()) return false;
+    std::size_t end = pos_;
+    while (end < bytes_.size() && bytes_[end] != '\n' && bytes_[end] != '\r') ++end;
+    *line = bytes_.substr(pos_, end - pos_);
+    if (end < bytes_.size() && bytes_[end] == '\r' && end + 1 < bytes_.size() &&
+        bytes_[end + 1] == '\n') {
+      ++end;
+    }
+    pos_ = end + 1;
+    ++line_;
+    return true;
+  }
+  int lineNumber() const { return line_; }
+  std::size_t offset() const { return pos_ > bytes_.size() ? bytes_.size() : pos_; }
+
+ private:
+  std::string_view bytes_;
+  std::size_t pos_ = 0;
+  int line_ = 0;
+};
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+
+std::vector<std::string_view> tokenize(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && isSpace(line[i])) ++i;
+    std::size_t start = i;
+    while (i < line.size() && !isSpace(line[i])) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+  return tokens;
+}
+
+std::string quoted(std::string_view token) {
+  const std::size_t kMax = 32;
+  std::string s(token.substr(0, kMax));
+  if (token.size() > kMax) s += "...";
+  return "'" + s + "'";
+}
+
+Status lineError(const std::string& name, int line, const std::string& problem) {
+  return Status(ErrorCode::kInvalidArgument, name + ":" + std::to_string(line) + ": " + problem);
+}
+
+// All tokens from `first` on must be finite numbers.
+Status checkFiniteNumbers(const std::vector<std::string_view>& tokens, std::size_t first,
+                          std::size_t minCount, const std::string& name, int line,
+                          const char* what) {
+  if (tokens.size() < first + minCount) {
+    return lineError(name, line,
+                     std::string(what) + " needs " + std::to_string(minCount) + " numbers, found " +
+                         std::to_string(tokens.size() > first ? tokens.size() - first : 0));
+  }
+  for (std::size_t i = first; i < tokens.size(); ++i) {
+    if (tokens[i][0] == '#') break;
+    double v = 0.0;
+    if (!parseNumberToken(tokens[i], &v)) {
+      return lineError(name, line, std::string(what) + " has a bad number " + quoted(tokens[i]));
+    }
+    if (!std::isfinite(v)) {
+      return lineError(name, line,
+                       std::string(what) + " has a non-finite coordinate " + quoted(tokens[i]));
+    }
+  }
+  return Status();
+}
+
+bool parseUnsigned(std::string_view token, std::uint64_t* value) {
+  const char* end = token.data() + token.size();
+  auto [ptr, ec] = std::from_chars(token.data(), end, *value);
+  return ec == std::errc() && ptr == end;
+}
+
+bool parseSigned(std::string_view token, std::int64_t* value) {
+  const char* end = token.data() + token.size();
+  auto [ptr, ec] = std::from_chars(token.data(), end, *value);
+  return ec == std::errc() && ptr == end;
+}
+
+Status limitError(const std::string& name, const char* what, std::uint64_t count,
+                  std::uint64_t limit) {
+  return Status(ErrorCode::kResourceExhausted, name + ": " + std::to_string(count) + " " + what +
+                                                   " exceed the limit of " + std::to_string(limit));
+}
+
+// ---------------------------------------------------------------- OBJ
+
+Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& name,
+                                   const MeshLoadOptions& options) {
+  LineScanner scanner(bytes);
+  std::string_view line;
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  while (scanner.next(&line)) {
+    const std::vector<std::string_view> tokens = tokenize(line);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    const std::string_view key = tokens[0];
+    const int ln = scanner.lineNumber();
+    if (key == "v") {
+      THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex"));
+      if (++vertices > options.maxVertices) {
+        return limitError(name, "vertices", vertices, options.maxVertices);
+      }
+    } else if (key == "vn") {
+      THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "normal"));
+    } else if (key == "vt") {
+      THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 2, name, ln, "texture coordinate"));
+    } else if (key == "f") {
+      std::size_t corners = 0;
+      for (std::size_t i = 1; i < tokens.size() && tokens[i][0] != '#'; ++i) {
+        // "v", "v/t", "v//n", "v/t/n": the vertex index is before the first '/'.
+        const std::string_view ref = tokens[i].substr(0, tokens[i].find('/'));
+        std::int64_t index = 0;
+        if (!parseSigned(ref, &index)) {
+          return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[i]));
+        }
+        // Positive indices are 1-based, negative ones count back from the
+        // last vertex read so far.
+        const std::int64_t n = static_cast<std::int64_t>(vertices);
+        if (index == 0 || index > n || index < -n) {
+          return lineError(name, ln,
+                           "face references vertex " + std::to_string(index) + " (only " +
+                               std::to_string(vertices) + " vertices so far)");
+        }
+        ++corners;
+      }
+      if (corners < 3) {
+        return lineError(name, ln,
+                         "face has " + std::to_string(corners) + " vertices (needs at least 3)");
+      }
+      if (++faces > options.maxFaces) return limitError(name, "faces", faces, options.maxFaces);
+    }
+  }
+  PrecheckResult result;
+  result.declaredFaces = faces;
+  return result;
+}
+
+// ---------------------------------------------------------------- OFF
+
+Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& name,
+                                   const MeshLoadOptions& options) {
+  LineScanner scanner(bytes);
+  std::string_view line;
+  auto nextContentLine = [&](std::vector<std::string_view>* tokens) {
+    while (scanner.next(&line)) {
+      *tokens = tokenize(line);
+      if (!tokens->empty() && (*tokens)[0][0] != '#') return true;
+    }
+    return false;
+  };
+  std::vector<std::string_view> tokens;
+  if (!nextContentLine(&tokens)) {
+    return Status(ErrorCode::kInvalidArgument, name + ": empty OFF file");
+  }
+  const std::string_view magic = tokens[0];
+  if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") {
+    return lineError(name, scanner.lineNumber(), "expected an OFF header, found " + quoted(magic));
+  }
+  if (magic.find('4') != std::string_view::npos || magic.find("n") == 0) {
+    return Status(ErrorCode::kUnsupported,
+                  name + ": OFF variant " + quoted(magic) + " (4D / nD) is not supported");
+  }
+  std::size_t countStart = 1;
+  if (tokens.size() > 1 && tokens[1] == "BINARY") {
+    return Status(ErrorCode::kUnsupported, name + ": binary OFF is not supported");
+  }
+  if (tokens.size() <= countStart) {
+    if (!nextContentLine(&tokens)) {
+      return Status(ErrorCode::kInvalidArgument, name + ": truncated: no vertex/face counts");
+    }
+    countStart = 0;
+  }
+  std::uint64_t nv = 0;
+  std::uint64_t nf = 0;
+  if (tokens.size() < countStart + 2 || !parseUnsigned(tokens[countStart], &nv) ||
+      !parseUnsigned(tokens[countStart + 1], &nf)) {
+    return lineError(name, scanner.lineNumber(), "expected vertex and face counts");
+  }
+  if (nv > options.maxVertices) return limitError(name, "vertices", nv, options.maxVertices);
+  if (nf > options.maxFaces) return limitError(name, "faces", nf, options.maxFaces);
+  // "x y z\n" is at least 6 bytes, "3 a b c\n" at least 8.
+  const std::uint64_t remaining = bytes.size() - scanner.offset();
+  if (nv * 6 + nf * 8 > remaining) {
+    return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                   std::to_string(nv) + " vertices and " +
+                                                   std::to_string(nf) + " faces but only " +
+                                                   std::to_string(remaining) + " bytes follow");
+  }
+  for (std::uint64_t v = 0; v < nv; ++v) {
+    if (!nextContentLine(&tokens)) {
+      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                     std::to_string(nv) + " vertices, found " +
+                                                     std::to_string(v));
+    }
+    THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 0, 3, name, scanner.lineNumber(), "vertex"));
+  }
+  for (std::uint64_t f = 0; f < nf; ++f) {
+    if (!nextContentLine(&tokens)) {
+      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                     std::to_string(nf) + " faces, found " +
+                                                     std::to_string(f));
+    }
+    const int ln = scanner.lineNumber();
+    std::uint64_t k = 0;
+    if (!parseUnsigned(tokens[0], &k) || k < 3) {
+      return lineError(name, ln, "face needs a vertex count >= 3, found " + quoted(tokens[0]));
+    }
+    if (tokens.size() < k + 1) {
+      return lineError(name, ln,
+                       "face declares " + std::to_string(k) + " vertices, found " +
+                           std::to_string(tokens.size() - 1));
+    }
+    for (std::uint64_t i = 1; i <= k; ++i) {
+      std::uint64_t index = 0;
+      if (!parseUnsigned(tokens[i], &index)) {
+        return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[i]));
+      }
+      if (index >= nv) {
+        return lineError(name, ln,
+                         "face references vertex " + std::to_string(index) + " (only " +
+                             std::to_string(nv) + " vertices)");
+      }
+    }
+  }
+  PrecheckResult result;
+  result.declaredFaces = nf;
+  return result;
+}
+
+// ---------------------------------------------------------------- PLY
+
+struct PlyProperty {
+  std::string name;
+  int scalarBytes = 0;     // size of the value (or of the list entries)
+  int listCountBytes = 0;  // 0: not a list
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+int plyTypeBytes(std::string_view type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32") {
+    return 4;
+  }
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& name,
+                                   const MeshLoadOptions& options) {
+  LineScanner scanner(bytes);
+  std::string_view line;
+  if (!scanner.next(&line) || line != "ply") {
+    return Status(ErrorCode::kInvalidArgument, name + ": missing 'ply' magic line");
+  }
+  std::string format;
+  std::vector<PlyElement> elements;
+  bool ended = false;
+  while (!ended && scanner.next(&line)) {
+    const std::vector<std::string_view> tokens = tokenize(line);
+    const int ln = scanner.lineNumber();
+    if (tokens.empty()) continue;
+    const std::string_view key = tokens[0];
+    if (key == "format") {
+      if (tokens.size() < 3 || tokens[2] != "1.0") {
+        return Status(ErrorCode::kVersionMismatch,
+                      name + ":" + std::to_string(ln) + ": unsupported PLY format line");
+      }
+      format = std::string(tokens[1]);
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
+        return lineError(name, ln, "unknown PLY format " + quoted(tokens[1]));
+      }
+    } else if (key == "element") {
+      PlyElement e;
+      if (tokens.size() < 3 || !parseUnsigned(tokens[2], &e.count)) {
+        return lineError(name, ln, "element line needs a name and a count");
+      }
+      e.name = std::string(tokens[1]);
+      elements.push_back(e);
+    } else if (key == "property") {
+      if (elements.empty()) return lineError(name, ln, "property before any element");
+      PlyProperty p;
+      if (tokens.size() >= 5 && tokens[1] == "list") {
+        p.listCountBytes = plyTypeBytes(tokens[2]);
+        p.scalarBytes = plyTypeBytes(tokens[3]);
+        p.name = std::string(tokens[4]);
+      } else if (tokens.size() >= 3) {
+        p.scalarBytes = plyTypeBytes(tokens[1]);
+        p.name = std::string(tokens[2]);
+      }
+      if (p.scalarBytes == 0 || (tokens[1] == "list" && p.listCountBytes == 0)) {
+        return lineError(name, ln, "bad property line");
+      }
+      elements.back().properties.push_back(p);
+    } else if (key == "end_header") {
+      ended = true;
+    } else if (key != "comment" && key != "obj_info") {
+      return lineError(name, ln, "unknown PLY header keyword " + quoted(key));
+    }
+  }
+  if (!ended) return Status(ErrorCode::kInvalidArgument, name + ": truncated: no end_header");
+  if (format.empty()) return Status(ErrorCode::kInvalidArgument, name + ": no format line");
+
+  std::uint64_t nv = 0;
+  std::uint64_t nf = 0;
+  for (const PlyElement& e : elements) {
+    if (e.name == "vertex") nv = e.count;
+    if (e.name == "face") nf = e.count;
+  }
+  if (nv > options.maxVertices) return limitError(name, "vertices", nv, options.maxVertices);
+  if (nf > options.maxFaces) return limitError(name, "faces", nf, options.maxFaces);
+
+  PrecheckResult result;
+  result.declaredFaces = nf;
+  result.binary = format != "ascii";
+  const std::uint64_t body = bytes.size() - scanner.offset();
+  if (result.binary) {
+    // Lower bound on the body: fixed-size properties exactly, lists with
+    // their count and (for faces) three entries.
+    std::uint64_t needed = 0;
+    for (const PlyElement& e : elements) {
+      std::uint64_t perItem = 0;
+      for (const PlyProperty& p : e.properties) {
+        if (p.listCountBytes == 0) {
+          perItem += static_cast<std::uint64_t>(p.scalarBytes);
+        } else {
+          perItem += static_cast<std::uint64_t>(p.listCountBytes) +
+                     (e.name == "face" ? 3u * static_cast<std::uint64_t>(p.scalarBytes) : 0u);
+        }
+      }
+      if (perItem != 0 &&
+          e.count > (std::numeric_limits<std::uint64_t>::max() - needed) / perItem) {
+        needed = std::numeric_limits<std::uint64_t>::max();
+        break;
+      }
+      needed += perItem * e.count;
+    }
+    if (needed > body) {
+      return Status(ErrorCode::kInvalidArgument,
+                    name + ": truncated: header declares " + std::to_string(nv) + " vertices and " +
+                        std::to_string(nf) + " faces, needing at least " + std::to_string(needed) +
+                        " bytes of data, file has " + std::to_string(body));
+    }
+    return result;
+  }
+  // ASCII: one line per element item, in header order.
+  std::vector<std::string_view> tokens;
+  for (const PlyElement& e : elements) {
+    if (e.count * 2 > body) {
+      return Status(ErrorCode::kInvalidArgument,
+                    name + ": truncated: header declares " + std::to_string(e.count) + " " +
+                        e.name + " items but only " + std::to_string(body) + " bytes follow");
+    }
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      do {
+        if (!scanner.next(&line)) {
+          return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                         std::to_string(e.count) + " " + e.name +
+                                                         " items, found " + std::to_string(i));
+        }
+        tokens = tokenize(line);
+      } while (tokens.empty());
+      const int ln = scanner.lineNumber();
+      if (e.name == "vertex") {
+        THINLOD_RETURN_IF_ERROR(
+            checkFiniteNumbers(tokens, 0, e.properties.size(), name, ln, "vertex"));
+      } else if (e.name == "face" && !e.properties.empty() && e.properties[0].listCountBytes != 0) {
+        std::uint64_t k = 0;
+        if (!parseUnsigned(tokens[0], &k) || k < 3 || tokens.size() < k + 1) {
+          return lineError(name, ln, "bad face line");
+        }
+        for (std::uint64_t j = 1; j <= k; ++j) {
+          std::uint64_t index = 0;
+          if (!parseUnsigned(tokens[j], &index)) {
+            return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[j]));
+          }
+          if (index >= nv) {
+            return lineError(name, ln,
+                             "face references vertex " + std::to_string(index) + " (only " +
+                                 std::to_string(nv) + " vertices)");
+          }
+        }
+      }
+    }
+  }
+  return result;
+}
+
+// ---------------------------------------------------------------- STL
+
+bool startsWithSolid(std::string_view bytes) {
+  std::size_t i = 0;
+  while (i < bytes.size() && (isSpace(bytes[i]) || bytes[i] == '\n' || bytes[i] == '\r')) ++i;
+  return bytes.substr(i, 5) == "solid";
+}
+
+std::uint32_t readLe32(const char* p) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(p[i]);
+  return v;
+}
+
+Result<PrecheckResult> precheckStl(std::string_view bytes, const std::string& name,
+                                   const MeshLoadOptions& options) {
+  PrecheckResult result;
+  const std::size_t kHeader = 84;
+  const std::size_t kTriangle = 50;
+  std::uint64_t declared = bytes.size() >= kHeader ? readLe32(bytes.data() + 80) : 0;
+  const bool exactBinary =
+      bytes.size() >= kHeader && kHeader + declared * kTriangle == bytes.size();
+  if (exactBinary) {
+    result.binary = true;
+    result.declaredFaces = declared;
+    if (declared > options.maxFaces) return limitError(name, "faces", declared, options.maxFaces);
+    for (std::uint64_t t = 0; t < declared; ++t) {
+      const char* tri = bytes.data() + kHeader + t * kTriangle;
+      for (int k = 3; k < 12; ++k) {  // skip the facet normal, check the corners
+        float f = 0.0f;
+        std::memcpy(&f, tri + 4 * k, 4);
+        if (!std::isfinite(f)) {
+          return Status(ErrorCode::kInvalidArgument,
+                        name + ": triangle " + std::to_string(t) + " has a non-finite coordinate");
+        }
+      }
+    }
+    return result;
+  }
+  if (!startsWithSolid(bytes)) {
+    if (bytes.size() < kHeader) {
+      return Status(ErrorCode::kInvalidArgument, name + ": too short for a binary STL (" +
+                                                     std::to_string(bytes.size()) +
+                                                     " bytes) and not an ASCII STL");
+    }
+    return Status(ErrorCode::kInvalidArgument,
+                  name + ": truncated: binary STL declares " + std::to_string(declared) +
+                      " triangles (" + std::to_string(kHeader + declared * kTriangle) +
+                      " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
+  }
+  LineScanner scanner(bytes);
+  std::string_view line;
+  std::uint64_t corners = 0;
+  bool endSolid = false;
+  while (scanner.next(&line)) {
+    const std::vector<std::string_view> tokens = tokenize(line);
+    if (tokens.empty()) continue;
+    if (tokens[0] == "vertex") {
+      THINLOD_RETURN_IF_ERROR(
+          checkFiniteNumbers(tokens, 1, 3, name, scanner.lineNumber(), "vertex"));
+      ++corners;
+    } else if (tokens[0] == "endsolid") {
+      endSolid = true;
+    }
+  }
+  if (!endSolid || corners % 3 != 0) {
+    return Status(ErrorCode::kInvalidArgument, name + ": truncated ASCII STL (no endsolid)");
+  }
+  result.declaredFaces = corners / 3;
+  if (result.declaredFaces > options.maxFaces) {
+    return limitError(name, "faces", result.declaredFaces, options.maxFaces);
+  }
+  return result;
+}
+
+}  // namespace
+
+bool parseNumberToken(std::string_view token, double* value) {
+  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  auto [ptr, ec] = std::from_chars(token.data(), end, *value);
+  if (ptr != end) return false;
+  if (ec == std::errc::result_out_of_range) {
+    // Overflow or underflow: strtod tells them apart (HUGE_VAL vs ~0).
+    const std::string copy(token);
+    *value = std::strtod(copy.c_str(), nullptr);
+    return true;
+  }
+  return ec == std::errc();
+}
+
+Result<PrecheckResult> precheckMesh(std::string_view bytes, MeshFormat format,
+                                    const std::string& name, const MeshLoadOptions& options) {
+  switch (format) {
+    case MeshFormat::kObj:
+      return precheckObj(bytes, name, options);
+    case MeshFormat::kOff:
+      return precheckOff(bytes, name, options);
+    case MeshFormat::kPly:
+      return precheckPly(bytes, name, options);
+    case MeshFormat::kStl:
+      return precheckStl(bytes, name, options);
+  }
+  return Status(ErrorCode::kInternal, name + ": unknown format");
+}
+
+}  // namespace thinlod::mesh_detail

@@ -1,0 +1,32 @@
+// Pre-checks of mesh files before OpenMesh reads them. OpenMesh trusts its
+// input: a header count of 2e9 makes it allocate (bad_alloc), a "nan" in an
+// OBJ is silently skipped, and a truncated OFF yields garbage faces. These
+// scans reject such files with a message naming the line or byte count.
+// Pure functions over bytes in memory.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::mesh_detail {
+
+enum class MeshFormat { kObj, kPly, kOff, kStl };
+
+struct PrecheckResult {
+  bool binary = false;              // PLY / STL: OpenMesh needs to be told for STL
+  std::uint64_t declaredFaces = 0;  // from the header (0 when the format has none)
+};
+
+// `name` prefixes every message.
+Result<PrecheckResult> precheckMesh(std::string_view bytes, MeshFormat format,
+                                    const std::string& name, const MeshLoadOptions& options);
+
+// std::from_chars on a token (a leading '+' allowed); false when the token
+// is not a number. `*value` may be non-finite ("nan", "inf", overflow).
+bool parseNumberToken(std::string_view token, double* value);
+
+}  // namespace thinlod::mesh_detail

@@ -1,0 +1,279 @@
+#include "thinlod/common/mesh_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace thinlod {
+namespace {
+
+std::string modelPath(const std::string& file) {
+  return std::string(THINLOD_SHARED_DIR) + "/models/" + file;
+}
+std::string dataPath(const std::string& file) {
+  return std::string(THINLOD_TEST_DATA_DIR) + "/mesh/" + file;
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+// Every shared model loads with the triangle count of models/README.md.
+struct ModelCase {
+  const char* file;
+  std::size_t triangles;
+};
+
+class SharedModels : public ::testing::TestWithParam<ModelCase> {};
+
+TEST_P(SharedModels, LoadsWithReadmeTriangleCount) {
+  const ModelCase& c = GetParam();
+  Result<LoadedMesh> r = loadMeshFile(modelPath(c.file));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.triangleCount(), c.triangles);
+  EXPECT_TRUE(r->mesh.validate(c.file).ok());
+  EXPECT_EQ(r->mesh.normals.size(), r->mesh.vertexCount());
+  EXPECT_GT(r->mesh.diameter(), 0.0f);
+}
+
+// suzanne.obj: the README lists 500, which is its face count (468 quads and
+// 32 triangles); triangulated that is 468 * 2 + 32 = 968 triangles.
+INSTANTIATE_TEST_SUITE_P(
+    Readme, SharedModels,
+    ::testing::Values(ModelCase{"cow.obj", 5804}, ModelCase{"stanford-bunny.obj", 69451},
+                      ModelCase{"horse.ply", 96966}, ModelCase{"fandisk.obj", 12946},
+                      ModelCase{"nefertiti.obj", 99938}, ModelCase{"ogre.obj", 124008},
+                      ModelCase{"spot.obj", 5856}, ModelCase{"teapot.obj", 6320},
+                      ModelCase{"suzanne.obj", 968}, ModelCase{"cheburashka.obj", 13334},
+                      ModelCase{"woody.obj", 1267}),
+    [](const ::testing::TestParamInfo<ModelCase>& info) {
+      std::string n = info.param.file;
+      for (char& ch : n) {
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      }
+      return n;
+    });
+
+TEST(MeshIo, CowReportsItsNonManifoldTriangles) {
+  Result<LoadedMesh> r = loadMeshFile(modelPath("cow.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->nonManifoldTriangles, 4u);
+  ASSERT_FALSE(r->warnings.empty());
+  EXPECT_TRUE(contains(r->warnings[0], "cow.obj")) << r->warnings[0];
+  EXPECT_TRUE(contains(r->warnings[0], "non-manifold")) << r->warnings[0];
+}
+
+TEST(MeshIo, SpotKeepsTextureCoordinates) {
+  Result<LoadedMesh> r = loadMeshFile(modelPath("spot.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.uvs.size(), r->mesh.vertexCount());
+}
+
+TEST(MeshIo, HorseBinaryPlyKeepsFileNormals) {
+  Result<LoadedMesh> r = loadMeshFile(modelPath("horse.ply"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  ASSERT_EQ(r->mesh.normals.size(), r->mesh.vertexCount());
+  EXPECT_NEAR(std::sqrt(r->mesh.normals[0].x * r->mesh.normals[0].x +
+                        r->mesh.normals[0].y * r->mesh.normals[0].y +
+                        r->mesh.normals[0].z * r->mesh.normals[0].z),
+              1.0f, 1e-3f);
+}
+
+// ---- small good files, one per reader
+
+struct GoodCase {
+  const char* file;
+  std::size_t vertices;
+  std::size_t triangles;
+};
+
+class GoodFiles : public ::testing::TestWithParam<GoodCase> {};
+
+TEST_P(GoodFiles, Load) {
+  const GoodCase& c = GetParam();
+  Result<LoadedMesh> r = loadMeshFile(dataPath(c.file));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.vertexCount(), c.vertices);
+  EXPECT_EQ(r->mesh.triangleCount(), c.triangles);
+  EXPECT_TRUE(r->warnings.empty()) << r->warnings[0];
+  const Bounds b = r->mesh.bounds();
+  EXPECT_FLOAT_EQ(b.min.x, 0.0f);
+  EXPECT_FLOAT_EQ(b.max.x, 1.0f);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, GoodFiles,
+                         ::testing::Values(GoodCase{"good_tetra.obj", 4, 4},
+                                           GoodCase{"good_tetra.off", 4, 4},
+                                           GoodCase{"good_tetra_ascii.ply", 4, 4},
+                                           GoodCase{"good_tetra_binary.ply", 4, 4},
+                                           GoodCase{"good_two_tris_ascii.stl", 4, 2},
+                                           GoodCase{"good_two_tris_binary.stl", 4, 2}),
+                         [](const ::testing::TestParamInfo<GoodCase>& info) {
+                           std::string n = info.param.file;
+                           for (char& ch : n) {
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           }
+                           return n;
+                         });
+
+TEST(MeshIo, BinaryPlyColoursAreRead) {
+  Result<LoadedMesh> r = loadMeshFile(dataPath("good_tetra_binary.ply"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  ASSERT_EQ(r->mesh.colors.size(), 4u);
+  EXPECT_EQ(r->mesh.colors[0][0], 200);
+  EXPECT_EQ(r->mesh.colors[0][1], 100);
+  EXPECT_EQ(r->mesh.colors[0][2], 50);
+}
+
+TEST(MeshIo, NonManifoldEdgeIsCountedNotFatal) {
+  // Four triangles share the edge 1-2.
+  Result<LoadedMesh> r = loadMeshFile(dataPath("nonmanifold_edge.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.triangleCount(), 4u);
+  EXPECT_EQ(r->nonManifoldTriangles, 2u);
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_TRUE(contains(r->warnings[0], "2 non-manifold triangles")) << r->warnings[0];
+}
+
+TEST(MeshIo, MemoryLoadMatchesFileLoad) {
+  const std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\n";
+  Result<LoadedMesh> r = loadMeshFromMemory(text, "obj", "quad.obj");
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.triangleCount(), 2u);  // the quad is triangulated
+}
+
+TEST(MeshIo, SaveAndReloadRoundTrips) {
+  Result<LoadedMesh> r = loadMeshFile(dataPath("good_tetra.obj"));
+  ASSERT_TRUE(r.ok());
+  for (const char* ext : {"obj", "off", "ply", "stl"}) {
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("thinlod_roundtrip_" + std::to_string(::getpid()) + "." + ext))
+                                 .string();
+    const Status saved = saveMeshFile(r->mesh, path, std::string(ext) == "ply");
+    ASSERT_TRUE(saved.ok()) << saved.toString();
+    Result<LoadedMesh> back = loadMeshFile(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(back.ok()) << ext << ": " << back.status().toString();
+    EXPECT_EQ(back->mesh.triangleCount(), 4u) << ext;
+    EXPECT_NEAR(back->mesh.diameter(), r->mesh.diameter(), 1e-6f) << ext;
+  }
+}
+
+// ---- broken files: each gives its error, naming the file and the problem
+
+struct BrokenCase {
+  const char* file;
+  ErrorCode code;
+  const char* messagePart;
+};
+
+class BrokenFiles : public ::testing::TestWithParam<BrokenCase> {};
+
+TEST_P(BrokenFiles, GiveANamedError) {
+  const BrokenCase& c = GetParam();
+  Result<LoadedMesh> r = loadMeshFile(dataPath(c.file));
+  ASSERT_FALSE(r.ok()) << c.file << " loaded";
+  EXPECT_EQ(r.status().code(), c.code) << r.status().toString();
+  EXPECT_TRUE(contains(r.status().message(), c.file)) << r.status().message();
+  EXPECT_TRUE(contains(r.status().message(), c.messagePart)) << r.status().message();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Files, BrokenFiles,
+    ::testing::Values(
+        BrokenCase{"does_not_exist.obj", ErrorCode::kNotFound, "no such file"},
+        BrokenCase{"something.xyz", ErrorCode::kUnsupported, "unknown mesh file extension"},
+        BrokenCase{"empty.obj", ErrorCode::kInvalidArgument, "empty file"},
+        BrokenCase{"garbage.obj", ErrorCode::kInvalidArgument, "no faces"},
+        BrokenCase{"no_faces.obj", ErrorCode::kInvalidArgument, "no faces"},
+        BrokenCase{"nan_coord.obj", ErrorCode::kInvalidArgument, ":3: vertex has a non-finite"},
+        BrokenCase{"inf_coord.obj", ErrorCode::kInvalidArgument, ":3: vertex has a non-finite"},
+        BrokenCase{"bad_index.obj", ErrorCode::kInvalidArgument, ":5: face references vertex 99"},
+        BrokenCase{"bad_index.off", ErrorCode::kInvalidArgument, "face references vertex 7"},
+        BrokenCase{"truncated.off", ErrorCode::kInvalidArgument, "truncated"},
+        BrokenCase{"huge_count.off", ErrorCode::kResourceExhausted, "exceed the limit"},
+        BrokenCase{"huge_count.ply", ErrorCode::kResourceExhausted, "exceed the limit"},
+        BrokenCase{"truncated_binary.ply", ErrorCode::kInvalidArgument, "truncated"},
+        BrokenCase{"truncated_binary.stl", ErrorCode::kInvalidArgument, "truncated"},
+        BrokenCase{"nan_coord.stl", ErrorCode::kInvalidArgument, "non-finite"}),
+    [](const ::testing::TestParamInfo<BrokenCase>& info) {
+      std::string n = info.param.file;
+      for (char& ch : n) {
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      }
+      return n;
+    });
+
+TEST(MeshIo, DirectoryIsNotAMesh) {
+  Result<LoadedMesh> r = loadMeshFile(std::string(THINLOD_TEST_DATA_DIR) + "/mesh.obj");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kNotFound);
+}
+
+TEST(MeshIo, FileSizeLimitIsEnforced) {
+  MeshLoadOptions options;
+  options.maxFileBytes = 16;
+  Result<LoadedMesh> r = loadMeshFile(dataPath("good_tetra.obj"), options);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(MeshIo, BinaryPlyWithNaNIsRejected) {
+  std::ifstream in(dataPath("good_tetra_binary.ply"), std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t body = bytes.find("end_header\n") + 11;
+  const float nan = std::nanf("");
+  std::memcpy(&bytes[body + 4], &nan, 4);  // y of vertex 0
+  Result<LoadedMesh> r = loadMeshFromMemory(bytes, "ply", "nan.ply");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.status().message(), "nan.ply: vertex 0")) << r.status().message();
+}
+
+// Memory safety: every truncated prefix and random byte corruptions of valid
+// files give a result (ok or error), never a crash or a hang.
+TEST(MeshIo, TruncatedPrefixesNeverCrash) {
+  for (const char* file :
+       {"good_tetra.obj", "good_tetra.off", "good_tetra_ascii.ply", "good_tetra_binary.ply",
+        "good_two_tris_ascii.stl", "good_two_tris_binary.stl"}) {
+    std::ifstream in(dataPath(file), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string ext = std::string(file).substr(std::string(file).rfind('.') + 1);
+    for (std::size_t n = 0; n < bytes.size(); ++n) {
+      Result<LoadedMesh> r = loadMeshFromMemory(std::string_view(bytes).substr(0, n), ext, file);
+      if (r.ok()) EXPECT_TRUE(r->mesh.validate(file).ok());
+    }
+  }
+}
+
+TEST(MeshIo, RandomCorruptionsNeverCrash) {
+  std::uint32_t state = 12345u;  // fixed seed
+  auto next = [&state]() {
+    state = state * 1664525u + 1013904223u;
+    return state >> 8;
+  };
+  for (const char* file : {"good_tetra.obj", "good_tetra.off", "good_tetra_ascii.ply",
+                           "good_tetra_binary.ply", "good_two_tris_binary.stl"}) {
+    std::ifstream in(dataPath(file), std::ios::binary);
+    const std::string original((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+    const std::string ext = std::string(file).substr(std::string(file).rfind('.') + 1);
+    for (int trial = 0; trial < 300; ++trial) {
+      std::string bytes = original;
+      const int flips = 1 + static_cast<int>(next() % 4);
+      for (int k = 0; k < flips; ++k) {
+        bytes[next() % bytes.size()] = static_cast<char>(next() & 0xff);
+      }
+      Result<LoadedMesh> r = loadMeshFromMemory(bytes, ext, file);
+      if (r.ok()) EXPECT_TRUE(r->mesh.validate(file).ok());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace thinlod
