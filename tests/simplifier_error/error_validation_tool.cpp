@@ -21,8 +21,8 @@ namespace {
 
 using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
-// Writes only referenced vertices; fails if OpenMesh rejects a face
-// (non-manifold), so MeshLab sees exactly the mesh we measure.
+// Writes only referenced vertices and every triangle, so MeshLab sees
+// exactly the surface we measure.
 bool writePly(const thinlod::IndexedMesh& mesh, const std::string& path) {
   OmMesh om;
   std::vector<OmMesh::VertexHandle> handles(mesh.vertexCount());
@@ -35,13 +35,24 @@ bool writePly(const thinlod::IndexedMesh& mesh, const std::string& path) {
     }
   }
   for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    const auto f = om.add_face(handles[mesh.indices[t]], handles[mesh.indices[t + 1]],
-                               handles[mesh.indices[t + 2]]);
+    auto f = om.add_face(handles[mesh.indices[t]], handles[mesh.indices[t + 1]],
+                         handles[mesh.indices[t + 2]]);
+    if (!f.is_valid()) {
+      // Non-manifold here: give the triangle its own copies of its corners.
+      // The surface (all the Hausdorff distance sees) is unchanged.
+      OmMesh::VertexHandle copies[3];
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3& p = mesh.positions[mesh.indices[t + k]];
+        copies[k] = om.add_vertex(OmMesh::Point(p.x, p.y, p.z));
+      }
+      f = om.add_face(copies[0], copies[1], copies[2]);
+    }
     if (!f.is_valid()) {
       std::fprintf(stderr, "%s: OpenMesh rejected triangle %zu\n", path.c_str(), t / 3);
       return false;
     }
   }
+  if (om.n_faces() != mesh.triangleCount()) return false;
   OpenMesh::IO::Options options = OpenMesh::IO::Options::Binary;
   return OpenMesh::IO::write_mesh(om, path, options);
 }
