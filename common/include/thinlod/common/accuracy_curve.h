@@ -53,8 +53,7 @@ class AccuracyCurve {
   // Validates the invariants above; the error names the offending triple.
   static Result<AccuracyCurve> fromTriples(const std::vector<CurveTriple>& triples,
                                            double maxAccuracy);
-  static Result<AccuracyCurve> fromSegments(std::vector<CurveSegment> segments,
-                                            double maxAccuracy);
+  static Result<AccuracyCurve> fromSegments(std::vector<CurveSegment> segments, double maxAccuracy);
   // A single representation: accuracy `accuracy` for `resources` (a point curve,
   // domain [accuracy, accuracy]).
   static AccuracyCurve point(double accuracy, double resources);
@@ -68,6 +67,8 @@ class AccuracyCurve {
   // r(a) on the domain. Left of the domain: r(minAccuracy) (a better
   // representation is acceptable). Right of it: +infinity (unreachable).
   // This is "the fewest resources that reach at least accuracy a".
+  // Empty curve: 0 everywhere. NaN a: +infinity. Exactly non-decreasing in
+  // floating point (every operation keeps that), O(log segments).
   double resourcesFor(double a) const;
   // Like resourcesFor, but right of the domain r(maxAccuracy): the Group
   // rule "render at your best when more is asked".
@@ -76,7 +77,9 @@ class AccuracyCurve {
   // The largest accuracy a in the domain with resourcesFor(a) <= budget
   // (exactly: a double for which resourcesFor(a) <= budget holds and the next
   // larger double either leaves the domain or exceeds the budget).
-  // std::nullopt when even minAccuracy costs more than budget.
+  // std::nullopt when even minAccuracy costs more than budget (or budget is
+  // NaN). At a vertical jump the answer is the last double below the jump.
+  // Empty curve: +infinity for budget >= 0 (everything is free).
   std::optional<double> maxAccuracyWithin(double budget) const;
 
   // Scales the accuracy axis by factor > 0: new r(a) = old r(a / factor).
@@ -86,10 +89,14 @@ class AccuracyCurve {
 
   // Group node: r(a) = sum of children's resourcesForClamped(a), on the union
   // of the children's domains (horizontal extension both sides).
+  // O(total knots * log children); values carry O(log children) roundings.
   static AccuracyCurve sum(const std::vector<const AccuracyCurve*>& children);
   // LOD node: r(a) = min of children's resourcesFor(a) (left extension only),
   // crossings computed exactly, monotone, no cracks. Also reports which child
-  // is cheapest on each resulting segment.
+  // is cheapest on each resulting segment (index into `children`).
+  // A child stays available up to and including its maxAccuracy, so where
+  // the cheapest child runs out the envelope jumps at the next double above
+  // that maxAccuracy. O(total knots and crossings * log children).
   static AccuracyCurve lowerEnvelope(const std::vector<const AccuracyCurve*>& children,
                                      std::vector<int>* segmentOwner = nullptr);
 
@@ -97,7 +104,10 @@ class AccuracyCurve {
   // conservatively: for every a, the fitted r(a) >= the measured staircase
   // min{ r_j : a_j >= a }, so the curve never promises more accuracy than was
   // measured for a given resource. Samples need not be sorted or monotone
-  // (dominated samples are dropped). Errors on no samples or non-finite data.
+  // (dominated samples are dropped). Errors on no samples, non-finite data,
+  // negative resources or maxSegments < 1. Domain [lowest, highest sample
+  // accuracy]. With enough segments the result is the staircase itself;
+  // otherwise a dynamic program picks the pieces of least area above it.
   static Result<AccuracyCurve> fitConservative(std::vector<AccuracySample> samples,
                                                int maxSegments);
 
