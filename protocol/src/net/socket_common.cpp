@@ -1,0 +1,35 @@
+#include <cstdio>
+#include <mutex>
+
+#include "net/socket_impl.h"
+
+namespace thinlod::protocol::detail {
+
+std::shared_ptr<zmq::context_t> sharedContext() {
+  static std::mutex mutex;
+  static std::weak_ptr<zmq::context_t> current;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::shared_ptr<zmq::context_t> context = current.lock();
+  if (!context) {
+    context = std::make_shared<zmq::context_t>(1);
+    current = context;
+  }
+  return context;
+}
+
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+
+std::string hexId(const std::string& routingId) {
+  std::string out;
+  char buffer[4];
+  for (unsigned char c : routingId) {
+    std::snprintf(buffer, sizeof(buffer), "%02x", c);
+    out += buffer;
+  }
+  return out;
+}
+
+}  // namespace thinlod::protocol::detail

@@ -1,0 +1,205 @@
+// WorkerPool: Endpoint for simplifier workers + PendingRequests
+// (transport.h). Request payloads are kept here until their first result.
+#include <spdlog/spdlog.h>
+
+#include <map>
+#include <random>
+
+#include "net/socket_impl.h"
+
+namespace thinlod::protocol {
+
+using detail::Clock;
+
+struct WorkerPool::Impl {
+  std::unique_ptr<Endpoint> endpoint;
+  PendingRequests pending;
+  std::map<std::uint64_t, Message> requests;       // by request id
+  std::map<std::uint64_t, std::uint32_t> workers;  // PeerId -> capacity
+  std::uint64_t nextRequestId = 1;
+  std::vector<WorkerPoolEvent> events;
+
+  explicit Impl(PendingRequests::Options options) : pending(options) {}
+
+  Result<std::uint64_t> submit(Message request);
+  void fail(const std::vector<std::uint64_t>& ids, ErrorCode code, const std::string& why);
+  void onResult(PeerId worker, std::uint64_t requestId, WorkerPoolEvent event);
+  void dispatch(Clock::time_point now);
+};
+
+namespace {
+// Request ids start at a random point so that a result computed for a
+// previous backbone process can never complete a request of this one.
+std::uint64_t randomIdBase() {
+  std::random_device device;
+  return ((std::uint64_t(device()) & 0x7fffffffu) << 32) | 1u;
+}
+
+std::uint64_t requestIdOf(const Message& m) {
+  if (const auto* s = std::get_if<SimplifyRequest>(&m)) return s->requestId;
+  return std::get<ImpostorRequest>(m).requestId;
+}
+}  // namespace
+
+Result<std::unique_ptr<WorkerPool>> WorkerPool::bind(Options options) {
+  if (options.requests.maxAttempts < 1 || options.requests.attemptTimeout.count() <= 0) {
+    return Status(ErrorCode::kInvalidArgument, "maxAttempts and attemptTimeout must be positive");
+  }
+  Endpoint::Options endpointOptions;
+  endpointOptions.address = options.address;
+  endpointOptions.role = Role::kBackbone;
+  endpointOptions.name = options.name;
+  endpointOptions.acceptedRoles = {Role::kSimplifier};
+  endpointOptions.transport = options.transport;
+  auto endpoint = Endpoint::bind(std::move(endpointOptions));
+  if (!endpoint.ok()) return endpoint.status();
+  auto impl = std::make_unique<Impl>(options.requests);
+  impl->endpoint = std::move(*endpoint);
+  impl->nextRequestId = randomIdBase();
+  return std::unique_ptr<WorkerPool>(new WorkerPool(std::move(impl)));
+}
+
+WorkerPool::WorkerPool(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+WorkerPool::~WorkerPool() = default;
+
+Endpoint& WorkerPool::endpoint() { return *impl_->endpoint; }
+std::size_t WorkerPool::pendingRequests() const { return impl_->pending.size(); }
+std::size_t WorkerPool::liveWorkers() const { return impl_->workers.size(); }
+
+Result<std::uint64_t> WorkerPool::submit(SimplifyRequest request) {
+  request.requestId = impl_->nextRequestId;
+  return impl_->submit(std::move(request));
+}
+
+Result<std::uint64_t> WorkerPool::submit(ImpostorRequest request) {
+  request.requestId = impl_->nextRequestId;
+  return impl_->submit(std::move(request));
+}
+
+Result<std::uint64_t> WorkerPool::Impl::submit(Message request) {
+  THINLOD_RETURN_IF_ERROR(validate(request));
+  const std::uint64_t id = requestIdOf(request);
+  THINLOD_RETURN_IF_ERROR(pending.add(id));
+  ++nextRequestId;
+  requests.emplace(id, std::move(request));
+  dispatch(Clock::now());
+  return id;
+}
+
+bool WorkerPool::cancel(std::uint64_t requestId) {
+  impl_->requests.erase(requestId);
+  return impl_->pending.cancel(requestId);
+}
+
+void WorkerPool::Impl::fail(const std::vector<std::uint64_t>& ids, ErrorCode code,
+                            const std::string& why) {
+  for (std::uint64_t id : ids) {
+    auto it = requests.find(id);
+    if (it == requests.end()) continue;
+    const Status status(code, "request " + std::to_string(id) + ": " + why);
+    spdlog::warn("event=request_failed request={} error=\"{}\"", id, status.toString());
+    WorkerPoolEvent event;
+    if (const auto* s = std::get_if<SimplifyRequest>(&it->second)) {
+      event.kind = WorkerPoolEvent::Kind::kSimplifyResult;
+      event.simplify.requestId = id;
+      event.simplify.objectId = s->objectId;
+      event.simplify.status = status;
+    } else {
+      const auto& r = std::get<ImpostorRequest>(it->second);
+      event.kind = WorkerPoolEvent::Kind::kImpostorResult;
+      event.impostor.requestId = id;
+      event.impostor.objectIds = r.objectIds;
+      event.impostor.status = status;
+    }
+    events.push_back(std::move(event));
+    requests.erase(it);
+  }
+}
+
+void WorkerPool::Impl::onResult(PeerId worker, std::uint64_t requestId, WorkerPoolEvent event) {
+  if (!pending.complete(requestId)) {
+    spdlog::debug("event=duplicate_result_dropped request={} worker={}", requestId, worker.value);
+    return;
+  }
+  requests.erase(requestId);
+  event.worker = worker;
+  events.push_back(std::move(event));
+}
+
+void WorkerPool::Impl::dispatch(Clock::time_point now) {
+  std::vector<PendingRequests::Worker> live;
+  for (const auto& [id, capacity] : workers) live.push_back({id, capacity});
+  for (const auto& d : pending.dispatch(live, now)) {
+    const Status sent = endpoint->send(PeerId{d.workerId}, requests.at(d.requestId));
+    if (sent.ok()) {
+      spdlog::debug("event=request_sent request={} worker={} attempt={}", d.requestId, d.workerId,
+                    d.attempt);
+      continue;
+    }
+    // The worker vanished between its last message and now: treat it as lost.
+    spdlog::warn("event=request_send_failed request={} worker={} error=\"{}\"", d.requestId,
+                 d.workerId, sent.toString());
+    auto released = pending.workerLost(d.workerId);
+    fail(released.failed, ErrorCode::kUnavailable, "could not be delivered to any worker");
+  }
+}
+
+std::vector<WorkerPoolEvent> WorkerPool::poll(std::chrono::milliseconds timeout) {
+  Impl& s = *impl_;
+  for (EndpointEvent& e : s.endpoint->poll(timeout)) {
+    switch (e.kind) {
+      case EndpointEvent::Kind::kJoined: {
+        const auto& hello = std::get<Hello>(e.message);
+        s.workers[e.peer.value] = std::max<std::uint32_t>(hello.capacity, 1);
+        WorkerPoolEvent event;
+        event.kind = WorkerPoolEvent::Kind::kWorkerJoined;
+        event.worker = e.peer;
+        s.events.push_back(std::move(event));
+        break;
+      }
+      case EndpointEvent::Kind::kLeft: {
+        s.workers.erase(e.peer.value);
+        auto released = s.pending.workerLost(e.peer.value);
+        if (!released.retry.empty()) {
+          spdlog::info("event=requests_resent_after_worker_loss worker={} count={}", e.peer.value,
+                       released.retry.size());
+        }
+        s.fail(released.failed, ErrorCode::kUnavailable, "its worker was lost on every attempt");
+        WorkerPoolEvent event;
+        event.kind = WorkerPoolEvent::Kind::kWorkerLeft;
+        event.worker = e.peer;
+        s.events.push_back(std::move(event));
+        break;
+      }
+      case EndpointEvent::Kind::kMessage:
+        if (auto* result = std::get_if<SimplifyResult>(&e.message)) {
+          WorkerPoolEvent event;
+          event.kind = WorkerPoolEvent::Kind::kSimplifyResult;
+          const std::uint64_t id = result->requestId;
+          event.simplify = std::move(*result);
+          s.onResult(e.peer, id, std::move(event));
+        } else if (auto* impostor = std::get_if<ImpostorResult>(&e.message)) {
+          WorkerPoolEvent event;
+          event.kind = WorkerPoolEvent::Kind::kImpostorResult;
+          const std::uint64_t id = impostor->requestId;
+          event.impostor = std::move(*impostor);
+          s.onResult(e.peer, id, std::move(event));
+        } else {
+          spdlog::warn("event=unexpected_dropped endpoint=workers worker={} message={}",
+                       e.peer.value, messageName(e.message));
+        }
+        break;
+    }
+  }
+  const auto now = Clock::now();
+  auto expired = s.pending.expire(now);
+  if (!expired.retry.empty())
+    spdlog::info("event=requests_timed_out count={}", expired.retry.size());
+  s.fail(expired.failed, ErrorCode::kTimeout, "no result after every attempt timed out");
+  s.dispatch(now);
+  std::vector<WorkerPoolEvent> events;
+  events.swap(s.events);
+  return events;
+}
+
+}  // namespace thinlod::protocol

@@ -1,0 +1,333 @@
+// DaemonRuntime (daemon_runtime.h): CLI11 + tomlplusplus + spdlog + signals.
+#include "thinlod/protocol/daemon_runtime.h"
+
+#include <fcntl.h>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+#include <toml++/toml.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <variant>
+#include <vector>
+
+namespace thinlod::protocol {
+namespace {
+
+// ---- process-wide signal state (async-signal-safe handler) ----
+volatile std::sig_atomic_t gShutdown = 0;
+int gWakePipe[2] = {-1, -1};
+
+void onSignal(int) {
+  const int savedErrno = errno;
+  gShutdown = 1;
+  if (gWakePipe[1] >= 0) {
+    const char byte = 1;
+    const ssize_t written = ::write(gWakePipe[1], &byte, 1);
+    (void)written;  // a full pipe is already readable: nothing to do
+  }
+  errno = savedErrno;
+}
+
+Status installSignalHandlersOnce() {
+  static std::once_flag once;
+  static Status result;
+  std::call_once(once, [] {
+    if (::pipe2(gWakePipe, O_NONBLOCK | O_CLOEXEC) != 0) {
+      result = Status(ErrorCode::kInternal, std::string("pipe2: ") + std::strerror(errno));
+      return;
+    }
+    struct sigaction action {};
+    action.sa_handler = onSignal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = 0;  // no SA_RESTART: a blocking poll returns EINTR
+    if (::sigaction(SIGINT, &action, nullptr) != 0 || ::sigaction(SIGTERM, &action, nullptr) != 0) {
+      result = Status(ErrorCode::kInternal, std::string("sigaction: ") + std::strerror(errno));
+      return;
+    }
+    std::signal(SIGPIPE, SIG_IGN);
+  });
+  return result;
+}
+
+using Target = std::variant<std::string*, std::int64_t*, int*, double*, bool*>;
+
+struct OptionEntry {
+  std::string key;
+  std::string help;
+  Target target;
+  CLI::Option* cli = nullptr;
+};
+
+const std::vector<std::string>& logLevels() {
+  static const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "off"};
+  return levels;
+}
+
+std::string where(const std::string& file, const toml::source_region& region) {
+  return file + ":" + std::to_string(region.begin.line) + ":" + std::to_string(region.begin.column);
+}
+
+// Assigns a TOML value to the option's target; the error names file:line:col.
+Status assign(const OptionEntry& option, const toml::node& node, const std::string& file) {
+  const std::string at = where(file, node.source()) + ": '" + option.key + "'";
+  return std::visit(
+      [&](auto* target) -> Status {
+        using T = std::remove_pointer_t<decltype(target)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          if (!node.is_string()) return Status(ErrorCode::kParseError, at + " must be a string");
+          *target = node.as_string()->get();
+        } else if constexpr (std::is_same_v<T, bool>) {
+          if (!node.is_boolean())
+            return Status(ErrorCode::kParseError, at + " must be true or false");
+          *target = node.as_boolean()->get();
+        } else if constexpr (std::is_same_v<T, double>) {
+          if (node.is_integer()) {
+            *target = static_cast<double>(node.as_integer()->get());
+          } else if (node.is_floating_point()) {
+            *target = node.as_floating_point()->get();
+          } else {
+            return Status(ErrorCode::kParseError, at + " must be a number");
+          }
+        } else {
+          if (!node.is_integer()) return Status(ErrorCode::kParseError, at + " must be an integer");
+          const std::int64_t value = node.as_integer()->get();
+          if (value < std::numeric_limits<T>::min() || value > std::numeric_limits<T>::max()) {
+            return Status(ErrorCode::kParseError,
+                          at + " = " + std::to_string(value) + " is out of range");
+          }
+          *target = static_cast<T>(value);
+        }
+        return Status();
+      },
+      option.target);
+}
+
+}  // namespace
+
+struct DaemonRuntime::Impl {
+  std::string name;
+  std::string description;
+  std::string logLevel = "info";
+  std::vector<OptionEntry> options;
+  std::map<std::string, std::size_t> byKey;
+  std::vector<std::function<void()>> afterParse;
+  // Staging for options whose target type is not an option type.
+  std::vector<std::unique_ptr<std::int64_t>> staging;
+
+  void add(const std::string& key, Target target, const std::string& help) {
+    if (byKey.count(key) != 0 || key == "log_level" || key == "config") {
+      // A programming error in the daemon's option table.
+      std::cerr << name << ": option '" << key << "' is registered twice\n";
+      std::abort();
+    }
+    byKey[key] = options.size();
+    options.push_back({key, help, target, nullptr});
+  }
+
+  Status applyConfigFile(const std::string& file);
+  Status walk(const toml::table& table, const std::string& prefix, const std::string& file);
+};
+
+DaemonRuntime::DaemonRuntime(std::string name, std::string description)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->name = std::move(name);
+  impl_->description = std::move(description);
+}
+DaemonRuntime::~DaemonRuntime() = default;
+
+void DaemonRuntime::addOption(const std::string& key, std::string* target,
+                              const std::string& help) {
+  impl_->add(key, target, help);
+}
+void DaemonRuntime::addOption(const std::string& key, std::int64_t* target,
+                              const std::string& help) {
+  impl_->add(key, target, help);
+}
+void DaemonRuntime::addOption(const std::string& key, int* target, const std::string& help) {
+  impl_->add(key, target, help);
+}
+void DaemonRuntime::addOption(const std::string& key, double* target, const std::string& help) {
+  impl_->add(key, target, help);
+}
+void DaemonRuntime::addOption(const std::string& key, bool* target, const std::string& help) {
+  impl_->add(key, target, help);
+}
+
+void DaemonRuntime::addTransportOptions(TransportOptions* target) {
+  auto heartbeat = std::make_unique<std::int64_t>(target->heartbeatInterval.count());
+  std::int64_t* heartbeatMs = heartbeat.get();
+  impl_->staging.push_back(std::move(heartbeat));
+  addOption("transport.heartbeat_ms", heartbeatMs,
+            "heartbeat interval (ms); peers silent for "
+            "heartbeat_ms * liveness_misses are gone");
+  addOption("transport.liveness_misses", &target->livenessMisses,
+            "missed heartbeats before a peer is gone");
+  addOption("transport.send_hwm", &target->sendHighWaterMark,
+            "messages queued per peer before sends fail");
+  impl_->afterParse.push_back([target, heartbeatMs] {
+    target->heartbeatInterval = std::chrono::milliseconds(*heartbeatMs);
+  });
+}
+
+Status DaemonRuntime::Impl::walk(const toml::table& table, const std::string& prefix,
+                                 const std::string& file) {
+  for (const auto& [rawKey, node] : table) {
+    const std::string key =
+        prefix.empty() ? std::string(rawKey.str()) : prefix + "." + std::string(rawKey.str());
+    if (const toml::table* sub = node.as_table()) {
+      THINLOD_RETURN_IF_ERROR(walk(*sub, key, file));
+      continue;
+    }
+    if (key == "log_level") {
+      if (!node.is_string())
+        return Status(ErrorCode::kParseError,
+                      where(file, node.source()) + ": 'log_level' must be a string");
+      logLevel = node.as_string()->get();
+      continue;
+    }
+    auto it = byKey.find(key);
+    if (it == byKey.end()) {
+      return Status(ErrorCode::kParseError,
+                    where(file, node.source()) + ": unknown key '" + key + "'");
+    }
+    const OptionEntry& option = options[it->second];
+    if (option.cli != nullptr && option.cli->count() > 0) continue;  // the flag wins
+    THINLOD_RETURN_IF_ERROR(assign(option, node, file));
+  }
+  return Status();
+}
+
+Status DaemonRuntime::Impl::applyConfigFile(const std::string& file) {
+  toml::table table;
+  try {
+    table = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    return Status(ErrorCode::kParseError,
+                  where(file, e.source()) + ": " + std::string(e.description()));
+  }
+  return walk(table, "", file);
+}
+
+std::optional<int> DaemonRuntime::parse(int argc, const char* const* argv) {
+  Impl& s = *impl_;
+  CLI::App app(s.description, s.name);
+  app.option_defaults()->always_capture_default();
+  std::string configFile;
+  std::string flagLogLevel;
+  bool printConfig = false;
+  app.add_option("--config", configFile, "TOML configuration file (flags override it)");
+  CLI::Option* logOption = app.add_option("--log-level,--log_level", flagLogLevel,
+                                          "trace|debug|info|warn|error|off (TOML: log_level)");
+  app.add_flag("--print-config", printConfig, "print the effective configuration as TOML and exit");
+  for (OptionEntry& option : s.options) {
+    const std::string flag = "--" + option.key;
+    std::visit(
+        [&](auto* target) {
+          using T = std::remove_pointer_t<decltype(target)>;
+          if constexpr (std::is_same_v<T, bool>) {
+            option.cli = app.add_flag(flag, *target, option.help);
+          } else {
+            option.cli = app.add_option(flag, *target, option.help);
+          }
+        },
+        option.target);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (!configFile.empty()) {
+    const Status loaded = s.applyConfigFile(configFile);
+    if (!loaded.ok()) {
+      std::cerr << s.name << ": " << loaded.message() << "\n";
+      return 2;
+    }
+  }
+  if (logOption->count() > 0) s.logLevel = flagLogLevel;
+  const auto& levels = logLevels();
+  if (std::find(levels.begin(), levels.end(), s.logLevel) == levels.end()) {
+    std::cerr << s.name << ": log level '" << s.logLevel
+              << "' is not one of trace|debug|info|warn|error|off\n";
+    return 2;
+  }
+  for (const auto& apply : s.afterParse) apply();
+
+  auto logger =
+      std::make_shared<spdlog::logger>(s.name, std::make_shared<spdlog::sinks::stderr_sink_mt>());
+  logger->set_pattern("%Y-%m-%dT%H:%M:%S.%e %n %l %v");
+  logger->set_level(spdlog::level::from_str(s.logLevel));
+  logger->flush_on(spdlog::level::warn);
+  spdlog::set_default_logger(logger);
+
+  if (printConfig) {
+    std::cout << effectiveConfig();
+    return 0;
+  }
+  const Status signals = installSignalHandlersOnce();
+  if (!signals.ok()) {
+    std::cerr << s.name << ": " << signals.toString() << "\n";
+    return 1;
+  }
+  spdlog::info("event=started daemon={} pid={}", s.name, ::getpid());
+  return std::nullopt;
+}
+
+bool DaemonRuntime::shutdownRequested() const { return gShutdown != 0; }
+
+void DaemonRuntime::requestShutdown() {
+  (void)installSignalHandlersOnce();
+  onSignal(0);
+}
+
+int DaemonRuntime::wakeFd() const {
+  (void)installSignalHandlersOnce();
+  return gWakePipe[0];
+}
+
+std::string DaemonRuntime::effectiveConfig() const {
+  toml::table root;
+  root.insert("log_level", impl_->logLevel);
+  for (const OptionEntry& option : impl_->options) {
+    // Walk/create the tables named by the dotted key.
+    toml::table* table = &root;
+    std::string key = option.key;
+    std::size_t dot;
+    while ((dot = key.find('.')) != std::string::npos) {
+      const std::string part = key.substr(0, dot);
+      key = key.substr(dot + 1);
+      auto [it, inserted] = table->insert(part, toml::table{});
+      (void)inserted;
+      table = it->second.as_table();
+    }
+    std::visit(
+        [&](auto* target) {
+          using T = std::remove_pointer_t<decltype(target)>;
+          if constexpr (std::is_same_v<T, int>) {
+            table->insert_or_assign(key, static_cast<std::int64_t>(*target));
+          } else {
+            table->insert_or_assign(key, *target);
+          }
+        },
+        option.target);
+  }
+  std::ostringstream out;
+  out << root << "\n";
+  return out.str();
+}
+
+const std::string& DaemonRuntime::name() const { return impl_->name; }
+const std::string& DaemonRuntime::logLevel() const { return impl_->logLevel; }
+
+}  // namespace thinlod::protocol
