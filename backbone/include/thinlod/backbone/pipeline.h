@@ -1,0 +1,152 @@
+// Per-step pipeline pieces shared by every scheduler: viewer prediction,
+// culling, relative -> absolute conversion, and the candidate
+// representations of a leaf.
+//
+// Contract:
+// - Units: metres, seconds, radians; accuracy in rad^-1 (absolute) or as a
+//   fraction of the object's diameter (relative); resources in triangles and
+//   encoded bytes.
+// - predictRegion: the viewer can reach the ball (position, reachRadius)
+//   before a representation requested now is replaced, with reachRadius =
+//   maxSpeed * (plannedLifetime + linkDelay + generationDelay); the ball of
+//   keepRadius = maxSpeed * (linkDelay + generationDelay + keepSlack) before
+//   a replacement requested now could arrive (a displayed copy is kept while
+//   it stays valid over that smaller ball). The view cone is the frustum's
+//   bounding cone widened by maxAngularSpeed * the same time as reachRadius.
+// - classifySphere is conservative: kCulled only when no point of the sphere
+//   can be seen from anywhere in the region; kInside only when all of it is
+//   seen from everywhere in it.
+// - conversionDistance D is the distance from a ball to a bounding sphere,
+//   clamped below by minimalDistance (> 0); a_abs = a_rel * D / diameter.
+// - Pure functions of their arguments; no allocation except into `out`.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "thinlod/backbone/scheduling_scene.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::backbone {
+
+struct ViewerState {
+  std::uint64_t frame = 0;
+  double timeSeconds = 0.0;
+  glm::dvec3 position{0.0};
+  glm::dvec3 viewDirection{0.0, 0.0, -1.0};   // non-zero, need not be unit
+  double horizontalFov = 1.0471975511965976;  // rad, full angle
+  double verticalFov = 0.7853981633974483;    // rad, full angle
+};
+
+struct SchedulerConfig {
+  // Prediction (paper 4.1 uses 0.1 m/s in a small room and ~1 s lifetime).
+  double maxSpeed = 1.0;         // m/s
+  double maxAngularSpeed = 1.0;  // rad/s
+  double plannedLifetime = 1.0;  // s; also the link accounting window
+  double linkDelay = 0.05;       // s
+  double generationDelay = 0.1;  // s
+  double keepSlack = 0.0;        // s added to the keep horizon
+  double minimalDistance = 0.1;  // m, lower clamp of D
+  double maxViewDistance = std::numeric_limits<double>::infinity();  // m
+  // Curve propagation: a group converts relative -> absolute once when
+  // D >= mergeDistanceFactor * its diameter (paper 3.4; infinity disables).
+  double mergeDistanceFactor = 1.0;
+  // Reuse: merged subtree curves are computed for the region grown by
+  // cacheDistanceMargin * D (and the cone by cacheAngleMargin) and reused
+  // while the predicted region stays inside. 0 disables the growth.
+  double cacheDistanceMargin = 0.05;
+  double cacheAngleMargin = 0.05;  // rad
+  // Stability (docs/scheduling.md, "Hysteresis"). All keep budgets hard.
+  double budgetReserveShare = 0.05;  // share of each budget kept for keeping copies
+  double preferCurrentShare = 0.15;  // keep a copy costing <= (1+share) x the best
+  int switchDelaySteps = 2;          // keep a valid copy this many steps before a voluntary switch
+  double targetHysteresis = 0.02;    // ignore target increases below this fraction
+  double rangeHysteresis = 0.0;      // m: a new kind must fit the region grown by this
+  // Two-resource solver: Pareto sets per node are thinned above this size
+  // (then the result is still within budget but may be below the optimum).
+  int paretoCap = 64;
+};
+
+Status validateConfig(const SchedulerConfig& config);
+Status validateViewer(const ViewerState& viewer);
+
+struct PredictedRegion {
+  glm::dvec3 center{0.0};
+  double reachRadius = 0.0;
+  double keepRadius = 0.0;
+  glm::dvec3 viewDirection{0.0, 0.0, -1.0};  // unit
+  double viewHalfAngle = 0.0;                // rad; >= pi: every direction
+  double maxViewDistance = std::numeric_limits<double>::infinity();
+
+  Sphere reachBall() const { return {center, reachRadius}; }
+  Sphere keepBall() const { return {center, keepRadius}; }
+};
+
+PredictedRegion predictRegion(const ViewerState& viewer, const SchedulerConfig& config);
+// The region grown by a distance (both radii) and an angle.
+PredictedRegion growRegion(const PredictedRegion& region, double distance, double angle);
+// True when every position/direction of `inner` is one of `outer`.
+bool regionContains(const PredictedRegion& outer, const PredictedRegion& inner);
+
+enum class Visibility : std::uint8_t { kCulled = 0, kPartial = 1, kInside = 2 };
+Visibility classifySphere(const PredictedRegion& region, const Sphere& bounds);
+
+double conversionDistance(const glm::dvec3& center, double radius, const Sphere& bounds,
+                          double minimalDistance);
+
+// ---- Candidate representations of one leaf object ----
+
+enum class CandidateSource : std::uint8_t {
+  kNew = 0,           // generate (simplifier) and send
+  kFrontendCopy = 1,  // keep the displayed copy
+  kBackboneCopy = 2,  // send an already generated copy
+  kPending = 3,       // a requested copy that is on its way
+};
+const char* candidateSourceName(CandidateSource source);
+
+// A copy this planner requested that has not been confirmed at the frontend.
+struct PendingCopy {
+  std::uint32_t option = 0;  // index into SchedulingScene::options
+  std::uint64_t requestId = 0;
+  double relativeAccuracy = 0.0;
+  double triangles = 0.0;
+  double encodedBytes = 0.0;
+  Sphere servesRegion;  // the reach ball it was generated for
+  double issuedAt = 0.0;
+};
+
+struct LeafCandidate {
+  std::uint32_t option = 0;
+  CandidateSource source = CandidateSource::kNew;
+  const RepresentationOption* representation = nullptr;
+  // Highest relative accuracy it reaches in the leaf's frame (absolute
+  // accuracy = a_rel * D_reach / diameter).
+  double maxRelativeAccuracy = 0.0;
+  double fixedTriangles = 0.0;  // copies: what they cost
+  double fixedLinkBytes = 0.0;
+  std::uint64_t copyId = 0;
+};
+
+struct CandidateCost {
+  double triangles = 0.0;
+  double linkBytes = 0.0;
+};
+// Precondition: relativeAccuracy <= candidate.maxRelativeAccuracy.
+CandidateCost candidateCost(const LeafCandidate& candidate, double relativeAccuracy);
+
+// kExact: candidates for exactly `region` (copies are credited with the
+// accuracy they have over the keep ball, pending copies count). kConservative:
+// valid for every region inside `region` (used for cached curves): copies get
+// no keep credit and pending copies are ignored.
+enum class CandidateContext : std::uint8_t { kExact = 0, kConservative = 1 };
+
+// `bounds` is the leaf's sphere; the leaf frame uses D = conversionDistance
+// of the reach ball. `pending` (may be null) holds this object's in-flight
+// copies.
+void collectLeafCandidates(const SchedulingScene& scene, std::uint32_t object,
+                           const PredictedRegion& region, const SchedulerConfig& config,
+                           CandidateContext context, const std::vector<PendingCopy>* pending,
+                           const Sphere& bounds, std::vector<LeafCandidate>& out);
+
+}  // namespace thinlod::backbone

@@ -1,0 +1,332 @@
+#include "curve_propagation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+
+namespace thinlod::backbone {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool sameRegion(const PredictedRegion& a, const PredictedRegion& b) {
+  return a.center == b.center && a.reachRadius == b.reachRadius && a.keepRadius == b.keepRadius &&
+         a.viewDirection == b.viewDirection && a.viewHalfAngle == b.viewHalfAngle &&
+         a.maxViewDistance == b.maxViewDistance;
+}
+
+double angleBetween(const glm::dvec3& a, const glm::dvec3& b) {
+  return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));  // both unit
+}
+
+// How far `inner` may still grow (distance, angle) and stay inside `outer`.
+void slackOf(const PredictedRegion& outer, const PredictedRegion& inner, double& distance,
+             double& angle) {
+  const double shift = glm::length(outer.center - inner.center);
+  distance = std::min(outer.reachRadius - shift - inner.reachRadius,
+                      outer.keepRadius - shift - inner.keepRadius);
+  angle = outer.viewHalfAngle >= kPi
+              ? kPi
+              : outer.viewHalfAngle - angleBetween(outer.viewDirection, inner.viewDirection) -
+                    inner.viewHalfAngle;
+  distance = std::max(0.0, distance);
+  angle = std::max(0.0, angle);
+}
+
+// The curve restricted to accuracies <= maxAccuracy (a representation whose
+// other resource curve ends earlier cannot be generated beyond that).
+AccuracyCurve restrictTo(const AccuracyCurve& curve, double maxAccuracy) {
+  if (maxAccuracy >= curve.maxAccuracy()) return curve;
+  std::vector<CurveSegment> kept;
+  for (const CurveSegment& s : curve.segments())
+    if (s.start < maxAccuracy) kept.push_back(s);
+  if (!kept.empty()) {
+    Result<AccuracyCurve> r = AccuracyCurve::fromSegments(std::move(kept), maxAccuracy);
+    if (r.ok()) return std::move(r).value();
+  }
+  // Conservative fallback: one point costing what maxAccuracy costs.
+  return AccuracyCurve::point(maxAccuracy, curve.resourcesFor(maxAccuracy));
+}
+
+const AccuracyCurve& curveOf(const RepresentationOption& option, Resource resource) {
+  return resource == Resource::kTriangles ? option.relativeTriangles : option.relativeLinkBytes;
+}
+
+}  // namespace
+
+CurvePropagator::CurvePropagator(const SchedulingScene& scene, const SchedulerConfig& config,
+                                 const PredictedRegion& region, PlannerStateImpl& state,
+                                 Resource resource, PlanStats& stats)
+    : scene_(scene),
+      config_(config),
+      region_(region),
+      state_(state),
+      cache_(state.cache[static_cast<int>(resource)]),
+      resource_(resource),
+      stats_(stats) {}
+
+const AccuracyCurve& CurvePropagator::evaluateRoot() { return evaluateAbsolute(0, false); }
+
+AccuracyCurve CurvePropagator::leafRelativeCurve(std::uint32_t n, const PredictedRegion& region,
+                                                 CandidateContext context) {
+  const SceneNode& node = scene_.nodes[n];
+  const std::vector<PendingCopy>* pending =
+      context == CandidateContext::kExact ? pendingFor(state_, node.object) : nullptr;
+  collectLeafCandidates(scene_, node.object, region, config_, context, pending, node.bounds,
+                        scratch_);
+  if (scratch_.empty()) return AccuracyCurve();
+  std::vector<AccuracyCurve> owned;
+  owned.reserve(scratch_.size());
+  std::vector<const AccuracyCurve*> parts;
+  parts.reserve(scratch_.size());
+  for (const LeafCandidate& c : scratch_) {
+    if (c.source == CandidateSource::kNew) {
+      const AccuracyCurve& full = curveOf(*c.representation, resource_);
+      if (c.maxRelativeAccuracy >= full.maxAccuracy()) {
+        parts.push_back(&full);
+        continue;
+      }
+      owned.push_back(restrictTo(full, c.maxRelativeAccuracy));
+    } else {
+      const double r = resource_ == Resource::kTriangles ? c.fixedTriangles : c.fixedLinkBytes;
+      owned.push_back(AccuracyCurve::point(c.maxRelativeAccuracy, r));
+    }
+  }
+  for (const AccuracyCurve& c : owned) parts.push_back(&c);
+  if (parts.size() == 1) return *parts.front();
+  return AccuracyCurve::lowerEnvelope(parts);
+}
+
+const AccuracyCurve& CurvePropagator::evaluateAbsolute(std::uint32_t n, bool parentInside) {
+  AbsoluteEntry& e = cache_.absolute[n];
+  const SceneNode& node = scene_.nodes[n];
+  if (e.valid && e.subtreeVersion == node.subtreeVersion &&
+      e.pendingGeneration == state_.pendingGeneration && sameRegion(e.region, region_)) {
+    ++stats_.curveReuses;
+    return e.curve;
+  }
+  e.valid = true;
+  e.subtreeVersion = node.subtreeVersion;
+  e.pendingGeneration = state_.pendingGeneration;
+  e.region = region_;
+  e.merged = false;
+  e.visibility = parentInside ? Visibility::kInside : classifySphere(region_, node.bounds);
+  if (e.visibility == Visibility::kCulled) {
+    ++stats_.culledNodes;
+    e.curve = AccuracyCurve();
+    return e.curve;
+  }
+  ++stats_.visitedNodes;
+  ++stats_.curveComputes;
+  const double diameter = 2.0 * node.bounds.radius;
+  e.distance =
+      conversionDistance(region_.center, region_.reachRadius, node.bounds, config_.minimalDistance);
+  const double toAbsolute = e.distance / diameter;
+  if (node.kind == SceneNodeKind::kLeaf) {
+    AccuracyCurve relative = leafRelativeCurve(n, region_, CandidateContext::kExact);
+    e.curve = relative.empty() ? AccuracyCurve() : relative.scaledAccuracy(toAbsolute);
+    return e.curve;
+  }
+  const bool inside = e.visibility == Visibility::kInside;
+  if (inside && e.distance >= config_.mergeDistanceFactor * diameter) {
+    // Far enough that one conversion for the whole subtree is valid (3.4).
+    PredictedRegion grown =
+        growRegion(region_, config_.cacheDistanceMargin * e.distance, config_.cacheAngleMargin);
+    if (classifySphere(grown, node.bounds) != Visibility::kInside) grown = region_;
+    Slack slack;
+    const AccuracyCurve& relative = evaluateRelative(n, grown, slack);
+    AbsoluteEntry& again = cache_.absolute[n];  // same storage; vectors never resize here
+    again.merged = true;
+    again.curve = relative.empty() ? AccuracyCurve() : relative.scaledAccuracy(toAbsolute);
+    ++stats_.mergedGroups;
+    return again.curve;
+  }
+  std::vector<const AccuracyCurve*> parts;
+  parts.reserve(node.childCount);
+  for (std::uint32_t i = 0; i < node.childCount; ++i) {
+    const std::uint32_t slot = node.firstChild + i;
+    if (node.kind == SceneNodeKind::kLod &&
+        !containsBall(scene_.childRanges[slot], region_.reachBall()))
+      continue;
+    const AccuracyCurve& child = evaluateAbsolute(scene_.children[slot], inside);
+    if (!child.empty()) parts.push_back(&child);
+  }
+  e.curve = node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
+                                               : AccuracyCurve::lowerEnvelope(parts);
+  return e.curve;
+}
+
+const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
+                                                       const PredictedRegion& computeRegion,
+                                                       Slack& slack) {
+  RelativeEntry& r = cache_.relative[n];
+  const SceneNode& node = scene_.nodes[n];
+  if (r.valid && r.subtreeVersion == node.subtreeVersion && regionContains(r.region, region_)) {
+    ++stats_.curveReuses;
+    slackOf(r.region, region_, slack.distance, slack.angle);
+    return r.curve;
+  }
+  ++stats_.curveComputes;
+  slackOf(computeRegion, region_, slack.distance, slack.angle);
+  AccuracyCurve curve;
+  if (node.kind == SceneNodeKind::kLeaf) {
+    curve = leafRelativeCurve(n, computeRegion, CandidateContext::kConservative);
+  } else {
+    const double diameter = 2.0 * node.bounds.radius;
+    std::vector<AccuracyCurve> scaled;
+    scaled.reserve(node.childCount);
+    for (std::uint32_t i = 0; i < node.childCount; ++i) {
+      const std::uint32_t slot = node.firstChild + i;
+      if (node.kind == SceneNodeKind::kLod &&
+          !containsBall(scene_.childRanges[slot], computeRegion.reachBall()))
+        continue;
+      const std::uint32_t c = scene_.children[slot];
+      Slack childSlack;
+      const AccuracyCurve& child = evaluateRelative(c, computeRegion, childSlack);
+      slack.distance = std::min(slack.distance, childSlack.distance);
+      slack.angle = std::min(slack.angle, childSlack.angle);
+      if (child.empty()) continue;
+      // Relative to this node's diameter: same distortion, larger size.
+      scaled.push_back(child.scaledAccuracy(diameter / (2.0 * scene_.nodes[c].bounds.radius)));
+    }
+    std::vector<const AccuracyCurve*> parts;
+    parts.reserve(scaled.size());
+    for (const AccuracyCurve& s : scaled) parts.push_back(&s);
+    curve = node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
+                                               : AccuracyCurve::lowerEnvelope(parts);
+  }
+  RelativeEntry& entry = cache_.relative[n];
+  entry.valid = true;
+  entry.subtreeVersion = node.subtreeVersion;
+  entry.region = growRegion(region_, slack.distance, slack.angle);
+  entry.curve = std::move(curve);
+  return entry.curve;
+}
+
+void CurvePropagator::pushDown(double targetAccuracy, std::vector<LeafSelection>& out) {
+  out_ = &out;
+  pushAbsolute(0, targetAccuracy);
+  out_ = nullptr;
+}
+
+void CurvePropagator::reportUnrenderable(std::uint32_t n) {
+  const SceneNode& node = scene_.nodes[n];
+  if (node.kind == SceneNodeKind::kLeaf) {
+    LeafSelection s;
+    s.node = n;
+    s.object = node.object;
+    s.rendered = false;
+    out_->push_back(s);
+  } else if (node.kind == SceneNodeKind::kGroup) {
+    for (std::uint32_t i = 0; i < node.childCount; ++i)
+      reportUnrenderable(scene_.children[node.firstChild + i]);
+  }
+  // An LOD without an eligible level renders nothing and names no object.
+}
+
+void CurvePropagator::pushAbsolute(std::uint32_t n, double accuracy) {
+  const AbsoluteEntry& e = cache_.absolute[n];
+  if (e.visibility == Visibility::kCulled) return;
+  const SceneNode& node = scene_.nodes[n];
+  const double diameter = 2.0 * node.bounds.radius;
+  if (node.kind == SceneNodeKind::kLeaf) {
+    if (e.curve.empty()) {
+      reportUnrenderable(n);
+      return;
+    }
+    chooseLeaf(n, accuracy, kInf);
+    return;
+  }
+  if (e.merged) {
+    if (e.curve.empty()) {
+      reportUnrenderable(n);
+      return;
+    }
+    pushRelative(n, accuracy * diameter / e.distance, accuracy);
+    return;
+  }
+  if (node.kind == SceneNodeKind::kGroup) {
+    for (std::uint32_t i = 0; i < node.childCount; ++i)
+      pushAbsolute(scene_.children[node.firstChild + i], accuracy);
+    return;
+  }
+  if (e.curve.empty()) return;
+  const double clamped = std::min(accuracy, e.curve.maxAccuracy());
+  std::int64_t best = -1;
+  double bestCost = kInf;
+  for (std::uint32_t i = 0; i < node.childCount; ++i) {
+    const std::uint32_t slot = node.firstChild + i;
+    if (!containsBall(scene_.childRanges[slot], region_.reachBall())) continue;
+    const AbsoluteEntry& child = cache_.absolute[scene_.children[slot]];
+    if (child.visibility == Visibility::kCulled || child.curve.empty()) continue;
+    if (child.curve.maxAccuracy() < clamped * (1.0 - kAccuracyTolerance)) continue;
+    const double cost = child.curve.resourcesFor(std::min(clamped, child.curve.maxAccuracy()));
+    if (cost < bestCost) {
+      bestCost = cost;
+      best = scene_.children[slot];
+    }
+  }
+  if (best >= 0) pushAbsolute(static_cast<std::uint32_t>(best), clamped);
+}
+
+void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
+                                   double absoluteAccuracy) {
+  const RelativeEntry& r = cache_.relative[n];
+  const SceneNode& node = scene_.nodes[n];
+  if (r.curve.empty()) {
+    reportUnrenderable(n);
+    return;
+  }
+  const double clamped = std::min(relativeAccuracy, r.curve.maxAccuracy());
+  if (node.kind == SceneNodeKind::kLeaf) {
+    chooseLeaf(n, absoluteAccuracy, clamped);
+    return;
+  }
+  const double diameter = 2.0 * node.bounds.radius;
+  if (node.kind == SceneNodeKind::kGroup) {
+    for (std::uint32_t i = 0; i < node.childCount; ++i) {
+      const std::uint32_t c = scene_.children[node.firstChild + i];
+      pushRelative(c, clamped * 2.0 * scene_.nodes[c].bounds.radius / diameter, absoluteAccuracy);
+    }
+    return;
+  }
+  std::int64_t best = -1;
+  double bestCost = kInf;
+  double bestAccuracy = 0.0;
+  for (std::uint32_t i = 0; i < node.childCount; ++i) {
+    const std::uint32_t slot = node.firstChild + i;
+    if (!containsBall(scene_.childRanges[slot], r.region.reachBall())) continue;
+    const std::uint32_t c = scene_.children[slot];
+    const AccuracyCurve& child = cache_.relative[c].curve;
+    if (child.empty()) continue;
+    const double childAccuracy = clamped * 2.0 * scene_.nodes[c].bounds.radius / diameter;
+    if (child.maxAccuracy() < childAccuracy * (1.0 - kAccuracyTolerance)) continue;
+    const double cost = child.resourcesFor(std::min(childAccuracy, child.maxAccuracy()));
+    if (cost < bestCost) {
+      bestCost = cost;
+      best = c;
+      bestAccuracy = childAccuracy;
+    }
+  }
+  if (best >= 0) pushRelative(static_cast<std::uint32_t>(best), bestAccuracy, absoluteAccuracy);
+}
+
+void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
+  const SceneNode& node = scene_.nodes[n];
+  const double diameter = 2.0 * node.bounds.radius;
+  const double distance =
+      conversionDistance(region_.center, region_.reachRadius, node.bounds, config_.minimalDistance);
+  collectLeafCandidates(scene_, node.object, region_, config_, CandidateContext::kExact,
+                        pendingFor(state_, node.object), node.bounds, scratch_);
+  double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
+  need = std::min(need, bestCandidateAccuracy(scratch_));
+  int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
+  if (pick < 0) {
+    reportUnrenderable(n);
+    return;
+  }
+  out_->push_back(makeSelection(n, node.object, scratch_[pick], need, distance, diameter));
+}
+
+}  // namespace thinlod::backbone

@@ -1,1 +1,0 @@
-// Placeholder translation unit until the backbone library's first sources land; delete then.

@@ -1,0 +1,99 @@
+// Exact uniform-accuracy solver on the visible tree, for two resources at
+// once and as the fallback of the curve path (private).
+//
+// For a target a, every node gets the set of (triangles, link bytes) totals
+// it can be rendered with at accuracy a (same clamping as the curves: a node
+// renders min(a, its best)): a leaf's candidates, a Group's pairwise sums, an
+// LOD's union over levels reaching it. Dominated points and points above a
+// budget are dropped, so the root set is non-empty iff some choice of one
+// representation per object and one level per LOD meets both budgets at a
+// (exact while no set exceeds paretoCap; larger sets are thinned, which can
+// only make the answer lower, never over budget). Feasibility is monotone in
+// a, so maximise() bisects (geometric, relative tolerance 1e-11). With a
+// single budget the sets are single points and a pass is O(visible nodes).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "selection.h"
+
+namespace thinlod::backbone {
+
+struct JointBudget {
+  bool useTriangles = false;
+  bool useLink = false;
+  double triangles = std::numeric_limits<double>::infinity();
+  double linkBytes = std::numeric_limits<double>::infinity();
+};
+
+class JointSolver {
+ public:
+  JointSolver(const SchedulingScene& scene, const SchedulerConfig& config,
+              const PredictedRegion& region, const PlannerStateImpl& state,
+              const JointBudget& budget, PlanStats& stats);
+
+  bool anythingVisible() const { return leafCount_ > 0; }
+  double lowestAccuracy() const;
+  double highestAccuracy() const;
+  bool feasible(double accuracy);
+  // Drops the least visible leaves (smallest diameter / D) until the
+  // cheapest plan fits; returns how many.
+  std::size_t dropUntilFeasible();
+  // The largest feasible accuracy <= cap, or nullopt when even the cheapest
+  // plan does not fit. `hint` (optional) narrows the bisection.
+  std::optional<double> maximise(std::optional<double> cap, std::optional<double> hint);
+  // Selections of a feasible accuracy (visible leaves of chosen levels).
+  void extract(double accuracy, std::vector<LeafSelection>& out);
+
+ private:
+  struct Node {
+    SceneNodeKind kind = SceneNodeKind::kGroup;
+    std::uint32_t sceneNode = 0;
+    std::uint32_t firstChild = 0;  // into children_
+    std::uint32_t childCount = 0;
+    std::uint32_t firstCandidate = 0;  // into candidates_
+    std::uint32_t candidateCount = 0;
+    std::uint32_t firstStage = 0;  // into stages_ (groups)
+    double distance = 0.0;
+    double diameter = 0.0;
+    double maxAccuracy = 0.0;  // absolute; -inf: renders nothing
+    double minAccuracy = 0.0;
+    bool dropped = false;
+  };
+  struct Point {
+    double triangles;
+    double link;
+    std::int32_t from;   // leaf: candidate; LOD: child position; group: previous stage index
+    std::int32_t child;  // LOD/group: index in the child's set
+    std::int32_t tie;    // prefers copies among equal costs
+  };
+  struct Span {
+    std::uint32_t begin = 0;
+    std::uint32_t size = 0;
+  };
+
+  std::int32_t build(std::uint32_t sceneNode, bool parentInside);
+  void refreshAccuracyBounds();
+  Span evaluate(std::uint32_t k, double accuracy);
+  Span finish(std::uint32_t begin);
+  void extractNode(std::uint32_t k, double accuracy, std::uint32_t index,
+                   std::vector<LeafSelection>& out);
+
+  const SchedulingScene& scene_;
+  const SchedulerConfig& config_;
+  const PredictedRegion& region_;
+  const PlannerStateImpl& state_;
+  JointBudget budget_;
+  PlanStats& stats_;
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> children_;
+  std::vector<LeafCandidate> candidates_;
+  std::vector<Point> arena_;
+  std::vector<Span> nodeSet_;
+  std::vector<Span> stages_;
+  std::size_t leafCount_ = 0;
+  std::int32_t root_ = -1;
+};
+
+}  // namespace thinlod::backbone

@@ -1,0 +1,72 @@
+// What a PlannerState remembers between planning steps (private).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "thinlod/backbone/scheduler.h"
+
+namespace thinlod::backbone {
+
+// Absolute curve of a node for exactly one predicted region (reused only
+// when the region, the subtree and the in-flight requests are unchanged).
+// Entries of a subtree are written in the same pass as their ancestor, so a
+// reused ancestor can read its descendants' entries during push-down.
+struct AbsoluteEntry {
+  bool valid = false;
+  std::uint64_t subtreeVersion = 0;
+  std::uint64_t pendingGeneration = 0;
+  PredictedRegion region;
+  Visibility visibility = Visibility::kCulled;
+  bool merged = false;    // curve = relative curve of the subtree, converted once
+  double distance = 0.0;  // conversion distance D of leaves and merged nodes
+  AccuracyCurve curve;
+};
+
+// Relative curve of a subtree (relative to the node's own diameter), valid
+// for every predicted region inside `region` (conservative candidates).
+struct RelativeEntry {
+  bool valid = false;
+  std::uint64_t subtreeVersion = 0;
+  PredictedRegion region;
+  AccuracyCurve curve;
+};
+
+struct ResourceCache {
+  std::vector<AbsoluteEntry> absolute;
+  std::vector<RelativeEntry> relative;
+};
+
+struct LinkSend {
+  double time = 0.0;
+  double bytes = 0.0;
+};
+
+struct PlannerStateImpl {
+  std::uint64_t steps = 0;
+  std::uint64_t configFingerprint = 0;
+  std::size_t nodeCount = 0;
+  std::size_t objectCount = 0;
+  ResourceCache cache[2];  // [0] triangles, [1] link bytes
+  std::uint64_t pendingGeneration = 1;
+  std::uint64_t nextRequestId = 1;
+  std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object
+  std::deque<LinkSend> linkLog;
+  std::optional<double> previousTarget;
+  std::vector<std::uint16_t> switchCounters;  // per object
+  std::vector<std::uint32_t> lastRendered;    // objects rendered by the previous plan
+  bool scannedFrontend = false;
+  double lastTime = -std::numeric_limits<double>::infinity();
+
+  void clearCaches() {
+    for (ResourceCache& c : cache) {
+      c.absolute.clear();
+      c.relative.clear();
+    }
+  }
+};
+
+}  // namespace thinlod::backbone

@@ -1,0 +1,179 @@
+#include "scheduler_common.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace thinlod::backbone {
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+Status validateBudget(const Budget& budget) {
+  if (!budget.maxTriangles && !budget.maxLinkBytesPerSecond && !budget.fixedAccuracy)
+    return Status(ErrorCode::kInvalidArgument,
+                  "Budget: set maxTriangles, maxLinkBytesPerSecond and/or fixedAccuracy");
+  if (budget.maxTriangles && !(std::isfinite(*budget.maxTriangles) && *budget.maxTriangles >= 0))
+    return Status(ErrorCode::kInvalidArgument, "Budget.maxTriangles must be finite and >= 0");
+  if (budget.maxLinkBytesPerSecond &&
+      !(std::isfinite(*budget.maxLinkBytesPerSecond) && *budget.maxLinkBytesPerSecond >= 0))
+    return Status(ErrorCode::kInvalidArgument,
+                  "Budget.maxLinkBytesPerSecond must be finite and >= 0");
+  if (budget.fixedAccuracy && !(std::isfinite(*budget.fixedAccuracy) && *budget.fixedAccuracy > 0))
+    return Status(ErrorCode::kInvalidArgument, "Budget.fixedAccuracy must be finite and > 0");
+  return Status::okStatus();
+}
+
+const char* objectActionName(ObjectAction action) {
+  switch (action) {
+    case ObjectAction::kKeep:
+      return "keep";
+    case ObjectAction::kSend:
+      return "send";
+    case ObjectAction::kRequest:
+      return "request";
+    case ObjectAction::kAwait:
+      return "await";
+    case ObjectAction::kRemove:
+      return "remove";
+  }
+  return "unknown";
+}
+
+const char* modeName(const Budget& budget) {
+  const int code = (budget.maxTriangles ? 1 : 0) | (budget.maxLinkBytesPerSecond ? 2 : 0) |
+                   (budget.fixedAccuracy ? 4 : 0);
+  static const char* const kNames[] = {
+      "none",  "polygon",       "link",       "polygon+link",
+      "fixed", "fixed+polygon", "fixed+link", "fixed+polygon+link"};
+  return kNames[code];
+}
+
+JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,
+                       const ViewerState& viewer, const SchedulerConfig& config) {
+  JointBudget hard;
+  if (budget.maxTriangles) {
+    hard.useTriangles = true;
+    hard.triangles = *budget.maxTriangles;
+  }
+  if (budget.maxLinkBytesPerSecond) {
+    hard.useLink = true;
+    const double window = config.plannedLifetime;
+    const double sent = recentLinkBytes(state, viewer.timeSeconds, window);
+    hard.linkBytes = std::max(0.0, *budget.maxLinkBytesPerSecond * window - sent);
+  }
+  return hard;
+}
+
+JointBudget reserveShare(const JointBudget& budget, double share) {
+  JointBudget soft = budget;
+  if (soft.useTriangles) soft.triangles *= 1.0 - share;
+  if (soft.useLink) soft.linkBytes *= 1.0 - share;
+  return soft;
+}
+
+bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudget& budget) {
+  double triangles = 0.0;
+  double link = 0.0;
+  for (const LeafSelection& s : selections) {
+    if (!s.rendered) continue;
+    triangles += s.cost.triangles;
+    link += s.cost.linkBytes;
+  }
+  return (!budget.useTriangles || triangles <= budget.triangles) &&
+         (!budget.useLink || link <= budget.linkBytes);
+}
+
+void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& config,
+                         const PredictedRegion& region, PlannerStateImpl& state,
+                         const JointBudget& hard, bool trianglesFirst,
+                         std::vector<LeafSelection>& selections, PlanStats& stats) {
+  double triangles = 0.0;
+  double link = 0.0;
+  for (const LeafSelection& s : selections) {
+    if (!s.rendered) continue;
+    triangles += s.cost.triangles;
+    link += s.cost.linkBytes;
+  }
+  double roomTriangles = hard.useTriangles ? hard.triangles - triangles : kInf;
+  double roomLink = hard.useLink ? hard.linkBytes - link : kInf;
+
+  struct Wish {
+    std::size_t selection;
+    LeafCandidate copy;
+    double extraTriangles;
+    double extraLink;
+    bool byDelay;
+  };
+  std::vector<Wish> wishes;
+  std::vector<LeafCandidate> candidates;
+  for (std::size_t i = 0; i < selections.size(); ++i) {
+    LeafSelection& s = selections[i];
+    if (!s.rendered || s.object >= state.switchCounters.size()) continue;
+    std::uint16_t& counter = state.switchCounters[s.object];
+    if (s.candidate.source == CandidateSource::kFrontendCopy ||
+        s.candidate.source == CandidateSource::kPending) {
+      counter = 0;
+      continue;
+    }
+    // Cheap skip: nothing displayed or in flight for this object.
+    const SceneObject& object = scene.objects[s.object];
+    bool hasCopy = pendingFor(state, s.object) != nullptr;
+    for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
+      hasCopy = scene.options[object.firstOption + k].atFrontend.present;
+    if (!hasCopy) continue;
+    const SceneNode& node = scene.nodes[s.node];
+    collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
+                          pendingFor(state, s.object), node.bounds, candidates);
+    int best = -1;
+    CandidateCost bestCost;
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const LeafCandidate& k = candidates[c];
+      if (k.source != CandidateSource::kFrontendCopy && k.source != CandidateSource::kPending)
+        continue;
+      if (!(k.maxRelativeAccuracy >= s.need * (1.0 - kAccuracyTolerance))) continue;
+      const CandidateCost cost = candidateCost(k, s.need);
+      const double p = trianglesFirst ? cost.triangles : cost.linkBytes;
+      const double bp = trianglesFirst ? bestCost.triangles : bestCost.linkBytes;
+      if (best < 0 || p < bp ||
+          (p == bp && k.source == CandidateSource::kFrontendCopy &&
+           candidates[best].source == CandidateSource::kPending)) {
+        best = static_cast<int>(c);
+        bestCost = cost;
+      }
+    }
+    if (best < 0) {
+      counter = 0;  // nothing valid to keep: the switch is forced
+      continue;
+    }
+    const double keepPrimary = trianglesFirst ? bestCost.triangles : bestCost.linkBytes;
+    const double pickPrimary = trianglesFirst ? s.cost.triangles : s.cost.linkBytes;
+    const bool smallGain = keepPrimary <= pickPrimary * (1.0 + config.preferCurrentShare);
+    const bool delayed = counter < config.switchDelaySteps;
+    if (!smallGain && !delayed) {
+      counter = 0;
+      continue;
+    }
+    wishes.push_back({i, candidates[best], bestCost.triangles - s.cost.triangles,
+                      bestCost.linkBytes - s.cost.linkBytes, !smallGain});
+  }
+  std::stable_sort(wishes.begin(), wishes.end(), [](const Wish& a, const Wish& b) {
+    if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
+    return a.extraLink < b.extraLink;
+  });
+  for (const Wish& w : wishes) {
+    LeafSelection& s = selections[w.selection];
+    std::uint16_t& counter = state.switchCounters[s.object];
+    if (w.extraTriangles > roomTriangles || w.extraLink > roomLink) {
+      counter = 0;  // no room: switch now
+      continue;
+    }
+    roomTriangles -= w.extraTriangles;
+    roomLink -= w.extraLink;
+    s = makeSelection(s.node, s.object, w.copy, s.need, s.distance, s.diameter);
+    counter = w.byDelay ? static_cast<std::uint16_t>(counter + 1) : 0;
+    ++stats.hysteresisKeeps;
+  }
+}
+
+}  // namespace thinlod::backbone
