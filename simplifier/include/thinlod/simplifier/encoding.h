@@ -1,0 +1,109 @@
+// Link encoding: meshes (Draco) and RGBA8 textures (zstd / PNG / JPEG) in a
+// small versioned frame. The encoded byte size is the link cost of a
+// representation (resources of a bytes accuracy curve).
+//
+// Frame (all integers little-endian, 32-byte header then payload):
+//   0 magic "TLME" (mesh) / "TLTX" (texture)   4 u16 version (kFrameVersion)
+//   6 u8 codec   7 u8 flags (0)   8 u32 mesh: vertices / texture: width
+//  12 u32 mesh: triangles / texture: height   16 u32 payload bytes
+//  20 u32 mesh: attribute bits (1 normals, 2 uvs, 4 colors) / texture: 0
+//  24 u64 FNV-1a 64 of the payload            32 payload
+// Contract:
+// - Mesh positions are quantized by Draco: each vertex moves by at most
+//   positionErrorBound() (half a step per axis, step = largest bbox extent /
+//   (2^bits - 1)); normals and uvs are quantized too; colors are exact.
+//   Triangles whose corners repeat an index are dropped before encoding;
+//   Draco may reorder or split vertices, so compare meshes geometrically.
+// - positionBitsForAccuracy(a): the fewest bits (clamped to [8, 20]) whose
+//   worst displacement, step * sqrt(3) / 2 with step <= diagonal/(2^bits-1),
+//   is at most budgetFraction of the error budget diagonal / a. Coarse levels
+//   get fewer bits.
+// - Decoders take untrusted bytes: header fields, payload size and checksum
+//   are verified and counts checked against DecodeLimits before anything is
+//   allocated or a third-party decoder runs; the decoded result is validated
+//   again. Any failure returns an error (kParseError, kVersionMismatch,
+//   kResourceExhausted, kUnsupported); decoders never crash or throw.
+// - Pure functions, no globals; safe to call concurrently.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::simplifier {
+
+inline constexpr std::uint16_t kFrameVersion = 1;
+inline constexpr std::size_t kFrameHeaderBytes = 32;
+
+struct DecodeLimits {
+  std::size_t maxPayloadBytes = 64u << 20;
+  std::size_t maxVertices = 1u << 24;
+  std::size_t maxTriangles = 1u << 24;
+  std::uint32_t maxTextureDimension = 8192;  // per side
+};
+
+// --- Meshes ---
+struct MeshEncodeOptions {
+  int positionBits = 14;  // [8, 20]; see positionBitsForAccuracy
+  int normalBits = 10;
+  int texcoordBits = 12;
+  int encodeSpeed = 5;  // Draco 0 (smallest) .. 10 (fastest)
+  int decodeSpeed = 5;
+};
+
+int positionBitsForAccuracy(double relativeAccuracy, double budgetFraction = 0.1);
+// Largest displacement of any vertex of `mesh` encoded with `bits` (units).
+double positionErrorBound(const IndexedMesh& mesh, int bits);
+
+// Errors: invalid mesh or options (kInvalidArgument), no triangles left.
+Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& mesh,
+                                             const MeshEncodeOptions& options = {});
+Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
+                               const DecodeLimits& limits = {});
+
+// --- Textures ---
+struct TextureRGBA8 {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::vector<std::uint8_t> pixels;  // width * height * 4, rows top to bottom
+};
+
+enum class TextureCodec : std::uint8_t { kZstd = 1, kPng = 2, kJpeg = 3 };
+
+// Codec choice (measured on a 256x256 impostor, PLATFORM.md: zstd-1 0.25 ms
+// / 20 KB, PNG 4.8 ms / 15 KB, JPEG q85 0.4 ms / 5.8 KB):
+// - kFastest: zstd only; for impostors refreshed every few frames.
+// - kSmallestLossless: PNG and zstd both, the smaller wins (costs both).
+// - kSmallest: as kSmallestLossless, plus JPEG when every alpha is 255 and
+//   the JPEG's PSNR >= jpegMinPsnr; the smallest acceptable encoding wins.
+enum class TexturePolicy : std::uint8_t { kFastest, kSmallestLossless, kSmallest };
+
+struct TextureEncodeOptions {
+  TexturePolicy policy = TexturePolicy::kSmallest;
+  int zstdLevel = 1;
+  int pngCompressionLevel = 6;  // zlib 0..9
+  int jpegQuality = 85;
+  double jpegMinPsnr = 32.0;  // dB over RGB
+};
+
+struct EncodedTexture {
+  TextureCodec codec = TextureCodec::kZstd;
+  std::vector<std::uint8_t> bytes;  // the whole frame
+};
+
+Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
+                                     const TextureEncodeOptions& options = {});
+// One codec, no policy (JPEG drops alpha: kInvalidArgument unless opaque).
+Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture, TextureCodec codec,
+                                                    const TextureEncodeOptions& options = {});
+Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
+                                   const DecodeLimits& limits = {});
+
+// FNV-1a 64 over bytes: the frame's payload checksum (catches corruption on
+// the link, not forgery).
+std::uint64_t frameChecksum(const std::uint8_t* data, std::size_t size);
+
+}  // namespace thinlod::simplifier

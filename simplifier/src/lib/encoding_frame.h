@@ -1,0 +1,40 @@
+// Private to encoding*.cpp: the 32-byte frame header of encoding.h.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "thinlod/common/status.h"
+#include "thinlod/simplifier/encoding.h"
+
+namespace thinlod::simplifier::detail {
+
+struct FrameHeader {
+  std::array<char, 4> magic{};
+  std::uint16_t version = kFrameVersion;
+  std::uint8_t codec = 0;
+  std::uint8_t flags = 0;
+  std::uint32_t countA = 0;  // mesh vertices / texture width
+  std::uint32_t countB = 0;  // mesh triangles / texture height
+  std::uint32_t payloadBytes = 0;
+  std::uint32_t attributes = 0;
+  std::uint64_t checksum = 0;
+};
+
+inline constexpr std::array<char, 4> kMeshMagic = {'T', 'L', 'M', 'E'};
+inline constexpr std::array<char, 4> kTextureMagic = {'T', 'L', 'T', 'X'};
+
+// Header + payload; fills payloadBytes and checksum. Precondition: the
+// payload fits in 32 bits (callers check against their limits first).
+std::vector<std::uint8_t> makeFrame(FrameHeader header, const std::uint8_t* payload,
+                                    std::size_t payloadSize);
+
+// Checks magic, version, flags, payload size (== size - header, within
+// limits.maxPayloadBytes) and checksum. `what` names the stream in errors.
+Result<FrameHeader> parseFrame(const std::uint8_t* data, std::size_t size,
+                               const std::array<char, 4>& magic, const DecodeLimits& limits,
+                               const char* what);
+
+}  // namespace thinlod::simplifier::detail

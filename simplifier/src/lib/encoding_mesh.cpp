@@ -1,0 +1,271 @@
+// Mesh link encoding with Draco (see encoding.h for the contract).
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+
+#include "encoding_frame.h"
+#include "thinlod/simplifier/encoding.h"
+
+namespace thinlod::simplifier {
+namespace {
+
+constexpr std::uint8_t kCodecDraco = 1;
+constexpr std::uint32_t kHasNormals = 1;
+constexpr std::uint32_t kHasUvs = 2;
+constexpr std::uint32_t kHasColors = 4;
+constexpr int kMinPositionBits = 8;
+constexpr int kMaxPositionBits = 20;
+
+Status invalid(const std::string& message) {
+  return Status(ErrorCode::kInvalidArgument, "encodeMesh: " + message);
+}
+
+// Triangles with a repeated corner index are dropped and unreferenced
+// vertices removed, so the vertex and face counts Draco reports are the ones
+// the decoder reproduces.
+IndexedMesh compactForEncoding(const IndexedMesh& mesh) {
+  IndexedMesh out;
+  std::vector<std::uint32_t> remap(mesh.vertexCount(), UINT32_MAX);
+  auto mapVertex = [&](std::uint32_t v) {
+    if (remap[v] == UINT32_MAX) {
+      remap[v] = static_cast<std::uint32_t>(out.positions.size());
+      out.positions.push_back(mesh.positions[v]);
+      if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
+      if (!mesh.uvs.empty()) out.uvs.push_back(mesh.uvs[v]);
+      if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
+    }
+    return remap[v];
+  };
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
+    if (a == b || b == c || c == a) continue;
+    out.indices.push_back(mapVertex(a));
+    out.indices.push_back(mapVertex(b));
+    out.indices.push_back(mapVertex(c));
+  }
+  return out;
+}
+
+template <typename T>
+int addAttribute(draco::Mesh& target, draco::GeometryAttribute::Type type, draco::DataType dataType,
+                 int components, bool normalized, const std::vector<T>& values) {
+  draco::GeometryAttribute attribute;
+  attribute.Init(type, nullptr, static_cast<std::uint8_t>(components), dataType, normalized,
+                 static_cast<std::int64_t>(sizeof(T)), 0);
+  const int id = target.AddAttribute(attribute, true, static_cast<std::uint32_t>(values.size()));
+  draco::PointAttribute* stored = target.attribute(id);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    stored->SetAttributeValue(draco::AttributeValueIndex(static_cast<std::uint32_t>(i)),
+                              &values[i]);
+  }
+  return id;
+}
+
+Status decodeError(ErrorCode code, const std::string& message) {
+  return Status(code, "decodeMesh: " + message);
+}
+
+// Reads a per-point attribute with the expected component count.
+template <int N, typename Store>
+Status readAttribute(const draco::Mesh& mesh, draco::GeometryAttribute::Type type, const char* name,
+                     Store& out) {
+  const draco::PointAttribute* attribute = mesh.GetNamedAttribute(type);
+  if (attribute == nullptr) {
+    return decodeError(ErrorCode::kParseError, std::string("missing attribute ") + name);
+  }
+  if (attribute->num_components() != N) {
+    return decodeError(ErrorCode::kParseError,
+                       std::string(name) + " has " +
+                           std::to_string(static_cast<int>(attribute->num_components())) +
+                           " components, expected " + std::to_string(N));
+  }
+  out.resize(mesh.num_points());
+  for (std::uint32_t i = 0; i < mesh.num_points(); ++i) {
+    const draco::AttributeValueIndex value = attribute->mapped_index(draco::PointIndex(i));
+    if (value.value() >= attribute->size()) {
+      return decodeError(ErrorCode::kParseError, std::string(name) + " index out of range");
+    }
+    using Element = std::remove_reference_t<decltype(out[0][0])>;
+    if (!attribute->template ConvertValue<Element, N>(value, &out[i][0])) {
+      return decodeError(ErrorCode::kParseError, std::string("cannot convert ") + name);
+    }
+  }
+  return Status();
+}
+
+Result<IndexedMesh> toIndexedMesh(const draco::Mesh& decoded, std::uint32_t attributes) {
+  IndexedMesh mesh;
+  THINLOD_RETURN_IF_ERROR(
+      readAttribute<3>(decoded, draco::GeometryAttribute::POSITION, "positions", mesh.positions));
+  if (attributes & kHasNormals) {
+    THINLOD_RETURN_IF_ERROR(
+        readAttribute<3>(decoded, draco::GeometryAttribute::NORMAL, "normals", mesh.normals));
+  }
+  if (attributes & kHasUvs) {
+    THINLOD_RETURN_IF_ERROR(
+        readAttribute<2>(decoded, draco::GeometryAttribute::TEX_COORD, "uvs", mesh.uvs));
+  }
+  if (attributes & kHasColors) {
+    THINLOD_RETURN_IF_ERROR(
+        readAttribute<4>(decoded, draco::GeometryAttribute::COLOR, "colors", mesh.colors));
+  }
+  mesh.indices.reserve(static_cast<std::size_t>(decoded.num_faces()) * 3);
+  for (draco::FaceIndex f(0); f < decoded.num_faces(); ++f) {
+    for (const draco::PointIndex& corner : decoded.face(f)) mesh.indices.push_back(corner.value());
+  }
+  THINLOD_RETURN_IF_ERROR(mesh.validate("decodeMesh: decoded mesh"));
+  return mesh;
+}
+
+}  // namespace
+
+int positionBitsForAccuracy(double relativeAccuracy, double budgetFraction) {
+  if (!(relativeAccuracy > 0.0) || !(budgetFraction > 0.0) || !std::isfinite(budgetFraction)) {
+    return kMaxPositionBits;
+  }
+  if (!std::isfinite(relativeAccuracy)) return kMaxPositionBits;
+  // diagonal / (2^b - 1) * sqrt(3) / 2 <= budgetFraction * diagonal / a
+  const double levels = relativeAccuracy * std::sqrt(3.0) / (2.0 * budgetFraction) + 1.0;
+  const int bits = static_cast<int>(std::ceil(std::log2(levels)));
+  return std::clamp(bits, kMinPositionBits, kMaxPositionBits);
+}
+
+double positionErrorBound(const IndexedMesh& mesh, int bits) {
+  const Bounds b = mesh.bounds();
+  if (b.empty) return 0.0;
+  const glm::vec3 extent = b.max - b.min;
+  const double range = std::max({extent.x, extent.y, extent.z});
+  const double step = range / (std::ldexp(1.0, bits) - 1.0);
+  return 0.5 * step * std::sqrt(3.0);
+}
+
+Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& input,
+                                             const MeshEncodeOptions& options) {
+  THINLOD_RETURN_IF_ERROR(input.validate("encodeMesh: input"));
+  if (options.positionBits < kMinPositionBits || options.positionBits > kMaxPositionBits) {
+    return invalid("positionBits " + std::to_string(options.positionBits) + " outside [8, 20]");
+  }
+  if (options.normalBits < 4 || options.normalBits > 20 || options.texcoordBits < 4 ||
+      options.texcoordBits > 20) {
+    return invalid("normalBits and texcoordBits must be in [4, 20]");
+  }
+  if (options.encodeSpeed < 0 || options.encodeSpeed > 10 || options.decodeSpeed < 0 ||
+      options.decodeSpeed > 10) {
+    return invalid("Draco speeds must be in [0, 10]");
+  }
+  const IndexedMesh mesh = compactForEncoding(input);
+  if (mesh.triangleCount() == 0) return invalid("no non-degenerate triangles");
+
+  try {
+    draco::Mesh draco;
+    draco.set_num_points(static_cast<std::uint32_t>(mesh.vertexCount()));
+    addAttribute(draco, draco::GeometryAttribute::POSITION, draco::DT_FLOAT32, 3, false,
+                 mesh.positions);
+    std::uint32_t attributes = 0;
+    if (!mesh.normals.empty()) {
+      addAttribute(draco, draco::GeometryAttribute::NORMAL, draco::DT_FLOAT32, 3, false,
+                   mesh.normals);
+      attributes |= kHasNormals;
+    }
+    if (!mesh.uvs.empty()) {
+      addAttribute(draco, draco::GeometryAttribute::TEX_COORD, draco::DT_FLOAT32, 2, false,
+                   mesh.uvs);
+      attributes |= kHasUvs;
+    }
+    if (!mesh.colors.empty()) {
+      addAttribute(draco, draco::GeometryAttribute::COLOR, draco::DT_UINT8, 4, true, mesh.colors);
+      attributes |= kHasColors;
+    }
+    draco.SetNumFaces(mesh.triangleCount());
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+      draco::Mesh::Face face;
+      for (int k = 0; k < 3; ++k) face[k] = draco::PointIndex(mesh.indices[3 * t + k]);
+      draco.SetFace(draco::FaceIndex(t), face);
+    }
+
+    draco::Encoder encoder;
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.positionBits);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.normalBits);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, options.texcoordBits);
+    encoder.SetSpeedOptions(options.encodeSpeed, options.decodeSpeed);
+    encoder.SetTrackEncodedProperties(true);
+    draco::EncoderBuffer buffer;
+    const draco::Status status = encoder.EncodeMeshToBuffer(draco, &buffer);
+    if (!status.ok()) {
+      return Status(ErrorCode::kInternal, std::string("encodeMesh: Draco: ") + status.error_msg());
+    }
+    if (buffer.size() > UINT32_MAX) return invalid("encoded mesh exceeds 4 GiB");
+
+    detail::FrameHeader header;
+    header.magic = detail::kMeshMagic;
+    header.codec = kCodecDraco;
+    header.countA = static_cast<std::uint32_t>(encoder.num_encoded_points());
+    header.countB = static_cast<std::uint32_t>(encoder.num_encoded_faces());
+    header.attributes = attributes;
+    return detail::makeFrame(header, reinterpret_cast<const std::uint8_t*>(buffer.data()),
+                             buffer.size());
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kResourceExhausted, "encodeMesh: out of memory");
+  } catch (const std::exception& e) {
+    return Status(ErrorCode::kInternal, std::string("encodeMesh: ") + e.what());
+  }
+}
+
+Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
+                               const DecodeLimits& limits) {
+  Result<detail::FrameHeader> parsed =
+      detail::parseFrame(data, size, detail::kMeshMagic, limits, "decodeMesh");
+  if (!parsed.ok()) return parsed.status();
+  const detail::FrameHeader& header = *parsed;
+  if (header.codec != kCodecDraco) {
+    return decodeError(ErrorCode::kUnsupported, "unknown codec " + std::to_string(header.codec));
+  }
+  if (header.attributes & ~(kHasNormals | kHasUvs | kHasColors)) {
+    return decodeError(ErrorCode::kUnsupported,
+                       "unknown attribute bits " + std::to_string(header.attributes));
+  }
+  if (header.countA > limits.maxVertices || header.countB > limits.maxTriangles) {
+    return decodeError(ErrorCode::kResourceExhausted,
+                       std::to_string(header.countA) + " vertices / " +
+                           std::to_string(header.countB) + " triangles exceed the limits");
+  }
+  if (header.countB == 0 || header.countA < 3) {
+    return decodeError(ErrorCode::kParseError, "frame declares an empty mesh");
+  }
+  try {
+    draco::DecoderBuffer buffer;
+    buffer.Init(reinterpret_cast<const char*>(data + kFrameHeaderBytes), header.payloadBytes);
+    draco::StatusOr<draco::EncodedGeometryType> type =
+        draco::Decoder::GetEncodedGeometryType(&buffer);
+    if (!type.ok() || type.value() != draco::TRIANGULAR_MESH) {
+      return decodeError(ErrorCode::kParseError, "payload is not a Draco triangle mesh");
+    }
+    draco::Decoder decoder;
+    draco::StatusOr<std::unique_ptr<draco::Mesh>> decoded = decoder.DecodeMeshFromBuffer(&buffer);
+    if (!decoded.ok()) {
+      return decodeError(ErrorCode::kParseError,
+                         std::string("Draco: ") + decoded.status().error_msg());
+    }
+    const draco::Mesh& mesh = *decoded.value();
+    if (mesh.num_points() != header.countA || mesh.num_faces() != header.countB) {
+      return decodeError(ErrorCode::kParseError,
+                         "decoded " + std::to_string(mesh.num_points()) + " vertices / " +
+                             std::to_string(mesh.num_faces()) + " triangles, header says " +
+                             std::to_string(header.countA) + " / " + std::to_string(header.countB));
+    }
+    return toIndexedMesh(mesh, header.attributes);
+  } catch (const std::bad_alloc&) {
+    return decodeError(ErrorCode::kResourceExhausted, "out of memory");
+  } catch (const std::exception& e) {
+    return decodeError(ErrorCode::kParseError, e.what());
+  }
+}
+
+}  // namespace thinlod::simplifier

@@ -1,0 +1,269 @@
+// Texture link encoding: raw RGBA8 + zstd, PNG or JPEG through OpenImageIO
+// (see encoding.h for the frame and the codec policy).
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+#include <zstd.h>
+
+#include <cmath>
+#include <exception>
+#include <new>
+#include <string>
+
+#include "encoding_frame.h"
+#include "thinlod/simplifier/encoding.h"
+
+namespace thinlod::simplifier {
+namespace {
+
+// A file name only selects OpenImageIO's format plugin; bytes go through
+// an in-memory IOProxy.
+const char* formatFileName(TextureCodec codec) {
+  return codec == TextureCodec::kPng ? "link.png" : "link.jpg";
+}
+
+Status textureError(ErrorCode code, const std::string& message) {
+  return Status(code, "texture: " + message);
+}
+
+Status checkTexture(const TextureRGBA8& texture) {
+  if (texture.width == 0 || texture.height == 0) {
+    return textureError(ErrorCode::kInvalidArgument, "empty image");
+  }
+  if (texture.width > 65500 || texture.height > 65500) {
+    return textureError(ErrorCode::kInvalidArgument, "side longer than 65500 pixels");
+  }
+  const std::uint64_t expected = std::uint64_t{texture.width} * texture.height * 4;
+  if (texture.pixels.size() != expected) {
+    return textureError(ErrorCode::kInvalidArgument,
+                        "pixel buffer has " + std::to_string(texture.pixels.size()) +
+                            " bytes, expected " + std::to_string(expected));
+  }
+  return Status();
+}
+
+bool isOpaque(const TextureRGBA8& texture) {
+  for (std::size_t i = 3; i < texture.pixels.size(); i += 4) {
+    if (texture.pixels[i] != 255) return false;
+  }
+  return true;
+}
+
+Result<std::vector<std::uint8_t>> zstdPayload(const TextureRGBA8& texture, int level) {
+  std::vector<std::uint8_t> out(ZSTD_compressBound(texture.pixels.size()));
+  const std::size_t written =
+      ZSTD_compress(out.data(), out.size(), texture.pixels.data(), texture.pixels.size(), level);
+  if (ZSTD_isError(written)) {
+    return textureError(ErrorCode::kInternal, std::string("zstd: ") + ZSTD_getErrorName(written));
+  }
+  out.resize(written);
+  return out;
+}
+
+Result<std::vector<std::uint8_t>> imagePayload(const TextureRGBA8& texture, TextureCodec codec,
+                                               const TextureEncodeOptions& options) {
+  const bool jpeg = codec == TextureCodec::kJpeg;
+  const int channels = jpeg ? 3 : 4;
+  std::vector<std::uint8_t> rgb;
+  const std::uint8_t* pixels = texture.pixels.data();
+  if (jpeg) {  // JPEG has no alpha channel: drop it (callers ensure it is 255)
+    rgb.resize(std::size_t{texture.width} * texture.height * 3);
+    for (std::size_t p = 0, n = rgb.size() / 3; p < n; ++p) {
+      for (int c = 0; c < 3; ++c) rgb[3 * p + c] = texture.pixels[4 * p + c];
+    }
+    pixels = rgb.data();
+  }
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  OIIO::ImageSpec spec(static_cast<int>(texture.width), static_cast<int>(texture.height), channels,
+                       OIIO::TypeDesc::UINT8);
+  if (jpeg) {
+    spec.attribute("Compression", "jpeg:" + std::to_string(options.jpegQuality));
+  } else {
+    spec.attribute("png:compressionLevel", options.pngCompressionLevel);
+    // libpng's default adaptive filter choice tries all five filters per
+    // row: about 4x slower than the fixed "sub" filter at a similar size on
+    // impostor images (measured in docs/results/error-validation.md).
+    constexpr int kPngFilterSub = 0x10;  // PNG_FILTER_SUB
+    spec.attribute("png:filter", kPngFilterSub);
+    // Our pixels are stored as given: no premultiplication either way.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+  }
+  std::unique_ptr<OIIO::ImageOutput> output =
+      OIIO::ImageOutput::create(formatFileName(codec), &proxy);
+  if (!output || !output->open(formatFileName(codec), spec) ||
+      !output->write_image(OIIO::TypeDesc::UINT8, pixels) || !output->close()) {
+    const std::string why = output ? output->geterror() : OIIO::geterror();
+    return textureError(ErrorCode::kInternal, "OpenImageIO encode: " + why);
+  }
+  return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+}
+
+Result<std::vector<std::uint8_t>> payloadFor(const TextureRGBA8& texture, TextureCodec codec,
+                                             const TextureEncodeOptions& options) {
+  switch (codec) {
+    case TextureCodec::kZstd:
+      return zstdPayload(texture, options.zstdLevel);
+    case TextureCodec::kPng:
+    case TextureCodec::kJpeg:
+      return imagePayload(texture, codec, options);
+  }
+  return textureError(ErrorCode::kInvalidArgument, "unknown codec");
+}
+
+Status decodeZstd(const std::uint8_t* payload, std::size_t size, TextureRGBA8& out) {
+  const std::size_t expected = out.pixels.size();
+  const unsigned long long content = ZSTD_getFrameContentSize(payload, size);
+  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN ||
+      content != expected) {
+    return textureError(ErrorCode::kParseError, "zstd frame size does not match the image");
+  }
+  if (ZSTD_findFrameCompressedSize(payload, size) != size) {
+    return textureError(ErrorCode::kParseError, "zstd payload is not exactly one frame");
+  }
+  const std::size_t written = ZSTD_decompress(out.pixels.data(), expected, payload, size);
+  if (ZSTD_isError(written) || written != expected) {
+    return textureError(ErrorCode::kParseError, "zstd payload is corrupt");
+  }
+  return Status();
+}
+
+Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
+                   TextureRGBA8& out) {
+  OIIO::Filesystem::IOMemReader proxy(payload, size);
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  // OpenImageIO 2.4 only honours the proxy next to other configuration
+  // hints when it arrives as the "oiio:ioproxy" hint itself.
+  void* proxyPointer = &proxy;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
+  std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(formatFileName(codec), &config);
+  if (!input) {
+    return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + OIIO::geterror());
+  }
+  const OIIO::ImageSpec& spec = input->spec();
+  const int wantChannels = codec == TextureCodec::kJpeg ? 3 : 4;
+  // Checked against the frame header before any pixel is decoded.
+  if (spec.width != static_cast<int>(out.width) || spec.height != static_cast<int>(out.height) ||
+      spec.depth != 1 || spec.nchannels != wantChannels) {
+    return textureError(ErrorCode::kParseError,
+                        "image is " + std::to_string(spec.width) + "x" +
+                            std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) +
+                            ", header says " + std::to_string(out.width) + "x" +
+                            std::to_string(out.height) + "x" + std::to_string(wantChannels));
+  }
+  bool ok = false;
+  if (wantChannels == 4) {
+    ok = input->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, out.pixels.data());
+  } else {
+    std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
+    ok = input->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
+    for (std::size_t p = 0, n = rgb.size() / 3; ok && p < n; ++p) {
+      for (int c = 0; c < 3; ++c) out.pixels[4 * p + c] = rgb[3 * p + c];
+      out.pixels[4 * p + 3] = 255;
+    }
+  }
+  if (!ok) return textureError(ErrorCode::kParseError, "OpenImageIO: " + input->geterror());
+  return Status();
+}
+
+double psnrRgb(const TextureRGBA8& a, const TextureRGBA8& b) {
+  double squared = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const double d = static_cast<double>(a.pixels[i]) - b.pixels[i];
+    squared += d * d;
+  }
+  const double mse = squared / (a.pixels.size() / 4 * 3);
+  return mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : INFINITY;
+}
+
+}  // namespace
+
+Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture, TextureCodec codec,
+                                                    const TextureEncodeOptions& options) {
+  THINLOD_RETURN_IF_ERROR(checkTexture(texture));
+  if (codec == TextureCodec::kJpeg && !isOpaque(texture)) {
+    return textureError(ErrorCode::kInvalidArgument, "JPEG needs an opaque image (alpha 255)");
+  }
+  try {
+    Result<std::vector<std::uint8_t>> payload = payloadFor(texture, codec, options);
+    if (!payload.ok()) return payload.status();
+    detail::FrameHeader header;
+    header.magic = detail::kTextureMagic;
+    header.codec = static_cast<std::uint8_t>(codec);
+    header.countA = texture.width;
+    header.countB = texture.height;
+    return detail::makeFrame(header, payload->data(), payload->size());
+  } catch (const std::bad_alloc&) {
+    return textureError(ErrorCode::kResourceExhausted, "out of memory");
+  } catch (const std::exception& e) {
+    return textureError(ErrorCode::kInternal, e.what());
+  }
+}
+
+Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
+                                     const TextureEncodeOptions& options) {
+  std::vector<TextureCodec> candidates = {TextureCodec::kZstd};
+  if (options.policy != TexturePolicy::kFastest) candidates.push_back(TextureCodec::kPng);
+  if (options.policy == TexturePolicy::kSmallest && checkTexture(texture).ok() &&
+      isOpaque(texture)) {
+    candidates.push_back(TextureCodec::kJpeg);
+  }
+  EncodedTexture best;
+  bool haveBest = false;
+  for (TextureCodec codec : candidates) {
+    Result<std::vector<std::uint8_t>> frame = encodeTextureWith(texture, codec, options);
+    if (!frame.ok()) return frame.status();
+    if (haveBest && frame->size() >= best.bytes.size()) continue;
+    if (codec == TextureCodec::kJpeg) {
+      Result<TextureRGBA8> decoded = decodeTexture(frame->data(), frame->size());
+      if (!decoded.ok() || psnrRgb(texture, *decoded) < options.jpegMinPsnr) continue;
+    }
+    best.codec = codec;
+    best.bytes = std::move(*frame);
+    haveBest = true;
+  }
+  return best;
+}
+
+Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
+                                   const DecodeLimits& limits) {
+  Result<detail::FrameHeader> parsed =
+      detail::parseFrame(data, size, detail::kTextureMagic, limits, "decodeTexture");
+  if (!parsed.ok()) return parsed.status();
+  const detail::FrameHeader& header = *parsed;
+  if (header.codec < static_cast<std::uint8_t>(TextureCodec::kZstd) ||
+      header.codec > static_cast<std::uint8_t>(TextureCodec::kJpeg)) {
+    return textureError(ErrorCode::kUnsupported, "unknown codec " + std::to_string(header.codec));
+  }
+  if (header.attributes != 0) {
+    return textureError(ErrorCode::kUnsupported, "unknown attribute bits");
+  }
+  if (header.countA == 0 || header.countB == 0 || header.countA > limits.maxTextureDimension ||
+      header.countB > limits.maxTextureDimension) {
+    return textureError(ErrorCode::kResourceExhausted,
+                        "dimensions " + std::to_string(header.countA) + "x" +
+                            std::to_string(header.countB) + " outside [1, " +
+                            std::to_string(limits.maxTextureDimension) + "]");
+  }
+  try {
+    TextureRGBA8 texture;
+    texture.width = header.countA;
+    texture.height = header.countB;
+    texture.pixels.resize(std::size_t{texture.width} * texture.height * 4);
+    const std::uint8_t* payload = data + kFrameHeaderBytes;
+    const TextureCodec codec = static_cast<TextureCodec>(header.codec);
+    if (codec == TextureCodec::kZstd) {
+      THINLOD_RETURN_IF_ERROR(decodeZstd(payload, header.payloadBytes, texture));
+    } else {
+      THINLOD_RETURN_IF_ERROR(decodeImage(payload, header.payloadBytes, codec, texture));
+    }
+    return texture;
+  } catch (const std::bad_alloc&) {
+    return textureError(ErrorCode::kResourceExhausted, "out of memory");
+  } catch (const std::exception& e) {
+    return textureError(ErrorCode::kParseError, e.what());
+  }
+}
+
+}  // namespace thinlod::simplifier
