@@ -96,7 +96,9 @@ class AccuracyCurve {
   // is cheapest on each resulting segment (index into `children`).
   // A child stays available up to and including its maxAccuracy, so where
   // the cheapest child runs out the envelope jumps at the next double above
-  // that maxAccuracy. O(total knots and crossings * log children).
+  // that maxAccuracy. Where two lines cross within one ulp of a knot the
+  // result may exceed the pointwise minimum by at most slope * ulp(a), the
+  // price of staying monotone. O(total knots and crossings * log children).
   static AccuracyCurve lowerEnvelope(const std::vector<const AccuracyCurve*>& children,
                                      std::vector<int>* segmentOwner = nullptr);
 

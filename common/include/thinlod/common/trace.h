@@ -1,0 +1,70 @@
+// Flight-path traces: timed camera poses the frontend replays and the
+// backbone predicts from. Text format in docs/trace-format.md.
+//
+// Contract:
+// - Pose: time in seconds (strictly increasing within a trace), position in
+//   metres (world frame), orientation camera-to-world (the camera looks down
+//   its -Z axis with +Y up, the OpenGL convention), vertical field of view in
+//   degrees in (0, 180). Everything finite.
+// - parseTrace() is pure: text in, Trace or Status out; it never throws and
+//   checks every field. Errors are kParseError ("line N: ..."), or
+//   kVersionMismatch for an unknown header version.
+// - writeTrace() emits the `quat` form with enough digits that
+//   parseTrace(writeTrace(t)) reproduces t bit for bit.
+// - loadTraceFile()/saveTraceFile() are the thin file wrappers; their
+//   errors are prefixed with the path (kNotFound, kIoError,
+//   kResourceExhausted above kMaxTraceFileBytes, or the parse error).
+// - samplePose() interpolates (position and fov linearly, orientation by
+//   slerp) and clamps outside the trace's time span.
+// - No globals; everything is thread-safe on distinct objects.
+#pragma once
+
+#include <cstddef>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "thinlod/common/status.h"
+
+namespace thinlod {
+
+inline constexpr int kTraceVersion = 1;
+inline constexpr std::size_t kMaxTraceFileBytes = std::size_t{256} << 20;
+
+struct Pose {
+  double time = 0.0;                              // seconds
+  glm::vec3 position{0.0f};                       // metres, world
+  glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};  // camera to world, unit
+  float fovYDegrees = 60.0f;                      // vertical, (0, 180)
+
+  float fovYRadians() const { return glm::radians(fovYDegrees); }
+  glm::vec3 forward() const { return orientation * glm::vec3(0.0f, 0.0f, -1.0f); }
+  bool operator==(const Pose& other) const;
+};
+
+struct Trace {
+  std::vector<Pose> poses;  // non-empty once parsed, times strictly increasing
+  double duration() const { return poses.empty() ? 0.0 : poses.back().time - poses.front().time; }
+};
+
+// World-to-camera matrix (what glm::lookAt would build for this pose).
+glm::mat4 viewMatrix(const Pose& pose);
+
+// The camera-to-world rotation that looks from `position` towards `target`
+// with world +Y up (+/-Z up when looking straight down/up). Precondition:
+// target != position.
+glm::quat lookAtOrientation(const glm::vec3& position, const glm::vec3& target);
+
+Result<Trace> parseTrace(std::string_view text);
+std::string writeTrace(const Trace& trace);
+
+// Precondition: !trace.poses.empty().
+Pose samplePose(const Trace& trace, double time);
+
+Result<Trace> loadTraceFile(const std::string& path);
+Status saveTraceFile(const std::string& path, const Trace& trace);
+
+}  // namespace thinlod

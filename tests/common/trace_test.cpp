@@ -1,0 +1,231 @@
+// Flight-path traces: parsing both pose forms, every error with its line
+// number, bit-exact write/parse round trips, sampling and the view matrix.
+#include "thinlod/common/trace.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <random>
+#include <string>
+
+namespace thinlod {
+namespace {
+
+constexpr const char* kHeader = "# thinlod-trace 1\n";
+
+::testing::AssertionResult failsOnLine(std::string_view text, int line, const char* needle,
+                                       ErrorCode code = ErrorCode::kParseError) {
+  const Result<Trace> t = parseTrace(text);
+  if (t.ok()) return ::testing::AssertionFailure() << "unexpectedly parsed";
+  const std::string& message = t.status().message();
+  if (t.status().code() != code) {
+    return ::testing::AssertionFailure() << "wrong code: " << t.status().toString();
+  }
+  const std::string prefix = "line " + std::to_string(line) + ": ";
+  if (message.rfind(prefix, 0) != 0) {
+    return ::testing::AssertionFailure() << "expected '" << prefix << "' in: " << message;
+  }
+  if (message.find(needle) == std::string::npos) {
+    return ::testing::AssertionFailure() << "expected '" << needle << "' in: " << message;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+std::string withHeader(const std::string& body) { return kHeader + body; }
+
+void expectNear(const glm::mat4& a, const glm::mat4& b, float tolerance) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(a[c][r], b[c][r], tolerance) << c << "," << r;
+  }
+}
+
+// --- Parsing ------------------------------------------------------------------
+
+TEST(Trace, ParsesLookatAndQuatLines) {
+  const auto t =
+      parseTrace(withHeader("# a comment line\n"
+                            "\n"
+                            "0.0  0 1.6 10  lookat 0 0.5 0  60\n"
+                            "0.5\t1 2 3\tquat 1 0 0 0 45   # trailing comment\n"));
+  ASSERT_TRUE(t.ok()) << t.status().toString();
+  ASSERT_EQ(t->poses.size(), 2u);
+  EXPECT_EQ(t->poses[0].time, 0.0);
+  EXPECT_EQ(t->poses[0].position, glm::vec3(0, 1.6f, 10));
+  EXPECT_EQ(t->poses[0].fovYDegrees, 60.0f);
+  EXPECT_EQ(t->poses[1].position, glm::vec3(1, 2, 3));
+  EXPECT_EQ(t->poses[1].orientation, glm::quat(1, 0, 0, 0));
+  EXPECT_EQ(t->poses[1].fovYDegrees, 45.0f);
+  EXPECT_DOUBLE_EQ(t->duration(), 0.5);
+}
+
+TEST(Trace, LookatPoseMatchesGlmLookAt) {
+  const auto t = parseTrace(withHeader("0 3 2 1 lookat -1 0.5 4 60\n"));
+  ASSERT_TRUE(t.ok());
+  const glm::mat4 expected =
+      glm::lookAt(glm::vec3(3, 2, 1), glm::vec3(-1, 0.5f, 4), glm::vec3(0, 1, 0));
+  expectNear(viewMatrix(t->poses[0]), expected, 1e-5f);
+  const glm::vec3 toTarget = glm::normalize(glm::vec3(-1, 0.5f, 4) - glm::vec3(3, 2, 1));
+  EXPECT_NEAR(glm::dot(t->poses[0].forward(), toTarget), 1.0f, 1e-6f);
+}
+
+TEST(Trace, LookingStraightDownIsWellDefined) {
+  const auto t = parseTrace(withHeader("0 0 10 0 lookat 0 0 0 60\n"));
+  ASSERT_TRUE(t.ok());
+  EXPECT_NEAR(t->poses[0].forward().y, -1.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(t->poses[0].orientation), 1.0f, 1e-6f);
+}
+
+TEST(Trace, NonUnitQuaternionIsNormalised) {
+  const auto t = parseTrace(withHeader("0 0 0 0 quat 2 0 0 0 60\n"));
+  ASSERT_TRUE(t.ok());
+  EXPECT_EQ(t->poses[0].orientation, glm::quat(1, 0, 0, 0));
+}
+
+TEST(Trace, AcceptsMissingFinalNewlineAndCrlf) {
+  const auto t =
+      parseTrace("# thinlod-trace 1\r\n0 0 0 0 quat 1 0 0 0 60\r\n1 0 0 1 quat 1 0 0 0 60");
+  ASSERT_TRUE(t.ok()) << t.status().toString();
+  EXPECT_EQ(t->poses.size(), 2u);
+}
+
+// --- Errors, each with its line number ----------------------------------------------
+
+TEST(Trace, MissingHeader) {
+  EXPECT_TRUE(failsOnLine("0 0 0 0 quat 1 0 0 0 60\n", 1, "missing header"));
+  EXPECT_TRUE(failsOnLine("", 1, "missing header"));
+}
+
+TEST(Trace, UnknownVersion) {
+  EXPECT_TRUE(failsOnLine("# thinlod-trace 2\n0 0 0 0 quat 1 0 0 0 60\n", 1, "version 2",
+                          ErrorCode::kVersionMismatch));
+}
+
+TEST(Trace, NoPoses) { EXPECT_TRUE(failsOnLine(withHeader("# only a comment\n"), 3, "no poses")); }
+
+TEST(Trace, WrongFieldCount) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 0 60\n1 0 0 0 lookat 1 1 60\n"), 3,
+                          "expected 9 fields"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 60\n"), 2, "expected 10 fields"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0\n"), 2, "got 3 fields"));
+}
+
+TEST(Trace, UnknownKeyword) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 euler 1 0 0 60\n"), 2, "'euler'"));
+}
+
+TEST(Trace, NotANumber) {
+  EXPECT_TRUE(failsOnLine(withHeader("\n0 0 abc 0 quat 1 0 0 0 60\n"), 3, "field py"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 1.5m 0 0 quat 1 0 0 0 60\n"), 2, "field px"));
+}
+
+TEST(Trace, RejectsNaN) {
+  EXPECT_TRUE(failsOnLine(withHeader("nan 0 0 0 quat 1 0 0 0 60\n"), 2, "field t is not finite"));
+}
+
+TEST(Trace, RejectsInfinity) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 inf quat 1 0 0 0 60\n"), 2, "field pz"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 lookat 1e39 0 0 60\n"), 2, "field tx"));
+}
+
+TEST(Trace, RejectsNonIncreasingTime) {
+  const std::string body =
+      "0 0 0 0 quat 1 0 0 0 60\n# c\n1 0 0 0 quat 1 0 0 0 60\n"
+      "1 0 0 0 quat 1 0 0 0 60\n";
+  EXPECT_TRUE(failsOnLine(withHeader(body), 5, "not after"));
+  EXPECT_TRUE(failsOnLine(withHeader("2 0 0 0 quat 1 0 0 0 60\n1 0 0 0 quat 1 0 0 0 60\n"), 3,
+                          "not after"));
+}
+
+TEST(Trace, RejectsZeroLengthLookDirection) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 1 2 3 lookat 1 2 3 60\n"), 2, "zero length"));
+}
+
+TEST(Trace, RejectsZeroQuaternion) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 0 0 0 0 60\n"), 2, "quaternion"));
+}
+
+TEST(Trace, RejectsFovOutsideOpenInterval) {
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 0 0\n"), 2, "fov_deg"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 0 180\n"), 2, "fov_deg"));
+  EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 lookat 0 0 1 -5\n"), 2, "fov_deg"));
+}
+
+// --- Writing, round trips ------------------------------------------------------------
+
+TEST(Trace, WriteParseRoundTripsBitExactly) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<float> coordinate(-1000.0f, 1000.0f);
+  std::uniform_real_distribution<double> step(1e-6, 3.0);
+  Trace trace;
+  double time = -5.0;
+  for (int i = 0; i < 500; ++i) {
+    Pose p;
+    time += step(rng);
+    p.time = time;
+    p.position = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    glm::vec3 target{coordinate(rng), coordinate(rng), coordinate(rng)};
+    if (target == p.position) target.x += 1.0f;
+    p.orientation = lookAtOrientation(p.position, target);
+    p.fovYDegrees = std::uniform_real_distribution<float>(1.0f, 179.0f)(rng);
+    trace.poses.push_back(p);
+  }
+  const auto parsed = parseTrace(writeTrace(trace));
+  ASSERT_TRUE(parsed.ok()) << parsed.status().toString();
+  ASSERT_EQ(parsed->poses.size(), trace.poses.size());
+  for (std::size_t i = 0; i < trace.poses.size(); ++i) {
+    ASSERT_TRUE(parsed->poses[i] == trace.poses[i]) << "pose " << i;
+  }
+}
+
+TEST(Trace, FileRoundTripAndErrorsNameThePath) {
+  const std::string path = std::string(THINLOD_BINARY_DIR) + "/trace_test_roundtrip.trace";
+  Trace trace;
+  trace.poses.push_back(Pose{0.0, {1, 2, 3}, {1, 0, 0, 0}, 50.0f});
+  trace.poses.push_back(Pose{0.25, {1, 2, 4}, {1, 0, 0, 0}, 50.0f});
+  ASSERT_TRUE(saveTraceFile(path, trace).ok());
+  const auto loaded = loadTraceFile(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().toString();
+  EXPECT_TRUE(loaded->poses[1] == trace.poses[1]);
+
+  { std::ofstream(path) << kHeader << "0 0 0 0 quat 1 0 0 0 200\n"; }
+  const auto bad = loadTraceFile(path);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().message().rfind(path + ": line 2: ", 0), 0u) << bad.status().message();
+  std::remove(path.c_str());
+
+  const auto missing = loadTraceFile(path);
+  EXPECT_EQ(missing.status().code(), ErrorCode::kNotFound);
+}
+
+TEST(Trace, SharedDefaultFlightPathParses) {
+  // Any trace shipped in the repo must parse (guards the docs' examples too).
+  const auto t = parseTrace(
+      "# thinlod-trace 1\n"
+      "# time_s  px py pz      orientation            fov_deg\n"
+      "0.0       0 1.6 10      lookat 0 0.5 0         60\n"
+      "0.5       0 1.6 9.5     lookat 0 0.5 0         60      # comments may follow a pose\n"
+      "1.0       0.2 1.6 9     quat 0.9998477 0 0.0174524 0  55\n");
+  ASSERT_TRUE(t.ok()) << t.status().toString();
+  EXPECT_EQ(t->poses.size(), 3u);
+}
+
+// --- Sampling --------------------------------------------------------------------------
+
+TEST(Trace, SamplePoseInterpolatesAndClamps) {
+  Trace trace;
+  trace.poses.push_back(Pose{1.0, {0, 0, 0}, {1, 0, 0, 0}, 40.0f});
+  trace.poses.push_back(
+      Pose{3.0, {2, 4, 6}, glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 1, 0)), 60.0f});
+  const Pose mid = samplePose(trace, 2.0);
+  EXPECT_EQ(mid.time, 2.0);
+  EXPECT_NEAR(mid.position.y, 2.0f, 1e-6f);
+  EXPECT_NEAR(mid.fovYDegrees, 50.0f, 1e-5f);
+  EXPECT_NEAR(glm::degrees(glm::angle(mid.orientation)), 45.0f, 1e-3f);
+  EXPECT_TRUE(samplePose(trace, -10.0) == trace.poses.front());
+  EXPECT_TRUE(samplePose(trace, 10.0) == trace.poses.back());
+}
+
+}  // namespace
+}  // namespace thinlod
