@@ -1,0 +1,237 @@
+// ImpostorRenderer: renders simple and meshed impostors offscreen with the
+// shared MeshRenderer (common/render) and derives their validity ranges.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+#include <glm/vec4.hpp>
+#include <string>
+
+#include "thinlod/simplifier/impostor.h"
+#include "thinlod/simplifier/progressive_mesh.h"
+
+namespace thinlod::simplifier {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  return true;
+}
+
+double coverageOf(const render::RgbaImage& image) {
+  std::size_t covered = 0;
+  for (std::size_t i = 3; i < image.pixels.size(); i += 4) covered += image.pixels[i] != 0;
+  const std::size_t total = image.pixels.size() / 4;
+  return total ? static_cast<double>(covered) / static_cast<double>(total) : 0.0;
+}
+
+}  // namespace
+
+ImpostorRenderer::ImpostorRenderer(render::OffscreenContext& context) : context_(&context) {}
+
+ImpostorRenderer::~ImpostorRenderer() {
+  // Handles die with the MeshRenderer; the target before the renderer (both need the context).
+  target_.reset();
+  renderer_.reset();
+}
+
+Result<std::unique_ptr<ImpostorRenderer>> ImpostorRenderer::create(
+    render::OffscreenContext& context) {
+  std::unique_ptr<ImpostorRenderer> impostors(new ImpostorRenderer(context));
+  auto renderer = render::MeshRenderer::create(context);
+  if (!renderer.ok()) return renderer.status();
+  impostors->renderer_ = std::move(renderer).value();
+  return impostors;
+}
+
+Status ImpostorRenderer::ensureTarget(int size) {
+  if (target_ && target_->width() == size && target_->height() == size) return Status();
+  target_.reset();
+  auto target = render::RenderTarget::create(*context_, size, size);
+  if (!target.ok()) return target.status();
+  target_ = std::move(target).value();
+  return Status();
+}
+
+Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptions& options,
+                                 const glm::vec3& viewpoint, ImpostorFraming& framing,
+                                 std::vector<render::DrawItem>& items) {
+  if (!context_->isCurrent()) {
+    return Status(ErrorCode::kUnavailable,
+                  "impostor: the GL context is not current on this thread");
+  }
+  if (!(options.maxAngularError > 0.0) || !std::isfinite(options.maxAngularError)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "impostor: maxAngularError must be positive and finite");
+  }
+  if (scene.parts.empty()) return Status(ErrorCode::kInvalidArgument, "impostor: no parts");
+  pointScratch_.clear();
+  std::size_t triangles = 0;
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+    const ImpostorPart& part = scene.parts[i];
+    const std::string name = "impostor part " + std::to_string(i);
+    if (!part.mesh) return Status(ErrorCode::kInvalidArgument, name + ": no mesh");
+    if (!finite(part.model) || glm::determinant(glm::mat3(part.model)) == 0.0f) {
+      return Status(ErrorCode::kInvalidArgument, name + ": model matrix singular or not finite");
+    }
+    THINLOD_RETURN_IF_ERROR(part.mesh->validate(name));
+    triangles += part.mesh->triangleCount();
+    // Only referenced vertices frame the texture: stray points would waste texels.
+    for (std::uint32_t index : part.mesh->indices) {
+      pointScratch_.push_back(glm::vec3(part.model * glm::vec4(part.mesh->positions[index], 1.0f)));
+    }
+  }
+  if (triangles == 0) return Status(ErrorCode::kInvalidArgument, "impostor: no triangles");
+  auto framed = frameImpostor(pointScratch_, viewpoint, options);
+  if (!framed.ok()) return framed.status();
+  framing = std::move(framed).value();
+  THINLOD_RETURN_IF_ERROR(ensureTarget(options.textureSize));
+
+  // Upload cache: a mesh stays on the GPU while its shared_ptr lives.
+  const auto uploadStart = Clock::now();
+  for (auto it = meshCache_.begin(); it != meshCache_.end();) {
+    if (it->second.source.expired()) {
+      renderer_->deleteMesh(it->second.handle);
+      it = meshCache_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  items.clear();
+  for (const ImpostorPart& part : scene.parts) {
+    auto cached = meshCache_.find(part.mesh.get());
+    if (cached == meshCache_.end() || cached->second.source.lock() != part.mesh) {
+      auto handle = renderer_->uploadMesh(*part.mesh);
+      if (!handle.ok()) return handle.status();
+      meshCache_[part.mesh.get()] = CachedMesh{part.mesh, *handle};
+      cached = meshCache_.find(part.mesh.get());
+    }
+    items.push_back(render::DrawItem{cached->second.handle, part.model, part.material});
+  }
+  timings_.uploadMs = millisecondsSince(uploadStart);
+  return Status();
+}
+
+Result<SimpleImpostor> ImpostorRenderer::renderSimple(const ImpostorScene& scene,
+                                                      const glm::vec3& viewpoint,
+                                                      const ImpostorOptions& options) {
+  timings_ = ImpostorTimings();
+  SimpleImpostor impostor;
+  std::vector<render::DrawItem> items;
+  THINLOD_RETURN_IF_ERROR(prepare(scene, options, viewpoint, impostor.framing, items));
+  const auto renderStart = Clock::now();
+  THINLOD_RETURN_IF_ERROR(renderer_->beginFrame(*target_, glm::vec4(0.0f)));
+  THINLOD_RETURN_IF_ERROR(renderer_->draw(items, impostor.framing.camera, scene.lighting));
+  THINLOD_RETURN_IF_ERROR(target_->readColor(impostor.texture));
+  timings_.renderMs = millisecondsSince(renderStart);
+
+  // Simple impostor: every point is drawn on the quad plane, so the depth
+  // deviation along a ray is at most the depth extent stretched by the
+  // steepest ray (1 / cos of its angle to the axis); it also bounds what a
+  // nearer part can uncover behind it.
+  const ImpostorFraming& f = impostor.framing;
+  double secant = 1.0;
+  for (const glm::vec3& p : pointScratch_) {
+    const glm::vec3 ray = p - f.viewpoint;
+    secant = std::max(secant, static_cast<double>(glm::length(ray) / glm::dot(ray, f.forward)));
+  }
+  impostor.errorModel.depthDeviation = (f.farDepth - f.nearDepth) * secant;
+  impostor.quad = f.quad;
+  impostor.validity = impostorValidity(f, impostor.errorModel, options.maxAngularError);
+  impostor.coverage = coverageOf(impostor.texture);
+  return impostor;
+}
+
+Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene,
+                                                      const glm::vec3& viewpoint,
+                                                      const MeshedImpostorOptions& options) {
+  timings_ = ImpostorTimings();
+  MeshedImpostor impostor;
+  std::vector<render::DrawItem> items;
+  THINLOD_RETURN_IF_ERROR(prepare(scene, options, viewpoint, impostor.framing, items));
+  const ImpostorFraming& f = impostor.framing;
+  const int n = f.textureSize;
+  const auto renderStart = Clock::now();
+  THINLOD_RETURN_IF_ERROR(renderer_->beginFrame(*target_, glm::vec4(0.0f)));
+  THINLOD_RETURN_IF_ERROR(renderer_->draw(items, f.camera, scene.lighting));
+  THINLOD_RETURN_IF_ERROR(target_->readColor(impostor.texture));
+  THINLOD_RETURN_IF_ERROR(target_->readDepth(depthScratch_));
+  timings_.renderMs = millisecondsSince(renderStart);
+
+  const auto meshStart = Clock::now();
+  auto mesh = buildDepthMesh(depthScratch_, f, options, &impostor.depthMesh);
+  if (!mesh.ok()) return mesh.status();
+  impostor.mesh = std::move(mesh).value();
+  if (options.targetTriangles > 0 && options.targetTriangles < impostor.mesh.triangleCount()) {
+    BuildOptions simplify;
+    simplify.stopAtTriangles = options.targetTriangles;
+    auto progressive = ProgressiveMesh::build(impostor.mesh, simplify);
+    if (!progressive.ok()) return progressive.status();
+    impostor.mesh = progressive->extract(options.targetTriangles);
+  }
+
+  // Measure what the depth mesh gets wrong: draw it with the capture camera
+  // and compare its depth with the object's, pixel by pixel, as distances
+  // along the pixel's ray.
+  double meshError = 0.0;
+  std::size_t covered = 0;
+  std::size_t missed = 0;
+  if (impostor.mesh.triangleCount() > 0) {
+    auto handle = renderer_->uploadMesh(impostor.mesh);
+    if (!handle.ok()) return handle.status();
+    render::Material plain;
+    plain.lit = false;
+    const render::DrawItem item{*handle, glm::mat4(1.0f), plain};
+    Status drawn = renderer_->beginFrame(*target_, glm::vec4(0.0f));
+    if (drawn.ok()) drawn = renderer_->draw(&item, 1, f.camera, render::Lighting());
+    std::vector<float> meshDepth;
+    if (drawn.ok()) drawn = target_->readDepth(meshDepth);
+    renderer_->deleteMesh(*handle);
+    THINLOD_RETURN_IF_ERROR(drawn);
+    const glm::mat4 inverse = glm::inverse(f.camera.projection * f.camera.view);
+    auto unproject = [&](int x, int y, float d) {
+      const glm::vec4 ndc(2.0f * (x + 0.5f) / n - 1.0f, 1.0f - 2.0f * (y + 0.5f) / n,
+                          2.0f * d - 1.0f, 1.0f);
+      const glm::vec4 world = inverse * ndc;
+      return glm::vec3(world) / world.w;
+    };
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * n + x;
+        if (!(depthScratch_[i] < 1.0f)) continue;
+        ++covered;
+        if (!(meshDepth[i] < 1.0f)) {
+          ++missed;
+          continue;
+        }
+        const double error =
+            glm::length(unproject(x, y, depthScratch_[i]) - unproject(x, y, meshDepth[i]));
+        meshError = std::max(meshError, error);
+      }
+    }
+  } else {
+    for (float d : depthScratch_) covered += d < 1.0f;
+    missed = covered;
+  }
+  impostor.meshDepthError = meshError;
+  impostor.uncoveredFraction = covered ? static_cast<double>(missed) / covered : 0.0;
+  impostor.errorModel.depthDeviation = std::max(meshError, impostor.depthMesh.maxDepthJump);
+  impostor.errorModel.silhouetteRadius = f.objectRadius;
+  impostor.validity = impostorValidity(f, impostor.errorModel, options.maxAngularError);
+  impostor.coverage = coverageOf(impostor.texture);
+  timings_.meshMs = millisecondsSince(meshStart);
+  return impostor;
+}
+
+}  // namespace thinlod::simplifier
