@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
       // Checked after timing: the object is there and the range contains the eye.
       if (simple.coverage <= 0.01) return 1;
       std::printf("%s,%s,%zu,simple,256,%.3f,%.3f,%.3f,%.3f,alpha=%.4frad\n", name, file, triangles,
-                  s.median, s.min, s.p90, simple.coverage, simple.validity.alpha);
+                  s.median, s.min, s.p90, simple.coverage, simple.validity.alpha());
 
       MeshedImpostor meshed;
       const Summary m = timeIt(repetitions, [&] {
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
           "%s,%s,%zu,meshed,256,%.3f,%.3f,%.3f,%.3f,tris=%zu render=%.2fms mesh=%.2fms "
           "alpha=%.4frad err=%.2e\n",
           name, file, triangles, m.median, m.min, m.p90, meshed.coverage,
-          meshed.mesh.triangleCount(), t.renderMs, t.meshMs, meshed.validity.alpha,
+          meshed.mesh.triangleCount(), t.renderMs, t.meshMs, meshed.validity.alpha(),
           meshed.meshDepthError);
     }
     (*impostors).reset();

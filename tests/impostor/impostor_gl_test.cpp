@@ -189,15 +189,21 @@ TEST_F(ImpostorTest, ValidityContainsViewpointAndExcludesFarOffAxis) {
   auto impostor = impostors_->renderSimple(sphereScene(1.0f), eye, options);
   ASSERT_TRUE(impostor.ok()) << impostor.status().toString();
   const ConicRange& range = impostor->validity;
-  EXPECT_NEAR(glm::length(range.center), 0.0f, 1e-3f);
-  EXPECT_NEAR(range.direction.z, 1.0f, 1e-5f);
-  EXPECT_LE(range.minDistance, 10.0f);
-  EXPECT_GE(range.maxDistance, 10.0f);
-  EXPECT_GT(range.alpha, 0.0f);
-  EXPECT_LT(range.alpha, 0.05f);  // parallax over a 2 m deep object: a small cone
+  EXPECT_NEAR(glm::length(range.center()), 0.0, 1e-3);
+  EXPECT_NEAR(range.direction().z, 1.0, 1e-5);
+  EXPECT_TRUE(range.containsPoint(glm::dvec3(eye)));
+  EXPECT_GT(range.alpha(), 0.0);
+  EXPECT_LT(range.alpha(), 0.05);  // parallax over a 2 m deep object: a small cone
   EXPECT_EQ(impostorErrorBound(impostor->framing, impostor->errorModel, eye), 0.0);
   const glm::vec3 offAxis(10.0f * std::sin(0.5f), 0.0f, 10.0f * std::cos(0.5f));
+  EXPECT_FALSE(range.containsPoint(glm::dvec3(offAxis)));
   EXPECT_GT(impostorErrorBound(impostor->framing, impostor->errorModel, offAxis),
+            options.maxAngularError);
+  // Just inside the cone's side the bound holds.
+  const float inside = 0.99f * static_cast<float>(range.alpha());
+  const glm::vec3 edge(10.0f * std::sin(inside), 0.0f, 10.0f * std::cos(inside));
+  EXPECT_TRUE(range.containsPoint(glm::dvec3(edge)));
+  EXPECT_LE(impostorErrorBound(impostor->framing, impostor->errorModel, edge),
             options.maxAngularError);
 }
 
@@ -264,8 +270,8 @@ TEST_F(ImpostorTest, MeshedValidityIsWiderThanSimple) {
   auto simple = impostors_->renderSimple(scene, glm::vec3(0, 0, 10));
   auto meshed = impostors_->renderMeshed(scene, glm::vec3(0, 0, 10));
   ASSERT_TRUE(simple.ok() && meshed.ok());
-  EXPECT_GT(meshed->validity.alpha, 4.0f * simple->validity.alpha)
-      << "meshed " << meshed->validity.alpha << " simple " << simple->validity.alpha;
+  EXPECT_GT(meshed->validity.alpha(), 4.0 * simple->validity.alpha())
+      << "meshed " << meshed->validity.alpha() << " simple " << simple->validity.alpha();
 }
 
 TEST_F(ImpostorTest, SimplifiedDepthMeshKeepsVerticesOnSurface) {

@@ -89,21 +89,23 @@ TEST(ImpostorValidity, MeasuredParallaxStaysWithinBoundInsideTheCone) {
     }
     const double maxError = 2e-3;
     const ConicRange range = impostorValidity(*framing, model, maxError);
-    ASSERT_GT(range.alpha, 0.0f);
-    const float farthest = std::min(range.maxDistance, range.minDistance * 20.0f);
+    ASSERT_GT(range.alpha(), 0.0);
+    const float farthest =
+        static_cast<float>(std::min(range.maxDistance(), range.minDistance() * 20.0));
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     double worst = 0.0;
     for (int trial = 0; trial < 300; ++trial) {
       // A random eye in the cone: angle <= alpha around the axis, distance in range.
-      const glm::vec3 axis = range.direction;
+      const glm::vec3 axis(range.direction());
       const glm::vec3 side = glm::normalize(glm::cross(axis, glm::vec3(0.0f, 1.0f, 0.0f)));
       const glm::vec3 side2 = glm::cross(axis, side);
-      const float theta = range.alpha * std::sqrt(unit(rng));
+      const float theta = static_cast<float>(range.alpha()) * std::sqrt(unit(rng));
       const float phi = 6.2831853f * unit(rng);
       const glm::vec3 direction =
           axis * std::cos(theta) + (side * std::cos(phi) + side2 * std::sin(phi)) * std::sin(theta);
-      const float d = range.minDistance + (farthest - range.minDistance) * unit(rng);
-      const glm::vec3 eye = range.center + direction * d;
+      const float nearest = static_cast<float>(range.minDistance());
+      const float d = nearest + (farthest - nearest) * unit(rng);
+      const glm::vec3 eye = glm::vec3(range.center()) + direction * d;
       const double bound = impostorErrorBound(*framing, model, eye);
       ASSERT_LE(bound, maxError * (1.0 + 1e-4)) << "distance " << d << " angle " << theta;
       for (int k = 0; k < 40; ++k) {
@@ -127,14 +129,17 @@ TEST(ImpostorValidity, CaptureViewpointIsInsideAndErrorFree) {
   model.depthDeviation = 2.0;
   EXPECT_EQ(impostorErrorBound(*framing, model, viewpoint), 0.0);
   const ConicRange range = impostorValidity(*framing, model, 1e-3);
-  const float d = glm::length(viewpoint - range.center);
-  EXPECT_LE(range.minDistance, d);
-  EXPECT_GE(range.maxDistance, d);
-  EXPECT_GT(range.alpha, 0.0f);
+  EXPECT_TRUE(range.containsPoint(glm::dvec3(viewpoint)));
+  const float d = glm::length(viewpoint - glm::vec3(range.center()));
+  EXPECT_LE(range.minDistance(), d);
+  EXPECT_GE(range.maxDistance(), d);
+  EXPECT_GT(range.alpha(), 0.0);
   // Alpha spends half the budget at the capture distance.
-  const glm::vec3 across = glm::normalize(glm::cross(range.direction, glm::vec3(0, 1, 0)));
+  const glm::vec3 axis(range.direction());
+  const glm::vec3 across = glm::normalize(glm::cross(axis, glm::vec3(0, 1, 0)));
+  const float alpha = static_cast<float>(range.alpha());
   const glm::vec3 side =
-      range.center + (range.direction * std::cos(range.alpha) + across * std::sin(range.alpha)) * d;
+      glm::vec3(range.center()) + (axis * std::cos(alpha) + across * std::sin(alpha)) * d;
   EXPECT_NEAR(impostorErrorBound(*framing, model, side), 0.5e-3, 2e-5);
 }
 
@@ -155,7 +160,7 @@ TEST(ImpostorValidity, BoundGrowsWithAngleAndShrinksWithDepthDeviation) {
   }
   const ConicRange wide = impostorValidity(*framing, shallow, 1e-3);
   const ConicRange narrow = impostorValidity(*framing, deep, 1e-3);
-  EXPECT_GT(wide.alpha, 10.0f * narrow.alpha);
+  EXPECT_GT(wide.alpha(), 10.0 * narrow.alpha());
 }
 
 TEST(ImpostorValidity, SilhouetteTermLimitsMeshedCones) {
@@ -164,11 +169,11 @@ TEST(ImpostorValidity, SilhouetteTermLimitsMeshedCones) {
   auto framing = frameImpostor(points, glm::vec3(0, 0, 10), {});
   ASSERT_TRUE(framing.ok());
   const ConicRange exact = impostorValidity(*framing, ImpostorErrorModel{0.0, 0.0}, 1e-3);
-  EXPECT_GT(exact.alpha, 3.1f);  // nothing can go wrong: every direction is fine
-  EXPECT_TRUE(std::isinf(exact.maxDistance));
+  EXPECT_GT(exact.alpha(), 3.1);  // nothing can go wrong: every direction is fine
+  EXPECT_TRUE(std::isinf(exact.maxDistance()));
   const ConicRange rim = impostorValidity(*framing, ImpostorErrorModel{0.0, 1.0}, 1e-3);
-  EXPECT_LT(rim.alpha, 0.2f);
-  EXPECT_GT(rim.alpha, 0.05f);
+  EXPECT_LT(rim.alpha(), 0.2);
+  EXPECT_GT(rim.alpha(), 0.05);
 }
 
 TEST(ImpostorValidity, FarViewersAreValidWhenParallaxShrinks) {
@@ -177,9 +182,9 @@ TEST(ImpostorValidity, FarViewersAreValidWhenParallaxShrinks) {
   auto framing = frameImpostor(points, glm::vec3(0, 0, 50), {});
   ASSERT_TRUE(framing.ok());
   const ConicRange range = impostorValidity(*framing, ImpostorErrorModel{2.0, 0.0}, 1e-2);
-  EXPECT_TRUE(std::isinf(range.maxDistance));
-  EXPECT_GT(range.minDistance, 1.0f);
-  EXPECT_LT(range.minDistance, 50.0f);
+  EXPECT_TRUE(std::isinf(range.maxDistance()));
+  EXPECT_GT(range.minDistance(), 1.0);
+  EXPECT_LT(range.minDistance(), 50.0);
 }
 
 }  // namespace

@@ -147,16 +147,13 @@ double impostorErrorBound(const ImpostorFraming& framing, const ImpostorErrorMod
 ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
                             double maxAngularError) {
   const BoundParameters p = parameters(framing, model);
-  ConicRange range;
-  range.center = framing.objectCenter;
-  range.direction = glm::normalize(framing.viewpoint - framing.objectCenter);
+  const glm::dvec3 center(framing.objectCenter);
   const double D = p.captureDistance;
-  if (!(maxAngularError > 0.0) || !(D > p.reach)) {  // only the viewpoint itself
-    range.alpha = 0.0f;
-    range.minDistance = range.maxDistance = static_cast<float>(D);
-    return range;
+  if (!(maxAngularError > 0.0) || !(D > p.reach)) {
+    return ConicRange::ball(glm::dvec3(framing.viewpoint), 0.0);  // only the viewpoint itself
   }
   const double alpha = largestAngle(p, D, 0.5 * maxAngularError);
+  if (!(alpha > 0.0)) return ConicRange::ball(glm::dvec3(framing.viewpoint), 0.0);
 
   // Beyond `far`, bound (1) <= t (D + d) / (d - R)^2 and the rim term
   // rho * 2 / (d - R) both decrease with d, so once they fit they fit forever.
@@ -173,17 +170,11 @@ ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorM
   }
   const double nearest = p.reach * (1.0 + 1e-6);
   const double minDistance = lastGoodDistance(p, alpha, maxAngularError, D, nearest);
-
-  // Round the float fields inwards so the stored cone is never larger than computed.
-  range.minDistance =
-      std::nextafter(static_cast<float>(minDistance), std::numeric_limits<float>::infinity());
-  range.maxDistance = std::isinf(maxDistance)
-                          ? std::numeric_limits<float>::infinity()
-                          : std::nextafter(static_cast<float>(maxDistance), 0.0f);
-  range.minDistance = std::min(range.minDistance, static_cast<float>(D));
-  range.maxDistance = std::max(range.maxDistance, static_cast<float>(D));
-  range.alpha = alpha > 0.0 ? std::nextafter(static_cast<float>(alpha), 0.0f) : 0.0f;
-  return range;
+  const glm::dvec3 direction = (glm::dvec3(framing.viewpoint) - center) / D;
+  auto range = ConicRange::make(center, std::min(minDistance, D), std::max(maxDistance, D),
+                                direction, std::min(alpha, kPi));
+  // make() only rejects values this function cannot produce; stay safe anyway.
+  return range.ok() ? range.value() : ConicRange::ball(glm::dvec3(framing.viewpoint), 0.0);
 }
 
 }  // namespace thinlod::simplifier

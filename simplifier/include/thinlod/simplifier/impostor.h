@@ -32,6 +32,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "thinlod/common/conic_range.h"
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
@@ -41,16 +42,6 @@
 #include "thinlod/common/status.h"
 
 namespace thinlod::simplifier {
-
-// The paper's ConicRange fields (Figure 8b). TODO(render): replace with
-// thinlod::ConicRange from common/conic_range.h once that header lands.
-struct ConicRange {
-  glm::vec3 center{0.0f};
-  float minDistance = 0.0f;
-  float maxDistance = 0.0f;               // may be +infinity
-  glm::vec3 direction{0.0f, 0.0f, 1.0f};  // unit
-  float alpha = 0.0f;                     // radians, half-angle of the cone
-};
 
 struct ImpostorPart {
   std::shared_ptr<const IndexedMesh> mesh;  // cached on the GPU while this pointer lives
@@ -126,6 +117,8 @@ double impostorErrorBound(const ImpostorFraming& framing, const ImpostorErrorMod
                           const glm::vec3& eye);
 // The cone around the capture direction (apex at the object centre) within
 // which impostorErrorBound <= maxAngularError; it contains the viewpoint.
+// When no cone is possible (maxAngularError <= 0), the ball of radius 0 at
+// the viewpoint.
 ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
                             double maxAngularError);
 
