@@ -1,0 +1,128 @@
+// Measured accuracy curves of a progressive mesh (Pasman & Jansen 2002,
+// sections 3.1-3.2: QSlim + Metro measurements fitted by a few (A, R, K)).
+//
+// Contract:
+// - A geometric ladder of triangle counts from minTriangles to maxTriangles
+//   is extracted; at each level d = symmetric Hausdorff max / original bbox
+//   diagonal (measureSurfaceError), floored at minRelativeError because the
+//   full mesh has d = 0 and a curve needs a finite domain; a = 1/d.
+// - triangles curve: resources = extracted triangle count against a.
+//   bytes curve: resources = Draco-encoded frame size (encodeMesh, position
+//   bits from positionBitsForAccuracy(a)) against the accuracy of what the
+//   client decodes, bounded by 1 / (d + quantization bound / diagonal)
+//   (Hausdorff triangle inequality: moving vertices by <= q moves the
+//   surface by <= q).
+// - Both curves come from AccuracyCurve::fitConservative: for every a the
+//   curve's resources >= the cheapest measured level reaching >= a, so it
+//   never promises more accuracy for a resource than was measured.
+// - measureMeshCurves is pure (no I/O). MeshCurveCache is its thin file
+//   wrapper: one JSON file per key (hash of the mesh bytes, producer tag,
+//   options, ladder and kMeshCurveFormatVersion) in a directory; files that
+//   fail to parse, have another version or key, or whose curves fail
+//   AccuracyCurve::fromTriples or are not conservative w.r.t. their own
+//   levels are ignored, recomputed and overwritten. Not thread-safe across
+//   one instance; distinct processes race benignly (atomic rename).
+// - Errors: invalid mesh / options (kInvalidArgument), extraction returning
+//   an invalid or empty mesh (kInternal), measurement and fit errors passed on.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/status.h"
+#include "thinlod/simplifier/encoding.h"
+#include "thinlod/simplifier/progressive_mesh.h"
+#include "thinlod/simplifier/surface_error.h"
+
+namespace thinlod::simplifier {
+
+inline constexpr int kMeshCurveFormatVersion = 1;
+
+struct MeshCurveOptions {
+  int levels = 12;                 // ladder rungs (duplicates after rounding merge)
+  int maxSegments = 4;             // per fitted curve
+  double minRelativeError = 1e-4;  // floor on d: accuracy at most 10^4
+  SurfaceErrorOptions error{};
+  bool measureEncodedBytes = true;
+  double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
+  MeshEncodeOptions encode{};               // positionBits is chosen per level
+};
+
+struct CurveLevel {
+  std::size_t requestedTriangles = 0;
+  std::size_t triangles = 0;      // what the extraction returned
+  double relativeMaxError = 0.0;  // measured d, before the floor
+  double relativeMeanError = 0.0;
+  double accuracy = 0.0;         // 1 / max(d, floor)
+  std::size_t encodedBytes = 0;  // 0 when not measured
+  int positionBits = 0;
+  double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / diagonal)
+};
+
+struct MeshCurves {
+  std::vector<CurveLevel> levels;  // increasing triangle counts
+  AccuracyCurve triangles;
+  AccuracyCurve bytes;  // empty unless measureEncodedBytes
+};
+
+// Returns a mesh with at most `targetTriangles` triangles of the same object.
+using ExtractTriangles = std::function<IndexedMesh(std::size_t targetTriangles)>;
+
+// `levels` counts spaced geometrically from min to max (both included),
+// rounded, deduplicated, increasing. Empty if min == 0 or min > max.
+std::vector<std::size_t> geometricLadder(std::size_t minTriangles, std::size_t maxTriangles,
+                                         int levels);
+
+Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, std::size_t minTriangles,
+                                     std::size_t maxTriangles, const ExtractTriangles& extract,
+                                     const MeshCurveOptions& options = {});
+// The ladder spans [max(1, pm.minTriangles()), pm.maxTriangles()].
+Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, const ProgressiveMesh& pm,
+                                     const MeshCurveOptions& options = {});
+
+// Pure (de)serialization of the cache file; `key` is stored and checked.
+std::string serializeMeshCurves(const MeshCurves& curves, const std::string& key);
+Result<MeshCurves> parseMeshCurves(const std::string& json, const std::string& expectedKey);
+// 32 hex digits over everything that determines the result. `producer` names
+// the simplifier and its settings (e.g. "qem boundaries=1 flips=1").
+std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& producer,
+                              std::size_t minTriangles, std::size_t maxTriangles,
+                              const MeshCurveOptions& options);
+
+class MeshCurveCache {
+ public:
+  struct Stats {
+    int hits = 0;
+    int misses = 0;         // no file: measured
+    int rejected = 0;       // file present but corrupt / stale: measured again
+    int writeFailures = 0;  // result still returned
+  };
+
+  explicit MeshCurveCache(std::filesystem::path directory);
+  // $THINLOD_CACHE_DIR if set and non-empty, else "build/cache/curves"
+  // (relative to the working directory).
+  static std::filesystem::path defaultDirectory();
+
+  Result<MeshCurves> getOrMeasure(const IndexedMesh& original, const std::string& producer,
+                                  std::size_t minTriangles, std::size_t maxTriangles,
+                                  const ExtractTriangles& extract,
+                                  const MeshCurveOptions& options = {});
+  Result<MeshCurves> getOrMeasure(const IndexedMesh& original, const std::string& producer,
+                                  const ProgressiveMesh& pm, const MeshCurveOptions& options = {});
+
+  std::filesystem::path fileFor(const std::string& key) const;
+  const std::filesystem::path& directory() const { return directory_; }
+  const Stats& stats() const { return stats_; }
+
+ private:
+  std::filesystem::path directory_;
+  Stats stats_;
+};
+
+}  // namespace thinlod::simplifier

@@ -1,0 +1,134 @@
+// Pure measured-curve builder (see mesh_curve.h). File I/O lives in
+// mesh_curve_cache.cpp.
+#include "thinlod/simplifier/mesh_curve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace thinlod::simplifier {
+namespace {
+
+Status invalid(const std::string& message) {
+  return Status(ErrorCode::kInvalidArgument, "measureMeshCurves: " + message);
+}
+
+Status checkOptions(const MeshCurveOptions& options) {
+  if (options.levels < 2) return invalid("levels must be >= 2");
+  if (options.maxSegments < 1) return invalid("maxSegments must be >= 1");
+  if (!(options.minRelativeError > 0.0) || !std::isfinite(options.minRelativeError)) {
+    return invalid("minRelativeError must be positive and finite");
+  }
+  if (!(options.quantizationBudgetFraction > 0.0) ||
+      !std::isfinite(options.quantizationBudgetFraction)) {
+    return invalid("quantizationBudgetFraction must be positive and finite");
+  }
+  return Status();
+}
+
+Result<CurveLevel> measureLevel(const IndexedMesh& original, double diagonal, std::size_t target,
+                                const IndexedMesh& level, const MeshCurveOptions& options) {
+  const std::string what = "extraction of " + std::to_string(target) + " triangles";
+  const Status valid = level.validate(what);
+  if (!valid.ok()) return Status(ErrorCode::kInternal, valid.message());
+  if (level.triangleCount() == 0 || level.triangleCount() > target) {
+    return Status(ErrorCode::kInternal,
+                  what + " returned " + std::to_string(level.triangleCount()) + " triangles");
+  }
+  Result<SurfaceError> error = measureSurfaceError(original, level, options.error);
+  if (!error.ok()) return error.status();
+
+  CurveLevel out;
+  out.requestedTriangles = target;
+  out.triangles = level.triangleCount();
+  out.relativeMaxError = error->relativeMax();
+  out.relativeMeanError = error->relativeMean();
+  const double d = std::max(out.relativeMaxError, options.minRelativeError);
+  out.accuracy = 1.0 / d;
+  if (options.measureEncodedBytes) {
+    MeshEncodeOptions encode = options.encode;
+    encode.positionBits = positionBitsForAccuracy(out.accuracy, options.quantizationBudgetFraction);
+    Result<std::vector<std::uint8_t>> frame = encodeMesh(level, encode);
+    if (!frame.ok()) return frame.status();
+    out.encodedBytes = frame->size();
+    out.positionBits = encode.positionBits;
+    out.encodedAccuracy = 1.0 / (d + positionErrorBound(level, encode.positionBits) / diagonal);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::size_t> geometricLadder(std::size_t minTriangles, std::size_t maxTriangles,
+                                         int levels) {
+  std::vector<std::size_t> ladder;
+  if (minTriangles == 0 || minTriangles > maxTriangles || levels < 1) return ladder;
+  if (levels == 1) return {maxTriangles};
+  const double ratio = static_cast<double>(maxTriangles) / static_cast<double>(minTriangles);
+  for (int i = 0; i < levels; ++i) {
+    const double t = static_cast<double>(i) / (levels - 1);
+    std::size_t n = static_cast<std::size_t>(std::llround(minTriangles * std::pow(ratio, t)));
+    if (i == 0) n = minTriangles;
+    if (i == levels - 1) n = maxTriangles;
+    n = std::clamp(n, minTriangles, maxTriangles);
+    if (ladder.empty() || n > ladder.back()) ladder.push_back(n);
+  }
+  return ladder;
+}
+
+Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, std::size_t minTriangles,
+                                     std::size_t maxTriangles, const ExtractTriangles& extract,
+                                     const MeshCurveOptions& options) {
+  THINLOD_RETURN_IF_ERROR(checkOptions(options));
+  THINLOD_RETURN_IF_ERROR(original.validate("measureMeshCurves: original"));
+  if (original.triangleCount() == 0) return invalid("original mesh has no triangles");
+  if (!extract) return invalid("no extraction function");
+  if (minTriangles == 0 || minTriangles > maxTriangles) {
+    return invalid("triangle range [" + std::to_string(minTriangles) + ", " +
+                   std::to_string(maxTriangles) + "] is empty");
+  }
+  const double diagonal = original.diameter();
+  if (!(diagonal > 0.0)) return invalid("original mesh has a zero-size bounding box");
+
+  MeshCurves curves;
+  for (std::size_t target : geometricLadder(minTriangles, maxTriangles, options.levels)) {
+    const IndexedMesh level = extract(target);
+    // Several requests can land on one collapse state: measure it once.
+    if (!curves.levels.empty() && level.triangleCount() == curves.levels.back().triangles) {
+      continue;
+    }
+    Result<CurveLevel> measured = measureLevel(original, diagonal, target, level, options);
+    if (!measured.ok()) return measured.status();
+    curves.levels.push_back(*measured);
+  }
+
+  std::vector<AccuracySample> triangleSamples;
+  std::vector<AccuracySample> byteSamples;
+  for (const CurveLevel& level : curves.levels) {
+    triangleSamples.push_back({level.accuracy, static_cast<double>(level.triangles)});
+    if (options.measureEncodedBytes) {
+      byteSamples.push_back({level.encodedAccuracy, static_cast<double>(level.encodedBytes)});
+    }
+  }
+  Result<AccuracyCurve> triangles =
+      AccuracyCurve::fitConservative(std::move(triangleSamples), options.maxSegments);
+  if (!triangles.ok()) return triangles.status();
+  curves.triangles = std::move(*triangles);
+  if (options.measureEncodedBytes) {
+    Result<AccuracyCurve> bytes =
+        AccuracyCurve::fitConservative(std::move(byteSamples), options.maxSegments);
+    if (!bytes.ok()) return bytes.status();
+    curves.bytes = std::move(*bytes);
+  }
+  return curves;
+}
+
+Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, const ProgressiveMesh& pm,
+                                     const MeshCurveOptions& options) {
+  const std::size_t minTriangles = std::max<std::size_t>(1, pm.minTriangles());
+  return measureMeshCurves(
+      original, minTriangles, pm.maxTriangles(), [&pm](std::size_t n) { return pm.extract(n); },
+      options);
+}
+
+}  // namespace thinlod::simplifier

@@ -1,0 +1,318 @@
+// The on-disk cache of measured curves (see mesh_curve.h): key hashing and
+// JSON (de)serialization (pure), and the thin file wrapper MeshCurveCache.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <system_error>
+
+#include "thinlod/simplifier/mesh_curve.h"
+
+namespace thinlod::simplifier {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr const char* kFormatName = "thinlod-mesh-curves";
+constexpr std::uintmax_t kMaxCacheFileBytes = 16u << 20;
+
+// FNV-1a with 128-bit state: a cache key, not a security boundary (a forged
+// file still has to pass every check in parseMeshCurves).
+class KeyHasher {
+ public:
+  void bytes(const void* data, std::size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i) {
+      state_ ^= p[i];
+      state_ *= kPrime;
+    }
+  }
+  void text(const std::string& s) {
+    number(s.size());
+    bytes(s.data(), s.size());
+  }
+  template <typename T>
+  void number(T value) {
+    bytes(&value, sizeof(value));
+  }
+  template <typename T>
+  void vector(const std::vector<T>& v) {
+    number(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  std::string hex() const {
+    static const char* kDigits = "0123456789abcdef";
+    std::string out(32, '0');
+    unsigned __int128 s = state_;
+    for (int i = 31; i >= 0; --i, s >>= 4) out[i] = kDigits[static_cast<int>(s & 0xf)];
+    return out;
+  }
+
+ private:
+  static constexpr unsigned __int128 kPrime =
+      (static_cast<unsigned __int128>(1) << 88) + (1u << 8) + 0x3b;
+  unsigned __int128 state_ =
+      (static_cast<unsigned __int128>(0x6c62272e07bb0142ull) << 64) | 0x62b821756295c58dull;
+};
+
+Json curveToJson(const AccuracyCurve& curve) {
+  if (curve.empty()) return nullptr;
+  Json triples = Json::array();
+  for (const CurveTriple& t : curve.triples()) triples.push_back({t.A, t.R, t.K});
+  return Json{{"maxAccuracy", curve.maxAccuracy()}, {"triples", triples}};
+}
+
+Status parseError(const std::string& message) {
+  return Status(ErrorCode::kParseError, "mesh curve cache: " + message);
+}
+
+double finiteNumber(const Json& object, const char* field) {
+  const double value = object.at(field).get<double>();
+  if (!std::isfinite(value) || value < 0.0) {
+    throw std::runtime_error(std::string("field ") + field +
+                             " is not a finite non-negative number");
+  }
+  return value;
+}
+
+Result<AccuracyCurve> curveFromJson(const Json& value, const char* name) {
+  if (value.is_null()) return AccuracyCurve();
+  std::vector<CurveTriple> triples;
+  for (const Json& t : value.at("triples")) {
+    if (!t.is_array() || t.size() != 3) {
+      return parseError(std::string(name) + ": a triple is not [A, R, K]");
+    }
+    triples.push_back({t[0].get<double>(), t[1].get<double>(), t[2].get<double>()});
+  }
+  Result<AccuracyCurve> curve =
+      AccuracyCurve::fromTriples(triples, value.at("maxAccuracy").get<double>());
+  if (!curve.ok()) return parseError(std::string(name) + ": " + curve.status().message());
+  return curve;
+}
+
+// The stored curve must not promise more than its own stored levels: for
+// every level, r(a_level) >= the cheapest level reaching at least a_level.
+Status checkConservative(const AccuracyCurve& curve, const std::vector<AccuracySample>& samples,
+                         const char* name) {
+  if (curve.empty()) return parseError(std::string(name) + " curve is missing");
+  for (const AccuracySample& s : samples) {
+    double cheapest = s.resources;
+    for (const AccuracySample& other : samples) {
+      if (other.accuracy >= s.accuracy) cheapest = std::min(cheapest, other.resources);
+    }
+    // triples() -> fromTriples() rounds R + K A: allow a few ulps.
+    const double r = curve.resourcesFor(s.accuracy);
+    if (!(r >= cheapest * (1.0 - 1e-12) - 1e-9)) {
+      return parseError(std::string(name) + " curve promises accuracy " +
+                        std::to_string(s.accuracy) + " for " + std::to_string(r) +
+                        ", measured cheapest " + std::to_string(cheapest));
+    }
+  }
+  return Status();
+}
+
+Result<std::string> readSmallFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Status(ErrorCode::kIoError, path.string() + ": " + ec.message());
+  if (size > kMaxCacheFileBytes) {
+    return Status(ErrorCode::kResourceExhausted, path.string() + ": larger than 16 MiB");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kIoError, path.string() + ": cannot open");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (in.gcount() != static_cast<std::streamsize>(size)) {
+    return Status(ErrorCode::kIoError, path.string() + ": short read");
+  }
+  return text;
+}
+
+// Write to a unique temporary name, then rename over the target: readers
+// never see a half-written file.
+Status writeFileAtomically(const std::filesystem::path& path, const std::string& text) {
+  std::error_code ec;
+  std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) return Status(ErrorCode::kIoError, path.parent_path().string() + ": " + ec.message());
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!out) return Status(ErrorCode::kIoError, temporary.string() + ": write failed");
+  }
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    return Status(ErrorCode::kIoError, path.string() + ": rename failed");
+  }
+  return Status();
+}
+
+}  // namespace
+
+std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& producer,
+                              std::size_t minTriangles, std::size_t maxTriangles,
+                              const MeshCurveOptions& options) {
+  KeyHasher h;
+  h.text(kFormatName);
+  h.number(kMeshCurveFormatVersion);
+  h.number(kFrameVersion);  // encoded sizes depend on the frame layout
+  h.text(producer);
+  h.number(static_cast<std::uint64_t>(minTriangles));
+  h.number(static_cast<std::uint64_t>(maxTriangles));
+  h.number(options.levels);
+  h.number(options.maxSegments);
+  h.number(options.minRelativeError);
+  h.number(static_cast<std::uint64_t>(options.error.samplesPerMesh));
+  h.number(options.error.seed);
+  h.number(options.error.includeVerticesAndEdges);
+  h.number(options.measureEncodedBytes);
+  h.number(options.quantizationBudgetFraction);
+  h.number(options.encode.normalBits);
+  h.number(options.encode.texcoordBits);
+  h.number(options.encode.encodeSpeed);
+  h.number(options.encode.decodeSpeed);
+  h.vector(original.positions);
+  h.vector(original.normals);
+  h.vector(original.uvs);
+  h.vector(original.colors);
+  h.vector(original.indices);
+  return h.hex();
+}
+
+std::string serializeMeshCurves(const MeshCurves& curves, const std::string& key) {
+  Json levels = Json::array();
+  for (const CurveLevel& l : curves.levels) {
+    levels.push_back({{"requestedTriangles", l.requestedTriangles},
+                      {"triangles", l.triangles},
+                      {"relativeMaxError", l.relativeMaxError},
+                      {"relativeMeanError", l.relativeMeanError},
+                      {"accuracy", l.accuracy},
+                      {"encodedBytes", l.encodedBytes},
+                      {"positionBits", l.positionBits},
+                      {"encodedAccuracy", l.encodedAccuracy}});
+  }
+  const Json document = {{"format", kFormatName},
+                         {"version", kMeshCurveFormatVersion},
+                         {"key", key},
+                         {"levels", levels},
+                         {"trianglesCurve", curveToJson(curves.triangles)},
+                         {"bytesCurve", curveToJson(curves.bytes)}};
+  return document.dump(1);
+}
+
+Result<MeshCurves> parseMeshCurves(const std::string& text, const std::string& expectedKey) {
+  const Json document = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (document.is_discarded() || !document.is_object()) return parseError("not a JSON object");
+  try {
+    if (document.at("format").get<std::string>() != kFormatName) {
+      return parseError("format is not " + std::string(kFormatName));
+    }
+    const int version = document.at("version").get<int>();
+    if (version != kMeshCurveFormatVersion) {
+      return Status(ErrorCode::kVersionMismatch, "mesh curve cache: version " +
+                                                     std::to_string(version) + ", expected " +
+                                                     std::to_string(kMeshCurveFormatVersion));
+    }
+    if (document.at("key").get<std::string>() != expectedKey) return parseError("key mismatch");
+
+    MeshCurves curves;
+    std::vector<AccuracySample> triangleSamples;
+    std::vector<AccuracySample> byteSamples;
+    for (const Json& l : document.at("levels")) {
+      CurveLevel level;
+      level.requestedTriangles = l.at("requestedTriangles").get<std::size_t>();
+      level.triangles = l.at("triangles").get<std::size_t>();
+      level.relativeMaxError = finiteNumber(l, "relativeMaxError");
+      level.relativeMeanError = finiteNumber(l, "relativeMeanError");
+      level.accuracy = finiteNumber(l, "accuracy");
+      level.encodedBytes = l.at("encodedBytes").get<std::size_t>();
+      level.positionBits = l.at("positionBits").get<int>();
+      level.encodedAccuracy = finiteNumber(l, "encodedAccuracy");
+      if (level.triangles == 0 || level.triangles > level.requestedTriangles ||
+          !(level.accuracy > 0.0) ||
+          (!curves.levels.empty() && level.triangles <= curves.levels.back().triangles)) {
+        return parseError("level " + std::to_string(curves.levels.size()) + " is inconsistent");
+      }
+      triangleSamples.push_back({level.accuracy, static_cast<double>(level.triangles)});
+      byteSamples.push_back({level.encodedAccuracy, static_cast<double>(level.encodedBytes)});
+      curves.levels.push_back(level);
+    }
+    if (curves.levels.empty()) return parseError("no levels");
+
+    Result<AccuracyCurve> triangles = curveFromJson(document.at("trianglesCurve"), "triangles");
+    if (!triangles.ok()) return triangles.status();
+    THINLOD_RETURN_IF_ERROR(checkConservative(*triangles, triangleSamples, "triangles"));
+    curves.triangles = std::move(*triangles);
+    Result<AccuracyCurve> bytes = curveFromJson(document.at("bytesCurve"), "bytes");
+    if (!bytes.ok()) return bytes.status();
+    if (!bytes->empty()) {
+      THINLOD_RETURN_IF_ERROR(checkConservative(*bytes, byteSamples, "bytes"));
+    }
+    curves.bytes = std::move(*bytes);
+    return curves;
+  } catch (const std::exception& e) {
+    return parseError(e.what());
+  }
+}
+
+MeshCurveCache::MeshCurveCache(std::filesystem::path directory)
+    : directory_(std::move(directory)) {}
+
+std::filesystem::path MeshCurveCache::defaultDirectory() {
+  const char* fromEnvironment = std::getenv("THINLOD_CACHE_DIR");
+  if (fromEnvironment != nullptr && fromEnvironment[0] != '\0') return fromEnvironment;
+  return std::filesystem::path("build") / "cache" / "curves";
+}
+
+std::filesystem::path MeshCurveCache::fileFor(const std::string& key) const {
+  return directory_ / (key + ".json");
+}
+
+Result<MeshCurves> MeshCurveCache::getOrMeasure(const IndexedMesh& original,
+                                                const std::string& producer,
+                                                std::size_t minTriangles, std::size_t maxTriangles,
+                                                const ExtractTriangles& extract,
+                                                const MeshCurveOptions& options) {
+  const std::string key =
+      meshCurveCacheKey(original, producer, minTriangles, maxTriangles, options);
+  const std::filesystem::path path = fileFor(key);
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec)) {
+    Result<std::string> text = readSmallFile(path);
+    if (text.ok()) {
+      Result<MeshCurves> cached = parseMeshCurves(*text, key);
+      if (cached.ok()) {
+        ++stats_.hits;
+        return cached;
+      }
+    }
+    ++stats_.rejected;
+  } else {
+    ++stats_.misses;
+  }
+  Result<MeshCurves> measured =
+      measureMeshCurves(original, minTriangles, maxTriangles, extract, options);
+  if (!measured.ok()) return measured;
+  if (!writeFileAtomically(path, serializeMeshCurves(*measured, key)).ok()) {
+    ++stats_.writeFailures;
+  }
+  return measured;
+}
+
+Result<MeshCurves> MeshCurveCache::getOrMeasure(const IndexedMesh& original,
+                                                const std::string& producer,
+                                                const ProgressiveMesh& pm,
+                                                const MeshCurveOptions& options) {
+  return getOrMeasure(
+      original, producer, std::max<std::size_t>(1, pm.minTriangles()), pm.maxTriangles(),
+      [&pm](std::size_t n) { return pm.extract(n); }, options);
+}
+
+}  // namespace thinlod::simplifier
