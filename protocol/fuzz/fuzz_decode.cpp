@@ -14,6 +14,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace thinlod::protocol;
+  using thinlod::Result;
   Result<Message> decoded = decode(data, size);
   if (!decoded.ok()) return 0;
   Result<Bytes> reencoded = encode(*decoded);

@@ -187,6 +187,7 @@ void Channel::Impl::handle(const zmq::message_t& payload, Clock::time_point now)
   Message& message = *decoded;
   if (const auto* reply = std::get_if<HelloReply>(&message)) {
     if (reply->accepted) {
+      rejected = false;
       if (!ready) {
         ready = true;
         interval = std::chrono::milliseconds(reply->heartbeatIntervalMs);
@@ -205,6 +206,7 @@ void Channel::Impl::handle(const zmq::message_t& payload, Clock::time_point now)
       return;
     }
     ready = false;
+    rejected = true;
     spdlog::error("event=rejected channel={} address={} error=\"{}\"", options.hello.name,
                   options.address, reply->status.toString());
     events.push_back({ChannelEvent::Kind::kRejected, Heartbeat{}, reply->status});
@@ -234,6 +236,13 @@ void Channel::Impl::checkTimers(Clock::time_point now) {
     if (!opened.ok())
       spdlog::error("event=reconnect_failed channel={} error=\"{}\"", options.hello.name,
                     opened.toString());
+    return;
+  }
+  const auto helloRetry = rejected ? liveness : interval;  // back off after a refusal
+  if (!ready && now - lastHello >= helloRetry) {
+    // Still no answer: say Hello again (a server that restarted on the same
+    // address answers the first one that reaches it; repeats are harmless).
+    sendHello(now);
     return;
   }
   if (ready && now - lastSent >= interval) {

@@ -62,6 +62,7 @@ struct Channel::Impl {
   std::unique_ptr<zmq::socket_t> socket;  // rebuilt after the server is lost
   Encoder encoder;
   bool ready = false;
+  bool rejected = false;  // the last HelloReply refused us: retry slowly
   std::chrono::milliseconds interval{500};
   detail::Clock::time_point lastHeard;
   detail::Clock::time_point lastSent;

@@ -1,0 +1,364 @@
+// Codec: round trips, limits, versions and semantic checks (codec.h).
+#include "thinlod/protocol/codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "seed_messages.h"
+#include "thinlod_wire_generated.h"
+
+namespace thinlod::protocol {
+namespace {
+
+namespace fb = flatbuffers;
+namespace w = thinlod::wire;
+
+Bytes finish(fb::FlatBufferBuilder& b, std::uint16_t version, w::Body type, fb::Offset<void> body) {
+  b.Finish(w::CreateEnvelope(b, version, type, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
+Bytes wireHeartbeat(std::uint16_t version) {
+  fb::FlatBufferBuilder b;
+  auto body = w::CreateHeartbeat(b, 5, 6).Union();
+  return finish(b, version, w::Body::Heartbeat, body);
+}
+
+Bytes wirePose(w::Vec3 position, w::Quat orientation, float fov) {
+  fb::FlatBufferBuilder b;
+  auto body = w::CreateViewerPose(b, 1, 2, &position, &orientation, fov, 640, 480).Union();
+  return finish(b, kProtocolVersion, w::Body::ViewerPose, body);
+}
+
+ViewerPose validPose() { return std::get<ViewerPose>(seeds::seedMessages()[3].message); }
+
+class SeedRoundTrip : public ::testing::TestWithParam<seeds::NamedMessage> {};
+
+TEST_P(SeedRoundTrip, DecodesToTheSameMessage) {
+  const Message& original = GetParam().message;
+  Result<Bytes> bytes = encode(original);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().toString();
+  Result<Message> decoded = decode(*bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  EXPECT_EQ(decoded->index(), original.index());
+  EXPECT_TRUE(*decoded == original) << GetParam().name;
+}
+
+TEST_P(SeedRoundTrip, EncodingIsDeterministicAndMatchesEncoder) {
+  const Message& original = GetParam().message;
+  Result<Bytes> first = encode(original);
+  Result<Bytes> second = encode(original);
+  ASSERT_TRUE(first.ok() && second.ok());
+  EXPECT_EQ(*first, *second);
+  Encoder encoder;
+  auto view = encoder.encode(original);
+  ASSERT_TRUE(view.ok());
+  EXPECT_EQ(Bytes(view->data, view->data + view->size), *first);
+}
+
+TEST_P(SeedRoundTrip, DecodesFromAMisalignedBuffer) {
+  Result<Bytes> bytes = encode(GetParam().message);
+  ASSERT_TRUE(bytes.ok());
+  Bytes shifted(bytes->size() + 1);
+  std::copy(bytes->begin(), bytes->end(), shifted.begin() + 1);
+  Result<Message> decoded = decode(shifted.data() + 1, bytes->size());
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  EXPECT_TRUE(*decoded == GetParam().message);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllMessages, SeedRoundTrip, ::testing::ValuesIn(seeds::seedMessages()),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(Codec, SeedsCoverEveryMessageType) {
+  std::vector<bool> seen(std::variant_size_v<Message>, false);
+  for (const auto& seed : seeds::seedMessages()) seen[seed.message.index()] = true;
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_TRUE(seen[i]) << "message index " << i;
+}
+
+TEST(Codec, LargeSceneUpdateRoundTrips) {
+  const SceneUpdate update = seeds::sceneUpdateOfSize(256 * 1024, 3);
+  auto bytes = encode(update);
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_GT(bytes->size(), 256u * 1024u);
+  auto decoded = decode(*bytes);
+  ASSERT_TRUE(decoded.ok());
+  EXPECT_TRUE(std::get<SceneUpdate>(*decoded) == update);
+}
+
+TEST(Codec, EveryErrorCodeMapsOneToOne) {
+  for (int code = 0; code <= static_cast<int>(ErrorCode::kInternal); ++code) {
+    const auto value = static_cast<ErrorCode>(code);
+    auto back = errorCodeFromWire(errorCodeToWire(value));
+    ASSERT_TRUE(back.ok());
+    EXPECT_EQ(*back, value);
+    if (value == ErrorCode::kOk) continue;
+    SimplifyResult failed;
+    failed.requestId = 1;
+    failed.status = Status(value, std::string("because ") + errorCodeName(value));
+    auto decoded = decode(*encode(failed));
+    ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+    EXPECT_EQ(std::get<SimplifyResult>(*decoded).status.code(), value);
+    EXPECT_EQ(std::get<SimplifyResult>(*decoded).status.message(), failed.status.message());
+  }
+  EXPECT_FALSE(errorCodeFromWire(static_cast<std::uint8_t>(ErrorCode::kInternal) + 1).ok());
+}
+
+TEST(Codec, WrongVersionIsVersionMismatch) {
+  for (std::uint16_t version :
+       {std::uint16_t(0), std::uint16_t(kProtocolVersion + 1), std::uint16_t(0xffff)}) {
+    auto decoded = decode(wireHeartbeat(version));
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), ErrorCode::kVersionMismatch) << decoded.status().toString();
+    EXPECT_NE(decoded.status().message().find(std::to_string(version)), std::string::npos);
+  }
+  EXPECT_TRUE(decode(wireHeartbeat(kProtocolVersion)).ok());
+}
+
+TEST(Codec, PeekVersionReadsOnlyTheHeader) {
+  auto version =
+      peekVersion(wireHeartbeat(kProtocolVersion).data(), wireHeartbeat(kProtocolVersion).size());
+  ASSERT_TRUE(version.ok());
+  EXPECT_EQ(*version, kProtocolVersion);
+}
+
+TEST(Codec, OversizedInputIsResourceExhausted) {
+  Bytes huge(kMaxMessageBytes + 1, 0);
+  auto decoded = decode(huge);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(Codec, OversizedMessageIsNotEncoded) {
+  SceneUpdate update = seeds::sceneUpdateOfSize(kMaxMessageBytes, 1);
+  auto bytes = encode(update);
+  ASSERT_FALSE(bytes.ok());
+  EXPECT_EQ(bytes.status().code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(Codec, ShortOrForeignInputIsInvalid) {
+  EXPECT_EQ(decode(nullptr, 0).status().code(), ErrorCode::kInvalidArgument);
+  Bytes bytes = wireHeartbeat(kProtocolVersion);
+  EXPECT_EQ(decode(bytes.data(), 7).status().code(), ErrorCode::kInvalidArgument);
+  bytes[4] = 'X';  // file identifier
+  auto decoded = decode(bytes);
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(decoded.status().message().find("identifier"), std::string::npos);
+}
+
+TEST(Codec, EnvelopeWithoutBodyIsInvalid) {
+  fb::FlatBufferBuilder b;
+  auto bytes = finish(b, kProtocolVersion, w::Body::NONE, 0);
+  EXPECT_EQ(decode(bytes).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, UnknownMessageTypeIsUnsupported) {
+  fb::FlatBufferBuilder b;
+  auto body = w::CreateHeartbeat(b, 1, 2).Union();
+  auto bytes = finish(b, kProtocolVersion, static_cast<w::Body>(200), body);
+  auto decoded = decode(bytes);
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kUnsupported) << decoded.status().toString();
+}
+
+TEST(Codec, NanPositionIsRejectedWithItsFieldName) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto decoded = decode(wirePose(w::Vec3(0, nan, 0), w::Quat(0, 0, 0, 1), 1.0f));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(decoded.status().message().find("ViewerPose.position.y"), std::string::npos)
+      << decoded.status().message();
+}
+
+TEST(Codec, NonUnitQuaternionIsRejected) {
+  auto decoded = decode(wirePose(w::Vec3(0, 0, 0), w::Quat(0, 0, 0, 2), 1.0f));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("orientation"), std::string::npos);
+  EXPECT_TRUE(decode(wirePose(w::Vec3(0, 0, 0), w::Quat(0, 0, 0, 1.0001f), 1.0f)).ok());
+}
+
+TEST(Codec, InfiniteFovIsRejected) {
+  auto decoded = decode(
+      wirePose(w::Vec3(0, 0, 0), w::Quat(0, 0, 0, 1), std::numeric_limits<float>::infinity()));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("fov_y"), std::string::npos);
+}
+
+TEST(Codec, MissingRequiredStructIsRejected) {
+  fb::FlatBufferBuilder b;
+  const w::Quat q(0, 0, 0, 1);
+  auto body = w::CreateViewerPose(b, 1, 2, nullptr, &q, 1.0f).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::ViewerPose, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("position: is missing"), std::string::npos);
+}
+
+TEST(Codec, EncodeRejectsWhatDecodeRejects) {
+  ViewerPose pose = validPose();
+  pose.position.x = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(encode(pose).status().code(), ErrorCode::kInvalidArgument);
+  pose = validPose();
+  pose.orientation = glm::quat(0.5f, 0.0f, 0.0f, 0.0f);
+  EXPECT_EQ(encode(pose).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, TextureLargerThanTheLimitIsResourceExhausted) {
+  SceneUpdate update;
+  SceneOperation op;
+  op.objectId = 1;
+  op.representation = seeds::sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 16);
+  op.representation.texture.width = kMaxTextureDimension + 1;
+  update.operations.push_back(op);
+  auto encoded = encode(update);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_EQ(encoded.status().code(), ErrorCode::kResourceExhausted);
+
+  // The same on the wire.
+  fb::FlatBufferBuilder b;
+  auto data = b.CreateVector(std::vector<std::uint8_t>(64, 1));
+  auto texture = w::CreateTexture(b, w::TextureCodec::Png, kMaxTextureDimension + 1, 4, data);
+  const w::Mat4 transform;
+  const w::ConicRange validity(w::Vec3(0, 0, 0), 0.0f, 10.0f, w::Vec3(0, 0, 1), 3.0f);
+  auto rep = w::CreateRepresentation(b, 1, 1, w::RepresentationKind::SimpleImpostor, 0, texture,
+                                     &transform, &validity, 1.0, 2);
+  auto ops = b.CreateVector(std::vector<fb::Offset<w::SceneOp>>{
+      w::CreateSceneOp(b, w::SceneOpType::AddOrReplace, 1, rep)});
+  auto body = w::CreateSceneUpdate(b, 1, 1, 1.0, ops).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::SceneUpdate, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted) << decoded.status().toString();
+  EXPECT_NE(decoded.status().message().find("operations[0].representation.texture"),
+            std::string::npos)
+      << decoded.status().message();
+}
+
+TEST(Codec, TooManyOperationsIsResourceExhausted) {
+  fb::FlatBufferBuilder b;
+  std::vector<fb::Offset<w::SceneOp>> ops;
+  for (std::size_t i = 0; i <= kMaxSceneOperations; ++i) {
+    ops.push_back(w::CreateSceneOp(b, w::SceneOpType::Remove, i, 0));
+  }
+  auto vector = b.CreateVector(ops);
+  auto body = w::CreateSceneUpdate(b, 1, 1, 1.0, vector).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::SceneUpdate, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted) << decoded.status().toString();
+}
+
+TEST(Codec, LongStringIsResourceExhausted) {
+  Shutdown shutdown{std::string(kMaxTextBytes + 1, 'x')};
+  EXPECT_EQ(encode(shutdown).status().code(), ErrorCode::kResourceExhausted);
+  fb::FlatBufferBuilder b;
+  auto reason = b.CreateString(std::string(kMaxTextBytes + 1, 'x'));
+  auto body = w::CreateShutdown(b, reason).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::Shutdown, body));
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(Codec, RawTextureSizeMustMatchItsDimensions) {
+  SceneUpdate update;
+  SceneOperation op;
+  op.objectId = 1;
+  op.representation = seeds::sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 4);
+  op.representation.texture.codec = TextureCodec::kRawRgba8;
+  op.representation.texture.data.assign(4 * 4 * 4 - 1, 0);
+  update.operations.push_back(op);
+  auto encoded = encode(update);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_NE(encoded.status().message().find("expected 64"), std::string::npos)
+      << encoded.status().message();
+}
+
+TEST(Codec, DuplicateObjectInOneBatchIsRejected) {
+  SceneUpdate update;
+  SceneOperation remove;
+  remove.type = SceneOperation::Type::kRemove;
+  remove.objectId = 9;
+  update.operations = {remove, remove};
+  auto encoded = encode(update);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_NE(encoded.status().message().find("object 9 appears twice"), std::string::npos);
+}
+
+TEST(Codec, MeshRepresentationNeedsMeshBytes) {
+  SceneUpdate update;
+  SceneOperation op;
+  op.objectId = 1;
+  op.representation = seeds::sampleRepresentation(RepresentationKind::kMesh, 10, 0);
+  op.representation.mesh.clear();
+  update.operations.push_back(op);
+  EXPECT_EQ(encode(update).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, ConicRangeMayBeUnboundedButNotNan) {
+  SceneUpdate update;
+  SceneOperation op;
+  op.objectId = 1;
+  op.representation = seeds::sampleRepresentation(RepresentationKind::kMesh, 10, 0);
+  op.representation.validity.distanceMax = std::numeric_limits<float>::infinity();
+  update.operations.push_back(op);
+  EXPECT_TRUE(encode(update).ok());
+  update.operations[0].representation.validity.distanceMax =
+      std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(encode(update).status().code(), ErrorCode::kInvalidArgument);
+  update.operations[0].representation.validity.distanceMax = 1.0f;  // below distance_min 2
+  EXPECT_EQ(encode(update).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, SimplifyRequestNeedsExactlyOneSource) {
+  SimplifyRequest request;
+  request.requestId = 1;
+  request.targetTriangles = 10;
+  EXPECT_EQ(encode(request).status().code(), ErrorCode::kInvalidArgument);
+  request.sourcePath = "a.obj";
+  EXPECT_TRUE(encode(request).ok());
+  request.sourceMesh = {1, 2, 3};
+  EXPECT_EQ(encode(request).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, RequestIdZeroIsReserved) {
+  SimplifyRequest request;
+  request.sourcePath = "a.obj";
+  request.targetTriangles = 10;
+  EXPECT_EQ(encode(request).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, ErrorResultCarriesNoPayload) {
+  SimplifyResult result;
+  result.requestId = 1;
+  result.status = Status(ErrorCode::kIoError, "disk");
+  result.mesh = {1};
+  EXPECT_EQ(encode(result).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Codec, ErrorTableWithOkCodeIsRejected) {
+  fb::FlatBufferBuilder b;
+  auto error = w::CreateError(b, w::ErrorCode::Ok, b.CreateString("fine"));
+  auto body = w::CreateSimplifyResult(b, 1, 1, error).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::SimplifyResult, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("error.code"), std::string::npos);
+}
+
+TEST(Codec, OutOfRangeEnumIsRejected) {
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("x");
+  auto body = w::CreateHello(b, 1, 1, static_cast<w::Role>(77), name).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::Hello, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("Hello.role"), std::string::npos);
+}
+
+TEST(Codec, NegotiatesTheHighestCommonVersion) {
+  Hello hello;
+  hello.minVersion = 1;
+  hello.maxVersion = 9;
+  auto version = negotiateVersion(hello);
+  ASSERT_TRUE(version.ok());
+  EXPECT_EQ(*version, kProtocolVersion);
+  hello.minVersion = kProtocolVersion + 1;
+  EXPECT_EQ(negotiateVersion(hello).status().code(), ErrorCode::kVersionMismatch);
+}
+
+}  // namespace
+}  // namespace thinlod::protocol

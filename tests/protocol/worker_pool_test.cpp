@@ -1,0 +1,301 @@
+// WorkerPool: requests to simplifier workers over loopback, re-sent when a
+// worker is lost, restarts or times out; first result wins.
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "seed_messages.h"
+#include "thinlod/protocol/codec.h"
+#include "transport_test_util.h"
+
+namespace thinlod::protocol {
+namespace {
+
+using namespace std::chrono_literals;
+using testing_util::fastTransport;
+using testing_util::helloAs;
+using testing_util::pumpUntil;
+
+std::unique_ptr<WorkerPool> bindPool(std::chrono::milliseconds attemptTimeout = 30s,
+                                     int maxAttempts = 3) {
+  WorkerPool::Options options;
+  options.address = "tcp://127.0.0.1:0";
+  options.transport = fastTransport();
+  options.requests.attemptTimeout = attemptTimeout;
+  options.requests.maxAttempts = maxAttempts;
+  auto pool = WorkerPool::bind(options);
+  EXPECT_TRUE(pool.ok()) << pool.status().toString();
+  return pool.ok() ? std::move(*pool) : nullptr;
+}
+
+// A simplifier worker driven by the test: records requests, answers on demand.
+struct FakeWorker {
+  std::unique_ptr<Channel> channel;
+  std::vector<SimplifyRequest> simplify;
+  std::vector<ImpostorRequest> impostor;
+
+  FakeWorker(const std::string& address, const std::string& name, std::uint32_t capacity = 1) {
+    Channel::Options options;
+    options.address = address;
+    options.hello = helloAs(Role::kSimplifier, name, capacity);
+    options.transport = fastTransport();
+    auto c = Channel::connect(options);
+    EXPECT_TRUE(c.ok());
+    channel = std::move(*c);
+  }
+  void poll() {
+    for (auto& e : channel->poll(2ms)) {
+      if (e.kind != ChannelEvent::Kind::kMessage) continue;
+      if (auto* s = std::get_if<SimplifyRequest>(&e.message)) simplify.push_back(*s);
+      if (auto* i = std::get_if<ImpostorRequest>(&e.message)) impostor.push_back(*i);
+    }
+  }
+  Status answer(const SimplifyRequest& request, std::uint32_t triangles) {
+    SimplifyResult result;
+    result.requestId = request.requestId;
+    result.objectId = request.objectId;
+    result.mesh = seeds::patternBytes(64, triangles);
+    result.triangleCount = triangles;
+    result.accuracy = 10.0;
+    return channel->send(result);
+  }
+};
+
+SimplifyRequest simplifyRequest(std::uint64_t objectId) {
+  SimplifyRequest request;
+  request.objectId = objectId;
+  request.sourcePath = "cow.obj";
+  request.targetTriangles = 100;
+  return request;
+}
+
+struct PoolRecorder {
+  std::vector<WorkerPoolEvent> events;
+  std::size_t count(WorkerPoolEvent::Kind kind) const {
+    std::size_t n = 0;
+    for (const auto& e : events) n += e.kind == kind ? 1 : 0;
+    return n;
+  }
+  void poll(WorkerPool& pool) {
+    for (auto& e : pool.poll(2ms)) events.push_back(std::move(e));
+  }
+};
+
+TEST(WorkerPool, RequestReachesAWorkerAndTheResultComesBack) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  FakeWorker worker(pool->endpoint().address(), "simplifier-a");
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(*pool);
+    worker.poll();
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->liveWorkers() == 1; }));
+  auto id = pool->submit(simplifyRequest(42));
+  ASSERT_TRUE(id.ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return !worker.simplify.empty(); }));
+  EXPECT_EQ(worker.simplify[0].requestId, *id);
+  EXPECT_EQ(worker.simplify[0].objectId, 42u);
+  ASSERT_TRUE(worker.answer(worker.simplify[0], 77).ok());
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 1; }));
+  const auto& result = r.events.back().simplify;
+  EXPECT_EQ(result.requestId, *id);
+  EXPECT_EQ(result.triangleCount, 77u);
+  EXPECT_TRUE(result.status.ok());
+  EXPECT_EQ(pool->pendingRequests(), 0u);
+}
+
+TEST(WorkerPool, ImpostorRequestsUseTheSameMachinery) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  FakeWorker worker(pool->endpoint().address(), "simplifier-a");
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(*pool);
+    worker.poll();
+  };
+  ImpostorRequest request = std::get<ImpostorRequest>(seeds::seedMessages()[10].message);
+  auto id = pool->submit(request);
+  ASSERT_TRUE(id.ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return !worker.impostor.empty(); }));
+  ImpostorResult result;
+  result.requestId = worker.impostor[0].requestId;
+  result.objectIds = worker.impostor[0].objectIds;
+  result.representation = seeds::sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 8);
+  ASSERT_TRUE(worker.channel->send(result).ok());
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kImpostorResult) == 1; }));
+  EXPECT_EQ(r.events.back().impostor.requestId, *id);
+}
+
+TEST(WorkerPool, InvalidRequestIsRefused) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  SimplifyRequest noSource = simplifyRequest(1);
+  noSource.sourcePath.clear();
+  EXPECT_EQ(pool->submit(noSource).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(WorkerPool, RequestsWaitForTheFirstWorker) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  ASSERT_TRUE(pool->submit(simplifyRequest(1)).ok());
+  ASSERT_TRUE(pool->submit(simplifyRequest(2)).ok());
+  EXPECT_EQ(pool->pendingRequests(), 2u);
+  FakeWorker worker(pool->endpoint().address(), "late", 2);
+  PoolRecorder r;
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        worker.poll();
+      },
+      [&] { return worker.simplify.size() == 2; }));
+}
+
+TEST(WorkerPool, LoadIsSpreadAndCapacityRespected) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  FakeWorker a(pool->endpoint().address(), "a", 1);
+  FakeWorker b(pool->endpoint().address(), "b", 1);
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(*pool);
+    a.poll();
+    b.poll();
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->liveWorkers() == 2; }));
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(pool->submit(simplifyRequest(i + 1)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return a.simplify.size() == 1 && b.simplify.size() == 1; }));
+  pumpUntil(
+      step, [] { return false; }, 200ms);  // nothing more while both are busy
+  EXPECT_EQ(a.simplify.size() + b.simplify.size(), 2u);
+  ASSERT_TRUE(a.answer(a.simplify[0], 1).ok());
+  ASSERT_TRUE(b.answer(b.simplify[0], 1).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return a.simplify.size() == 2 && b.simplify.size() == 2; }));
+  ASSERT_TRUE(a.answer(a.simplify[1], 1).ok());
+  ASSERT_TRUE(b.answer(b.simplify[1], 1).ok());
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 4; }));
+}
+
+TEST(WorkerPool, RequestOfALostWorkerIsResentToAnother) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  auto a = std::make_unique<FakeWorker>(pool->endpoint().address(), "a");
+  PoolRecorder r;
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        a->poll();
+      },
+      [&] { return pool->liveWorkers() == 1; }));
+  auto id = pool->submit(simplifyRequest(5));
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        a->poll();
+      },
+      [&] { return !a->simplify.empty(); }));
+
+  FakeWorker b(pool->endpoint().address(), "b");
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        a->poll();
+        b.poll();
+      },
+      [&] { return pool->liveWorkers() == 2; }));
+  a.reset();  // worker a goes away with the request
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        b.poll();
+      },
+      [&] { return !b.simplify.empty(); }));
+  EXPECT_EQ(b.simplify[0].requestId, *id);  // same idempotency key
+  ASSERT_TRUE(b.answer(b.simplify[0], 9).ok());
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        b.poll();
+      },
+      [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 1; }));
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kWorkerLeft), 1u);
+}
+
+TEST(WorkerPool, RestartedWorkerGetsItsRequestAgainAndDuplicatesAreDropped) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  FakeWorker old(pool->endpoint().address(), "simplifier@host");
+  PoolRecorder r;
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        old.poll();
+      },
+      [&] { return pool->liveWorkers() == 1; }));
+  auto id = pool->submit(simplifyRequest(5));
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        old.poll();
+      },
+      [&] { return !old.simplify.empty(); }));
+
+  // The same worker name comes back as a new process (new instance id)
+  // while the old connection lingers: the pool re-sends to the new one.
+  FakeWorker restarted(pool->endpoint().address(), "simplifier@host");
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        restarted.poll();
+      },
+      [&] { return !restarted.simplify.empty(); }));
+  EXPECT_EQ(restarted.simplify[0].requestId, *id);
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kWorkerLeft), 1u);
+
+  ASSERT_TRUE(restarted.answer(restarted.simplify[0], 11).ok());
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        r.poll(*pool);
+        restarted.poll();
+      },
+      [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 1; }));
+  ASSERT_TRUE(restarted.answer(restarted.simplify[0], 12).ok());  // a duplicate
+  pumpUntil(
+      [&] {
+        r.poll(*pool);
+        restarted.poll();
+      },
+      [] { return false; }, 300ms);
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kSimplifyResult), 1u);
+  for (const auto& e : r.events) {
+    if (e.kind == WorkerPoolEvent::Kind::kSimplifyResult) EXPECT_EQ(e.simplify.triangleCount, 11u);
+  }
+}
+
+TEST(WorkerPool, UnansweredRequestFailsWithTimeoutAfterEveryAttempt) {
+  auto pool = bindPool(300ms, 2);
+  ASSERT_TRUE(pool);
+  FakeWorker silent(pool->endpoint().address(), "silent");
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(*pool);
+    silent.poll();
+  };
+  auto id = pool->submit(simplifyRequest(3));
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 1; }));
+  const WorkerPoolEvent* failed = nullptr;
+  for (const auto& e : r.events)
+    if (e.kind == WorkerPoolEvent::Kind::kSimplifyResult) failed = &e;
+  EXPECT_EQ(failed->simplify.requestId, *id);
+  EXPECT_EQ(failed->simplify.objectId, 3u);
+  EXPECT_EQ(failed->simplify.status.code(), ErrorCode::kTimeout);
+  EXPECT_EQ(silent.simplify.size(), 2u);  // both attempts reached the only worker
+  EXPECT_EQ(pool->pendingRequests(), 0u);
+}
+
+}  // namespace
+}  // namespace thinlod::protocol
