@@ -108,6 +108,31 @@ void BM_Evaluate(benchmark::State& state) {
 }
 BENCHMARK(BM_Evaluate)->RangeMultiplier(2)->Range(2, 64);
 
+void BM_FitConservative(benchmark::State& state) {
+  // Measured (accuracy, triangles) samples of a progressive mesh: noisy
+  // r ~ a^1.5. Fitted to 8 segments; items are samples.
+  const int count = static_cast<int>(state.range(0));
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<AccuracySample> samples(count);
+  for (AccuracySample& s : samples) {
+    s.accuracy = 1.0 + 999.0 * unit(rng);
+    s.resources = std::pow(s.accuracy, 1.5) * (0.9 + 0.2 * unit(rng));
+  }
+  std::size_t segments = 0;
+  for (auto _ : state) {
+    auto fit = AccuracyCurve::fitConservative(samples, 8);
+    segments = fit->segments().size();
+    benchmark::DoNotOptimize(fit);
+  }
+  state.counters["segments"] = static_cast<double>(segments);
+  state.SetItemsProcessed(state.iterations() * count);
+}
+BENCHMARK(BM_FitConservative)
+    ->RangeMultiplier(10)
+    ->Range(10, 100000)
+    ->Unit(benchmark::kMicrosecond);
+
 // Balanced tree, fan-out 4; levels alternate LOD (lowest level: 4 versions
 // of an object) and Group. Propagates level by level, freeing the children.
 constexpr int kFanOut = 4;
