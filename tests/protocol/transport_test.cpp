@@ -327,8 +327,17 @@ TEST(Transport, ChannelRejoinsARestartedServer) {
       [&] { return !channel->connected(); }));
   EXPECT_EQ(r.count(ChannelEvent::Kind::kDisconnected), 1u);
 
-  endpoint = bindLoopback(fastTransport(), address);  // same port, new process state
-  ASSERT_TRUE(endpoint);
+  // Same port, fresh state. ZeroMQ closes the old listener asynchronously,
+  // so the port may stay busy for a moment: retry the bind.
+  Endpoint::Options options;
+  options.address = address;
+  options.transport = fastTransport();
+  ASSERT_TRUE(pumpUntil([] { std::this_thread::sleep_for(10ms); },
+                        [&] {
+                          auto bound = Endpoint::bind(options);
+                          if (bound.ok()) endpoint = std::move(*bound);
+                          return endpoint != nullptr;
+                        }));
   Recorder after;
   auto step = pumpBoth(*endpoint, *channel, after);
   ASSERT_TRUE(pumpUntil(step, [&] { return channel->connected() && !endpoint->peers().empty(); }));

@@ -12,7 +12,9 @@ namespace thinlod::protocol::testing_util {
 
 inline constexpr std::chrono::seconds kDeadline{15};
 
-inline TransportOptions fastTransport(int heartbeatMs = 50, int misses = 4) {
+// Short heartbeats (fast re-joins) but a 1 s liveness timeout, so a stalled
+// test thread does not look like a dead peer.
+inline TransportOptions fastTransport(int heartbeatMs = 50, int misses = 20) {
   TransportOptions options;
   options.heartbeatInterval = std::chrono::milliseconds(heartbeatMs);
   options.livenessMisses = misses;

@@ -271,7 +271,9 @@ TEST(WorkerPool, RestartedWorkerGetsItsRequestAgainAndDuplicatesAreDropped) {
       [] { return false; }, 300ms);
   EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kSimplifyResult), 1u);
   for (const auto& e : r.events) {
-    if (e.kind == WorkerPoolEvent::Kind::kSimplifyResult) EXPECT_EQ(e.simplify.triangleCount, 11u);
+    if (e.kind == WorkerPoolEvent::Kind::kSimplifyResult) {
+      EXPECT_EQ(e.simplify.triangleCount, 11u);
+    }
   }
 }
 
