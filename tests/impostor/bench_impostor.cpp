@@ -1,11 +1,14 @@
 // bench_impostor: times 256x256 simple and meshed impostors of the shared cow
 // and bunny on each offscreen back-end, with an empty-frame baseline measured
 // in the same run. Not a test. Usage: bench_impostor [repetitions] [models dir]
-// Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,coverage,extra
+// Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra
+// (cpu_ms: process CPU time per call, all llvmpipe threads included; less
+// sensitive than wall time to other processes competing for the 2 cores).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -19,8 +22,14 @@ using namespace thinlod::simplifier;
 namespace {
 
 struct Summary {
-  double median = 0, min = 0, p90 = 0;
+  double median = 0, min = 0, p90 = 0, cpu = 0;
 };
+
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
 
 Summary summarize(std::vector<double> samples) {
   std::sort(samples.begin(), samples.end());
@@ -35,6 +44,7 @@ template <typename F>
 Summary timeIt(int repetitions, F&& body) {
   std::vector<double> samples;
   body();  // warm-up: shader compile, first upload, target allocation
+  const double cpuStart = cpuMs();
   for (int i = 0; i < repetitions; ++i) {
     const auto start = std::chrono::steady_clock::now();
     body();
@@ -42,7 +52,9 @@ Summary timeIt(int repetitions, F&& body) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
   }
-  return summarize(samples);
+  Summary s = summarize(samples);
+  s.cpu = (cpuMs() - cpuStart) / repetitions;
+  return s;
 }
 
 }  // namespace
@@ -50,7 +62,7 @@ Summary timeIt(int repetitions, F&& body) {
 int main(int argc, char** argv) {
   const int repetitions = argc > 1 ? std::max(3, std::atoi(argv[1])) : 21;
   const std::string models = argc > 2 ? argv[2] : std::string(THINLOD_SHARED_DIR) + "/models";
-  std::printf("backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,coverage,extra\n");
+  std::printf("backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra\n");
   for (render::Backend backend : {render::Backend::kEgl, render::Backend::kOsMesa}) {
     auto context = render::createOffscreenContext(backend, 16, 16);
     if (!context.ok()) {
@@ -82,13 +94,17 @@ int main(int argc, char** argv) {
 
       // Baseline: the same framing with nothing drawn but clear + colour readback.
       auto baselineContextTarget = render::RenderTarget::create(**context, 256, 256);
+      if (!baselineContextTarget.ok()) {
+        std::fprintf(stderr, "%s\n", baselineContextTarget.status().toString().c_str());
+        return 1;
+      }
       render::RgbaImage scratch;
       const Summary baseline = timeIt(repetitions, [&] {
         (void)(*baselineContextTarget)->clear(0, 0, 0, 0);
         (void)(*baselineContextTarget)->readColor(scratch);
       });
-      std::printf("%s,%s,%zu,clear+readback,256,%.3f,%.3f,%.3f,,\n", name, file, triangles,
-                  baseline.median, baseline.min, baseline.p90);
+      std::printf("%s,%s,%zu,clear+readback,256,%.3f,%.3f,%.3f,%.3f,,\n", name, file, triangles,
+                  baseline.median, baseline.min, baseline.p90, baseline.cpu);
 
       SimpleImpostor simple;
       const Summary s = timeIt(repetitions, [&] {
@@ -101,8 +117,9 @@ int main(int argc, char** argv) {
       });
       // Checked after timing: the object is there and the range contains the eye.
       if (simple.coverage <= 0.01) return 1;
-      std::printf("%s,%s,%zu,simple,256,%.3f,%.3f,%.3f,%.3f,alpha=%.4frad\n", name, file, triangles,
-                  s.median, s.min, s.p90, simple.coverage, simple.validity.alpha());
+      std::printf("%s,%s,%zu,simple,256,%.3f,%.3f,%.3f,%.3f,%.3f,alpha=%.4frad\n", name, file,
+                  triangles, s.median, s.min, s.p90, s.cpu, simple.coverage,
+                  simple.validity.alpha());
 
       MeshedImpostor meshed;
       const Summary m = timeIt(repetitions, [&] {
@@ -115,9 +132,9 @@ int main(int argc, char** argv) {
       });
       const ImpostorTimings& t = (*impostors)->lastTimings();
       std::printf(
-          "%s,%s,%zu,meshed,256,%.3f,%.3f,%.3f,%.3f,tris=%zu render=%.2fms mesh=%.2fms "
+          "%s,%s,%zu,meshed,256,%.3f,%.3f,%.3f,%.3f,%.3f,tris=%zu render=%.2fms mesh=%.2fms "
           "alpha=%.4frad err=%.2e\n",
-          name, file, triangles, m.median, m.min, m.p90, meshed.coverage,
+          name, file, triangles, m.median, m.min, m.p90, m.cpu, meshed.coverage,
           meshed.mesh.triangleCount(), t.renderMs, t.meshMs, meshed.validity.alpha(),
           meshed.meshDepthError);
     }
