@@ -188,14 +188,12 @@ class EnvelopeTree {
     base_ = 1;
     while (base_ < leafCount) base_ *= 2;
     lines_.assign(base_, CurveSegment{});
-    active_.assign(base_, false);
     winner_.assign(2 * static_cast<std::size_t>(base_), -1);
     certificate_.assign(2 * static_cast<std::size_t>(base_), kInfinity);
     nextEvent_.assign(2 * static_cast<std::size_t>(base_), kInfinity);
   }
   void setLeafNoUpdate(int leaf, const CurveSegment& line, bool active) {
     lines_[leaf] = line;
-    active_[leaf] = active;
     winner_[base_ + leaf] = active ? leaf : -1;
   }
   void build(double x) {
@@ -275,7 +273,6 @@ class EnvelopeTree {
 
   int base_ = 1;
   std::vector<CurveSegment> lines_;
-  std::vector<bool> active_;
   std::vector<int> winner_;          // per node: winning leaf, -1 when none active
   std::vector<double> certificate_;  // per internal node: where its winner changes
   std::vector<double> nextEvent_;    // per node: min certificate in the subtree
@@ -550,8 +547,8 @@ AccuracyCurve AccuracyCurve::sum(const std::vector<const AccuracyCurve*>& childr
   }
   tree.build(lowest);
 
-  std::vector<CurveSegment>& out_segments = out.segments_;
-  out_segments.reserve(eventCount);
+  std::vector<CurveSegment>& summed = out.segments_;
+  summed.reserve(eventCount);
   while (!events.empty()) {
     const double x = events.top().at;
     while (!events.empty() && events.top().at == x) {
@@ -570,10 +567,10 @@ AccuracyCurve AccuracyCurve::sum(const std::vector<const AccuracyCurve*>& childr
         tree.setLeaf(e.child, CurveSegment{x, atMax, 0.0}, x);
       }
     }
-    out_segments.push_back(CurveSegment{x, tree.valueAt(x), tree.slope()});
+    summed.push_back(CurveSegment{x, tree.valueAt(x), tree.slope()});
   }
   out.maxAccuracy_ = highest;
-  normalize(out_segments, highest, nullptr);
+  normalize(summed, highest, nullptr);
   return out;
 }
 
