@@ -9,12 +9,11 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <glm/geometric.hpp>
 #include <iostream>
 #include <mutex>
 #include <new>
 #include <sstream>
-
-#include <glm/geometric.hpp>
 
 #include "mesh/mesh_precheck.h"
 #include "thinlod/common/tri_mesh.h"

@@ -13,11 +13,12 @@
 //   sagitta R (1 - cos(pi/n)); box 0. Diameter = bbox diagonal of the true
 //   shape; relative accuracy a = diameter / error, capped at
 //   kExactRelativeAccuracy (the box, and errors below float precision).
-// - The accuracy curve is AccuracyCurve::fitConservative over the exact
-//   (a, triangles) points of every tessellation up to maxTriangles, so it
-//   never promises more accuracy than a tessellation of that cost has:
+// - The accuracy curve is a conservative piecewise-linear fit over the exact
+//   (a, triangles) points of every tessellation up to maxTriangles: it never
+//   promises more accuracy than a tessellation of that cost has, i.e.
 //   tessellate(shape, chooseTessellation(shape, r(a))) reaches accuracy >= a
-//   with at most r(a) triangles.
+//   with at most r(a) triangles, and r(a) <= stepRatio * (the cheapest
+//   tessellation's triangles that reach a).
 // - Invalid shapes (non-finite or non-positive sizes, no parts) are rejected
 //   by validatePrimitive(); other functions assert it.
 // - Pure functions, no I/O, thread-safe.
@@ -82,7 +83,10 @@ IndexedMesh tessellate(const PrimitiveShape& shape, const TessellationParams& pa
 
 struct PrimitiveCurveOptions {
   int maxTriangles = 16384;  // top of the ladder of tessellations
-  int maxSegments = 16;      // curve segments for fitConservative
+  // Resources grow by at most this factor within one curve segment, which
+  // bounds the overestimate: r(a) <= stepRatio * cheapest tessellation that
+  // reaches a (25-31 segments up to 16k triangles at 1.25).
+  double stepRatio = 1.25;
 };
 // Relative accuracy curve, resources in triangles. Box: a point curve at
 // (kExactRelativeAccuracy, 12).
