@@ -495,7 +495,9 @@ Result<Plan> BruteForceScheduler::plan(const SchedulingScene& scene, const Viewe
       }
     } while (advance(search.choice));
     search.choice = bestChoice;
-    target = best;
+    // A fixed accuracy that every object reaches or exceeds its best at is
+    // the target itself (same convention as the accuracy-curve scheduler).
+    target = budget.fixedAccuracy && best >= high ? *budget.fixedAccuracy : best;
     search.select(0, target, scene, selections);
   }
   PlanContext context{scene, config_, viewer, region, state};

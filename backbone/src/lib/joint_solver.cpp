@@ -303,7 +303,9 @@ std::optional<double> JointSolver::maximise(std::optional<double> cap, std::opti
     lo = std::min(lo, hi);
   }
   if (!feasible(lo)) return std::nullopt;
-  if (feasible(hi)) return hi;
+  // Above the best any object reaches nothing costs more: a reachable cap
+  // (fixed accuracy) is the target itself.
+  if (feasible(hi)) return cap ? *cap : hi;
   if (hint && *hint > lo && *hint < hi) {
     if (feasible(*hint)) {
       lo = *hint;
@@ -345,22 +347,30 @@ void JointSolver::extract(double accuracy, std::vector<LeafSelection>& out) {
   extractNode(static_cast<std::uint32_t>(root_), accuracy, best, out);
 }
 
+void JointSolver::reportNothing(std::uint32_t k, bool underLod,
+                                std::vector<LeafSelection>& out) const {
+  // A subtree that renders nothing: its visible leaves are reported (under
+  // an LOD only the dropped ones, the other levels were never candidates).
+  const Node& n = nodes_[k];
+  if (n.kind == SceneNodeKind::kLeaf) {
+    if (underLod && !n.dropped) return;
+    LeafSelection s;
+    s.node = n.sceneNode;
+    s.object = scene_.nodes[n.sceneNode].object;
+    s.rendered = false;
+    s.dropped = n.dropped;
+    out.push_back(s);
+    return;
+  }
+  for (std::uint32_t c = 0; c < n.childCount; ++c)
+    reportNothing(children_[n.firstChild + c], underLod || n.kind == SceneNodeKind::kLod, out);
+}
+
 void JointSolver::extractNode(std::uint32_t k, double accuracy, std::uint32_t index,
                               std::vector<LeafSelection>& out) {
   const Node& n = nodes_[k];
   if (n.maxAccuracy == -kInf) {
-    // Renders nothing: report its visible leaves (group children) as such.
-    if (n.kind == SceneNodeKind::kLeaf) {
-      LeafSelection s;
-      s.node = n.sceneNode;
-      s.object = scene_.nodes[n.sceneNode].object;
-      s.rendered = false;
-      s.dropped = n.dropped;
-      out.push_back(s);
-    } else if (n.kind == SceneNodeKind::kGroup) {
-      for (std::uint32_t c = 0; c < n.childCount; ++c)
-        extractNode(children_[n.firstChild + c], accuracy, 0, out);
-    }
+    reportNothing(k, false, out);
     return;
   }
   const double clamped = std::min(accuracy, n.maxAccuracy);

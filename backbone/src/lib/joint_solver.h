@@ -77,6 +77,7 @@ class JointSolver {
   void refreshAccuracyBounds();
   Span evaluate(std::uint32_t k, double accuracy);
   Span finish(std::uint32_t begin);
+  void reportNothing(std::uint32_t k, bool underLod, std::vector<LeafSelection>& out) const;
   void extractNode(std::uint32_t k, double accuracy, std::uint32_t index,
                    std::vector<LeafSelection>& out);
 
