@@ -1,0 +1,53 @@
+// Scene objects: the drawable leaves of a scene graph, numbered the same way
+// by all three daemons so that an object id on the wire means one Shape.
+//
+// Contract:
+// - collectSceneObjects() walks flattenInstances() (pre-order over all
+//   roots): each Shape instance with drawable geometry becomes one object,
+//   id = 1 + its position among them. A Shape USEd twice is two objects. The
+//   numbering depends only on the scene file, so daemons that load the same
+//   file agree on every id.
+// - fullMesh is the Shape's best geometry in its own (content) frame: the
+//   loaded mesh file or IndexedFaceSet as is, a primitive tessellated at
+//   `primitiveTriangles` (its "original"). objectToWorld maps that frame to
+//   world; worldBounds / worldSphere are the transformed bounds.
+// - Pointers refer into the Scene, which must outlive the objects.
+// - Errors: a mesh-file Shape whose mesh was not resolved -> kNotFound naming
+//   the url; an invalid primitive -> kInvalidArgument.
+// - Pure apart from the tessellation work; thread-safe for a const Scene.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/scene.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::scene {
+
+struct SceneObject {
+  std::uint64_t id = 0;
+  const ShapeNode* shape = nullptr;
+  int instance = -1;  // index into flattenInstances(scene)
+  glm::mat4 objectToWorld{1.0f};
+  std::shared_ptr<const IndexedMesh> fullMesh;  // content frame
+  Bounds worldBounds;
+  BoundingSphere worldSphere;  // of the transformed full mesh
+  double diameter = 0.0;       // content-frame bbox diagonal (relative accuracy's size)
+};
+
+struct SceneObjectOptions {
+  int primitiveTriangles = 4096;  // tessellation of a primitive's "original"
+};
+
+Result<std::vector<SceneObject>> collectSceneObjects(const Scene& scene,
+                                                     const SceneObjectOptions& options = {});
+
+// The object with `id`, or nullptr.
+const SceneObject* findSceneObject(const std::vector<SceneObject>& objects, std::uint64_t id);
+
+}  // namespace thinlod::scene
