@@ -1,0 +1,156 @@
+// FrontendScene: what the thin client holds (Pasman & Jansen 2002, section 4):
+// one representation per object id, replaced by atomic update batches that
+// become visible only once every new representation in them is on the GPU.
+//
+// Contract:
+// - Representations are already decoded (IndexedMesh + RgbaImage); the wire
+//   codecs live elsewhere. Transforms are object -> world, metres.
+// - enqueue() validates the WHOLE batch (ids unique, meshes valid, textures
+//   consistent, transforms finite and invertible, impostors textured, textured
+//   meshes with uvs) and queues nothing on error (kInvalidArgument naming the
+//   operation). A SimpleImpostor with a null or empty mesh gets the unit quad
+//   (unitQuadMesh()). Limits: kResourceExhausted past maxPendingBatches.
+// - Upload bookkeeping (pure; the renderer does the GL work): planUploads()
+//   hands out the queued representations to upload this frame, oldest first,
+//   within a byte bound (one oversized item may go alone so nothing stalls);
+//   markUploaded()/dropBatch() report back. commitReady() applies every fully
+//   uploaded batch at the head of the queue, in arrival order, all operations
+//   of a batch in one step; until then the previous representations stay.
+// - Removing an id that is not held is not an error (counted, see CommitResult).
+// - Keys: every queued representation gets a unique RepresentationKey, never
+//   reused, so GPU resources can be tracked by key across replacements.
+// - Not thread-safe: one owner (the frame loop) calls everything.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::frontend {
+
+using ObjectId = std::uint64_t;
+using RepresentationKey = std::uint64_t;  // 0 = none
+
+enum class RepresentationKind : std::uint8_t {
+  kMesh = 0,
+  kSimpleImpostor = 1,
+  kMeshedImpostor = 2
+};
+const char* representationKindName(RepresentationKind kind);  // "Mesh", "SimpleImpostor", ...
+
+struct Representation {
+  RepresentationKind kind = RepresentationKind::kMesh;
+  // kMesh: required. kSimpleImpostor: null/empty = unit quad. kMeshedImpostor:
+  // the depth mesh, uvs required.
+  std::shared_ptr<const IndexedMesh> mesh;
+  // Required for impostors (their lighting is baked in: drawn unlit); optional
+  // for meshes (drawn lit). Non-premultiplied RGBA, rows top-down.
+  std::shared_ptr<const render::RgbaImage> texture;
+  glm::mat4 transform{1.0f};  // object -> world
+  glm::vec4 color{1.0f};      // multiplies texture and vertex colours, components in [0,1]
+  std::uint32_t generation = 0;
+};
+
+struct SceneOperation {
+  enum class Type : std::uint8_t { kAddOrReplace = 0, kRemove = 1 };
+  Type type = Type::kAddOrReplace;
+  ObjectId id = 0;
+  Representation representation;  // kAddOrReplace only
+};
+
+struct SceneBatch {
+  std::uint64_t plan = 0;  // the backbone's planning step, reported back when applied
+  std::vector<SceneOperation> operations;
+};
+
+// One held (or queued) representation after validation.
+struct SceneObject {
+  ObjectId id = 0;
+  RepresentationKey key = 0;
+  Representation representation;  // mesh never null (unit quad substituted)
+  std::size_t triangleCount = 0;
+  std::size_t uploadBytes = 0;  // texture bytes + GPU vertex/index bytes (see uploadBytesOf)
+};
+
+struct PendingUpload {
+  RepresentationKey key = 0;
+  std::uint64_t batchSequence = 0;      // which queued batch it belongs to
+  const SceneObject* object = nullptr;  // valid until the next non-const call
+};
+
+struct CommitResult {
+  std::vector<std::uint64_t> plans;          // plans applied, in order
+  std::vector<RepresentationKey> activated;  // now drawn
+  std::vector<RepresentationKey> released;   // replaced or removed: free their GPU resources
+  std::size_t missingRemovals = 0;           // removals of ids not held
+  bool changed() const { return !activated.empty() || !released.empty(); }
+};
+
+struct SceneLimits {
+  std::size_t maxPendingBatches = 256;
+  std::size_t maxOperationsPerBatch = 65536;
+};
+
+// GPU bytes MeshRenderer stores per vertex (interleaved) and per index.
+constexpr std::size_t kGpuVertexBytes = 40;
+constexpr std::size_t kGpuIndexBytes = 4;
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const render::RgbaImage* texture);
+
+// Two counter-clockwise triangles spanning [-0.5, 0.5]^2 at z = 0, facing +z,
+// uv (0,0) at (-0.5,-0.5) and (1,1) at (0.5,0.5): the simple impostor default.
+std::shared_ptr<const IndexedMesh> unitQuadMesh();
+
+class FrontendScene {
+ public:
+  explicit FrontendScene(const SceneLimits& limits = {});
+
+  Status enqueue(SceneBatch batch);
+
+  // Oldest-first representations still to upload, whose byte sizes sum to at
+  // most `byteBudget`; if the first one alone exceeds it, just that one.
+  std::vector<PendingUpload> planUploads(std::size_t byteBudget) const;
+  // kNotFound for an unknown or already uploaded key.
+  Status markUploaded(RepresentationKey key);
+  // Discards a queued batch (e.g. its upload failed); returns the keys of its
+  // representations (uploaded or not) so their GPU resources can be freed.
+  std::vector<RepresentationKey> dropBatch(std::uint64_t batchSequence);
+
+  CommitResult commitReady();
+
+  const std::map<ObjectId, SceneObject>& objects() const { return objects_; }
+  const SceneObject* find(ObjectId id) const;
+  // A queued (not yet committed) representation, or null.
+  const SceneObject* findPending(RepresentationKey key) const;
+  std::size_t polygons() const { return polygons_; }  // triangles of the held objects
+  std::size_t pendingBatches() const { return pending_.size(); }
+  std::size_t pendingUploadBytes() const;
+  std::uint64_t lastAppliedPlan() const { return lastPlan_; }
+
+ private:
+  struct QueuedBatch {
+    std::uint64_t sequence = 0;
+    std::uint64_t plan = 0;
+    std::vector<SceneOperation::Type> types;
+    std::vector<SceneObject> objects;  // one per operation (removals: id only)
+    std::vector<bool> uploaded;        // per operation; removals start true
+  };
+
+  SceneLimits limits_;
+  std::map<ObjectId, SceneObject> objects_;
+  std::deque<QueuedBatch> pending_;
+  std::uint64_t nextSequence_ = 1;
+  RepresentationKey nextKey_ = 1;
+  std::size_t polygons_ = 0;
+  std::uint64_t lastPlan_ = 0;
+};
+
+}  // namespace thinlod::frontend

@@ -1,0 +1,381 @@
+#include "thinlod/frontend/frontend_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "texture_fit.h"
+#include "thinlod/common/render/mesh_batch.h"
+#include "thinlod/common/render/render_target.h"
+
+namespace thinlod::frontend {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::uint8_t toByte(float v) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
+
+bool finiteMatrix(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  return true;
+}
+
+// Which merged draw a representation belongs to.
+struct BatchKey {
+  int page = 0;
+  bool lit = false;
+  bool operator<(const BatchKey& o) const { return page != o.page ? page < o.page : lit < o.lit; }
+};
+
+// GPU-side state of one uploaded representation.
+struct GpuPart {
+  BatchKey batch;
+  int layer = -1;     // own texture layer in `batch.page`, or -1 (untextured: the white layer)
+  IndexedMesh world;  // baked to world space, uvs mapped into the layer
+  std::vector<std::uint16_t> layers;
+};
+
+struct Page {
+  render::TextureHandle texture;
+  std::vector<int> freeLayers;  // popped from the back
+};
+
+struct DrawBatch {
+  render::MeshHandle mesh;
+  bool dirty = true;
+  std::size_t triangles = 0;
+};
+
+// Page 0, layer 0 is opaque white: untextured meshes sample it so they can
+// share the draw call of textured ones.
+constexpr int kWhiteLayer = 0;
+
+}  // namespace
+
+struct FrontendRenderer::Impl {
+  render::OffscreenContext* context = nullptr;
+  FrontendRendererOptions options;
+  FrontendScene scene;
+  std::unique_ptr<render::RenderTarget> target;
+  std::unique_ptr<render::MeshRenderer> renderer;
+  std::vector<Page> pages;
+  std::unordered_map<RepresentationKey, GpuPart> parts;
+  std::map<BatchKey, DrawBatch> batches;
+  IndexedMesh mergeScratch;
+  std::vector<std::uint16_t> layerScratch;
+  std::vector<render::DrawItem> items;
+
+  explicit Impl(const FrontendRendererOptions& o) : options(o), scene(o.limits) {}
+
+  ~Impl() {
+    // GL objects must go while the context is current; the renderer frees its
+    // meshes and textures itself.
+    if (context != nullptr && !context->isCurrent()) (void)context->makeCurrent();
+    renderer.reset();
+    target.reset();
+  }
+
+  Status addPage() {
+    render::TextureOptions textureOptions;
+    textureOptions.linearFilter = options.linearFilter;
+    textureOptions.mipmaps = false;
+    textureOptions.clampToEdge = true;
+    auto texture = renderer->createTextureArray(options.layerSize, options.layerSize,
+                                                options.layersPerPage, textureOptions);
+    if (!texture.ok()) return texture.status();
+    Page page;
+    page.texture = *texture;
+    const bool first = pages.empty();
+    for (int layer = options.layersPerPage - 1; layer >= (first ? 1 : 0); --layer) {
+      page.freeLayers.push_back(layer);
+    }
+    if (first) {
+      render::RgbaImage white(options.layerSize, options.layerSize);
+      std::fill(white.pixels.begin(), white.pixels.end(), std::uint8_t{255});
+      Status status = renderer->setTextureLayer(page.texture, kWhiteLayer, white);
+      if (!status.ok()) {
+        renderer->deleteTexture(page.texture);
+        return status;
+      }
+    }
+    pages.push_back(std::move(page));
+    return Status();
+  }
+
+  // A free (page, layer); makes a new page when all are taken.
+  Status acquireLayer(int& pageIndex, int& layer) {
+    for (std::size_t p = 0; p < pages.size(); ++p) {
+      if (!pages[p].freeLayers.empty()) {
+        pageIndex = static_cast<int>(p);
+        layer = pages[p].freeLayers.back();
+        pages[p].freeLayers.pop_back();
+        return Status();
+      }
+    }
+    THINLOD_RETURN_IF_ERROR(addPage());
+    pageIndex = static_cast<int>(pages.size() - 1);
+    layer = pages.back().freeLayers.back();
+    pages.back().freeLayers.pop_back();
+    return Status();
+  }
+
+  void releasePart(RepresentationKey key) {
+    auto it = parts.find(key);
+    if (it == parts.end()) return;
+    if (it->second.layer >= 0) pages[it->second.batch.page].freeLayers.push_back(it->second.layer);
+    parts.erase(it);
+  }
+
+  Status uploadOne(const SceneObject& object) {
+    const Representation& rep = object.representation;
+    GpuPart part;
+    part.batch.lit = rep.kind == RepresentationKind::kMesh;
+    render::MeshBatch::Part batchPart;
+    batchPart.model = rep.transform;
+    batchPart.color = {toByte(rep.color.r), toByte(rep.color.g), toByte(rep.color.b),
+                       toByte(rep.color.a)};
+    if (rep.texture != nullptr) {
+      int page = 0;
+      int layer = 0;
+      THINLOD_RETURN_IF_ERROR(acquireLayer(page, layer));
+      part.batch.page = page;
+      part.layer = layer;
+      const detail::FittedTexture fitted =
+          detail::fitTextureToLayer(*rep.texture, options.layerSize);
+      Status status = renderer->setTextureLayer(pages[page].texture, layer,
+                                                fitted.useSource ? *rep.texture : fitted.image);
+      if (!status.ok()) {
+        pages[page].freeLayers.push_back(layer);
+        return status;
+      }
+      batchPart.textureLayer = layer;
+      batchPart.uvScale = fitted.uvScale;
+    } else {
+      part.batch.page = 0;
+      batchPart.textureLayer = kWhiteLayer;
+    }
+    render::MeshBatch baked;
+    Status status =
+        baked.append(*rep.mesh, batchPart, "object " + std::to_string(object.id) + " mesh");
+    if (!status.ok()) {
+      if (part.layer >= 0) pages[part.batch.page].freeLayers.push_back(part.layer);
+      return status;
+    }
+    part.world = baked.mesh();
+    part.layers = baked.textureLayers();
+    parts[object.key] = std::move(part);
+    return Status();
+  }
+
+  void uploadPending(FrameReport& report) {
+    const std::vector<PendingUpload> plan = scene.planUploads(options.uploadBytesPerFrame);
+    for (const PendingUpload& upload : plan) {
+      Status status = uploadOne(*upload.object);
+      if (status.ok()) {
+        report.uploadedBytes += upload.object->uploadBytes;
+        ++report.uploadedObjects;
+        (void)scene.markUploaded(upload.key);
+        continue;
+      }
+      // The batch can never be shown whole: drop it and free what it uploaded.
+      for (RepresentationKey key : scene.dropBatch(upload.batchSequence)) releasePart(key);
+      ++report.droppedBatches;
+      report.lastUploadError = status.toString();
+      break;  // dropBatch may have invalidated the remaining plan entries
+    }
+  }
+
+  void markDirty(RepresentationKey key) {
+    auto it = parts.find(key);
+    if (it != parts.end()) batches[it->second.batch].dirty = true;
+  }
+
+  Status rebuildDirtyBatches(FrameReport& report) {
+    for (auto& [key, batch] : batches) {
+      if (!batch.dirty) continue;
+      IndexedMesh& merged = mergeScratch;
+      merged.positions.clear();
+      merged.normals.clear();
+      merged.uvs.clear();
+      merged.colors.clear();
+      merged.indices.clear();
+      layerScratch.clear();
+      for (const auto& [id, object] : scene.objects()) {
+        auto part = parts.find(object.key);
+        if (part == parts.end() || part->second.batch.page != key.page ||
+            part->second.batch.lit != key.lit) {
+          continue;
+        }
+        const IndexedMesh& world = part->second.world;
+        const auto base = static_cast<std::uint32_t>(merged.positions.size());
+        merged.positions.insert(merged.positions.end(), world.positions.begin(),
+                                world.positions.end());
+        merged.normals.insert(merged.normals.end(), world.normals.begin(), world.normals.end());
+        merged.uvs.insert(merged.uvs.end(), world.uvs.begin(), world.uvs.end());
+        merged.colors.insert(merged.colors.end(), world.colors.begin(), world.colors.end());
+        for (std::uint32_t index : world.indices) merged.indices.push_back(base + index);
+        layerScratch.insert(layerScratch.end(), part->second.layers.begin(),
+                            part->second.layers.end());
+      }
+      batch.triangles = merged.triangleCount();
+      batch.dirty = false;
+      if (merged.indices.empty()) continue;  // drawn as nothing; the handle keeps its old data
+      report.geometryBytesRebuilt +=
+          merged.vertexCount() * kGpuVertexBytes + merged.indices.size() * kGpuIndexBytes;
+      if (batch.mesh.valid()) {
+        THINLOD_RETURN_IF_ERROR(renderer->updateMesh(batch.mesh, merged, layerScratch));
+      } else {
+        auto handle = renderer->uploadMesh(merged, layerScratch);
+        if (!handle.ok()) return handle.status();
+        batch.mesh = *handle;
+      }
+    }
+    return Status();
+  }
+
+  render::Material materialFor(const BatchKey& key) const {
+    render::Material m;
+    m.diffuse = glm::vec4(1.0f);
+    m.useVertexColors = true;
+    m.texture = pages[key.page].texture;
+    m.doubleSided = true;
+    if (key.lit) {
+      m.lit = true;
+      m.specular = options.meshSpecular;
+      m.shininess = options.meshShininess;
+      m.alphaMode = render::AlphaMode::kOpaque;
+    } else {
+      m.lit = false;
+      m.alphaMode = options.impostorAlpha;
+      m.alphaCutoff = options.alphaCutoff;
+    }
+    return m;
+  }
+};
+
+FrontendRenderer::FrontendRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FrontendRenderer::~FrontendRenderer() = default;
+
+Result<std::unique_ptr<FrontendRenderer>> FrontendRenderer::create(
+    render::OffscreenContext& context, const FrontendRendererOptions& options) {
+  if (!context.isCurrent()) {
+    return Status(ErrorCode::kUnavailable,
+                  "FrontendRenderer::create: the GL context is not current on this thread");
+  }
+  const int maxSize = context.maxRenderTargetSize();
+  if (options.width < 1 || options.height < 1 || options.width > maxSize ||
+      options.height > maxSize) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "FrontendRenderer: frame " + std::to_string(options.width) + "x" +
+                      std::to_string(options.height) + " outside 1.." + std::to_string(maxSize));
+  }
+  if (options.layerSize < 2 || options.layerSize > 4096 || options.layersPerPage < 2 ||
+      options.layersPerPage > 2048) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "FrontendRenderer: layerSize " + std::to_string(options.layerSize) +
+                      " (2..4096) or layersPerPage " + std::to_string(options.layersPerPage) +
+                      " (2..2048) out of range");
+  }
+  if (options.uploadBytesPerFrame == 0) {
+    return Status(ErrorCode::kInvalidArgument, "FrontendRenderer: uploadBytesPerFrame is 0");
+  }
+  if (!std::isfinite(options.alphaCutoff) || !std::isfinite(options.meshShininess) ||
+      !std::isfinite(options.meshSpecular.x) || !std::isfinite(options.meshSpecular.y) ||
+      !std::isfinite(options.meshSpecular.z) || !std::isfinite(options.clearColor.r) ||
+      !std::isfinite(options.clearColor.g) || !std::isfinite(options.clearColor.b) ||
+      !std::isfinite(options.clearColor.a)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "FrontendRenderer: alpha cutoff, shininess, specular or clear colour not finite");
+  }
+  auto impl = std::make_unique<Impl>(options);
+  impl->context = &context;
+  auto target = render::RenderTarget::create(context, options.width, options.height);
+  if (!target.ok()) return target.status();
+  impl->target = std::move(target).value();
+  auto renderer = render::MeshRenderer::create(context);
+  if (!renderer.ok()) return renderer.status();
+  impl->renderer = std::move(renderer).value();
+  THINLOD_RETURN_IF_ERROR(impl->addPage());
+  return std::unique_ptr<FrontendRenderer>(new FrontendRenderer(std::move(impl)));
+}
+
+Status FrontendRenderer::submit(SceneBatch batch) { return impl_->scene.enqueue(std::move(batch)); }
+
+Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
+                                                  const render::Lighting& lighting,
+                                                  render::RgbaImage& frame) {
+  Impl& impl = *impl_;
+  if (!impl.context->isCurrent()) {
+    return Status(ErrorCode::kUnavailable,
+                  "FrontendRenderer::renderFrame: the GL context is not current on this thread");
+  }
+  if (!finiteMatrix(camera.view) || !finiteMatrix(camera.projection)) {
+    return Status(ErrorCode::kInvalidArgument, "renderFrame: camera matrices are not finite");
+  }
+  if (lighting.lights.size() > static_cast<std::size_t>(render::kMaxLights)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "renderFrame: " + std::to_string(lighting.lights.size()) + " lights, at most " +
+                      std::to_string(render::kMaxLights));
+  }
+  FrameReport report;
+  const Clock::time_point frameStart = Clock::now();
+
+  impl.uploadPending(report);
+  report.timing.uploadMs = millisecondsSince(frameStart);
+
+  const Clock::time_point commitStart = Clock::now();
+  const CommitResult commit = impl.scene.commitReady();
+  for (RepresentationKey key : commit.released) {
+    impl.markDirty(key);
+    impl.releasePart(key);
+  }
+  for (RepresentationKey key : commit.activated) impl.markDirty(key);
+  report.committedBatches = commit.plans.size();
+  THINLOD_RETURN_IF_ERROR(impl.rebuildDirtyBatches(report));
+  report.timing.commitMs = millisecondsSince(commitStart);
+
+  const Clock::time_point drawStart = Clock::now();
+  impl.items.clear();
+  for (const auto& [key, batch] : impl.batches) {
+    if (batch.triangles == 0 || !batch.mesh.valid()) continue;
+    render::DrawItem item;
+    item.mesh = batch.mesh;
+    item.material = impl.materialFor(key);
+    impl.items.push_back(item);
+  }
+  THINLOD_RETURN_IF_ERROR(impl.renderer->beginFrame(*impl.target, impl.options.clearColor));
+  THINLOD_RETURN_IF_ERROR(impl.renderer->draw(impl.items, camera, lighting));
+  THINLOD_RETURN_IF_ERROR(impl.target->readColor(frame));
+  report.timing.drawMs = millisecondsSince(drawStart);
+  report.timing.totalMs = millisecondsSince(frameStart);
+
+  const render::RenderStats& stats = impl.renderer->stats();
+  report.drawCalls = stats.drawCalls;
+  report.textureBinds = stats.textureBinds;
+  report.triangles = stats.triangles;
+  report.pendingBatches = impl.scene.pendingBatches();
+  report.texturePages = impl.pages.size();
+  report.appliedPlan = impl.scene.lastAppliedPlan();
+  return report;
+}
+
+const FrontendScene& FrontendRenderer::scene() const { return impl_->scene; }
+const FrontendRendererOptions& FrontendRenderer::options() const { return impl_->options; }
+int FrontendRenderer::width() const { return impl_->options.width; }
+int FrontendRenderer::height() const { return impl_->options.height; }
+
+}  // namespace thinlod::frontend

@@ -1,0 +1,270 @@
+#include "thinlod/frontend/frontend_scene.h"
+
+#include <cmath>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+#include <string>
+#include <unordered_set>
+#include <utility>
+
+namespace thinlod::frontend {
+namespace {
+
+bool finiteMatrix(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  return true;
+}
+
+// Checks one add/replace operation; `what` names it ("batch plan 7, operation 3 (object 12)").
+Status validateRepresentation(const Representation& rep, const std::string& what) {
+  const int kind = static_cast<int>(rep.kind);
+  if (kind < 0 || kind > 2) {
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": unknown representation kind " + std::to_string(kind));
+  }
+  if (!finiteMatrix(rep.transform)) {
+    return Status(ErrorCode::kInvalidArgument, what + ": transform is not finite");
+  }
+  const float det = glm::determinant(glm::mat3(rep.transform));
+  if (!std::isfinite(det) || std::fabs(det) < 1e-20f) {
+    return Status(ErrorCode::kInvalidArgument, what + ": transform is singular");
+  }
+  for (int c = 0; c < 4; ++c) {
+    if (!std::isfinite(rep.color[c]) || rep.color[c] < 0.0f || rep.color[c] > 1.0f) {
+      return Status(ErrorCode::kInvalidArgument,
+                    what + ": colour component " + std::to_string(c) + " outside [0,1]");
+    }
+  }
+  const bool impostor = rep.kind != RepresentationKind::kMesh;
+  if (impostor && rep.texture == nullptr) {
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": " + representationKindName(rep.kind) + " needs a texture");
+  }
+  if (rep.texture != nullptr) {
+    const render::RgbaImage& t = *rep.texture;
+    if (!t.consistent() || t.empty()) {
+      return Status(ErrorCode::kInvalidArgument, what + ": texture " + std::to_string(t.width) +
+                                                     "x" + std::to_string(t.height) + " with " +
+                                                     std::to_string(t.pixels.size()) +
+                                                     " bytes is empty or inconsistent");
+    }
+  }
+  const bool needsMesh = rep.kind != RepresentationKind::kSimpleImpostor;
+  if (needsMesh && (rep.mesh == nullptr || rep.mesh->indices.empty())) {
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": " + representationKindName(rep.kind) + " needs a non-empty mesh");
+  }
+  if (rep.mesh != nullptr && !rep.mesh->positions.empty()) {
+    THINLOD_RETURN_IF_ERROR(rep.mesh->validate(what + " mesh"));
+    if (rep.texture != nullptr && rep.mesh->uvs.empty()) {
+      return Status(ErrorCode::kInvalidArgument, what + ": textured mesh has no uvs");
+    }
+    if (rep.mesh->indices.empty()) {
+      return Status(ErrorCode::kInvalidArgument, what + ": mesh has vertices but no triangles");
+    }
+  }
+  return Status();
+}
+
+}  // namespace
+
+const char* representationKindName(RepresentationKind kind) {
+  switch (kind) {
+    case RepresentationKind::kMesh:
+      return "Mesh";
+    case RepresentationKind::kSimpleImpostor:
+      return "SimpleImpostor";
+    case RepresentationKind::kMeshedImpostor:
+      return "MeshedImpostor";
+  }
+  return "unknown";
+}
+
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const render::RgbaImage* texture) {
+  std::size_t bytes = mesh.vertexCount() * kGpuVertexBytes + mesh.indices.size() * kGpuIndexBytes;
+  if (texture != nullptr) bytes += texture->pixels.size();
+  return bytes;
+}
+
+std::shared_ptr<const IndexedMesh> unitQuadMesh() {
+  static const std::shared_ptr<const IndexedMesh> quad = [] {
+    auto mesh = std::make_shared<IndexedMesh>();
+    mesh->positions = {
+        {-0.5f, -0.5f, 0.0f}, {0.5f, -0.5f, 0.0f}, {0.5f, 0.5f, 0.0f}, {-0.5f, 0.5f, 0.0f}};
+    mesh->normals.assign(4, glm::vec3(0.0f, 0.0f, 1.0f));
+    mesh->uvs = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+    mesh->indices = {0, 1, 2, 0, 2, 3};
+    return std::shared_ptr<const IndexedMesh>(std::move(mesh));
+  }();
+  return quad;
+}
+
+FrontendScene::FrontendScene(const SceneLimits& limits) : limits_(limits) {}
+
+Status FrontendScene::enqueue(SceneBatch batch) {
+  const std::string batchName = "scene batch (plan " + std::to_string(batch.plan) + ")";
+  if (pending_.size() >= limits_.maxPendingBatches) {
+    return Status(ErrorCode::kResourceExhausted,
+                  batchName + ": " + std::to_string(pending_.size()) +
+                      " batches already queued (limit " +
+                      std::to_string(limits_.maxPendingBatches) + ")");
+  }
+  if (batch.operations.size() > limits_.maxOperationsPerBatch) {
+    return Status(ErrorCode::kResourceExhausted,
+                  batchName + ": " + std::to_string(batch.operations.size()) +
+                      " operations (limit " + std::to_string(limits_.maxOperationsPerBatch) + ")");
+  }
+  std::unordered_set<ObjectId> seen;
+  for (std::size_t i = 0; i < batch.operations.size(); ++i) {
+    const SceneOperation& op = batch.operations[i];
+    const std::string what =
+        batchName + ", operation " + std::to_string(i) + " (object " + std::to_string(op.id) + ")";
+    if (!seen.insert(op.id).second) {
+      return Status(ErrorCode::kInvalidArgument, what + ": object id appears twice in the batch");
+    }
+    if (op.type == SceneOperation::Type::kRemove) continue;
+    if (op.type != SceneOperation::Type::kAddOrReplace) {
+      return Status(ErrorCode::kInvalidArgument,
+                    what + ": unknown operation type " + std::to_string(static_cast<int>(op.type)));
+    }
+    THINLOD_RETURN_IF_ERROR(validateRepresentation(op.representation, what));
+  }
+
+  QueuedBatch queued;
+  queued.sequence = nextSequence_++;
+  queued.plan = batch.plan;
+  queued.types.reserve(batch.operations.size());
+  queued.objects.reserve(batch.operations.size());
+  for (SceneOperation& op : batch.operations) {
+    SceneObject object;
+    object.id = op.id;
+    queued.types.push_back(op.type);
+    if (op.type == SceneOperation::Type::kAddOrReplace) {
+      object.key = nextKey_++;
+      object.representation = std::move(op.representation);
+      Representation& rep = object.representation;
+      if (rep.mesh == nullptr || rep.mesh->positions.empty()) rep.mesh = unitQuadMesh();
+      object.triangleCount = rep.mesh->triangleCount();
+      object.uploadBytes = uploadBytesOf(*rep.mesh, rep.texture.get());
+    }
+    queued.uploaded.push_back(op.type == SceneOperation::Type::kRemove);
+    queued.objects.push_back(std::move(object));
+  }
+  pending_.push_back(std::move(queued));
+  return Status();
+}
+
+std::vector<PendingUpload> FrontendScene::planUploads(std::size_t byteBudget) const {
+  std::vector<PendingUpload> plan;
+  std::size_t spent = 0;
+  for (const QueuedBatch& batch : pending_) {
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (batch.uploaded[i]) continue;
+      const SceneObject& object = batch.objects[i];
+      const bool fits = spent + object.uploadBytes <= byteBudget;
+      // Strict arrival order: stop at the first item that does not fit, unless
+      // nothing went yet (an oversized item goes alone rather than stall).
+      if (!fits && !plan.empty()) return plan;
+      plan.push_back(PendingUpload{object.key, batch.sequence, &object});
+      spent += object.uploadBytes;
+      if (!fits) return plan;
+    }
+  }
+  return plan;
+}
+
+Status FrontendScene::markUploaded(RepresentationKey key) {
+  for (QueuedBatch& batch : pending_) {
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (batch.types[i] != SceneOperation::Type::kAddOrReplace || batch.objects[i].key != key) {
+        continue;
+      }
+      if (batch.uploaded[i]) {
+        return Status(ErrorCode::kNotFound,
+                      "markUploaded: representation " + std::to_string(key) + " already uploaded");
+      }
+      batch.uploaded[i] = true;
+      return Status();
+    }
+  }
+  return Status(ErrorCode::kNotFound,
+                "markUploaded: no queued representation " + std::to_string(key));
+}
+
+std::vector<RepresentationKey> FrontendScene::dropBatch(std::uint64_t batchSequence) {
+  std::vector<RepresentationKey> keys;
+  for (auto it = pending_.begin(); it != pending_.end(); ++it) {
+    if (it->sequence != batchSequence) continue;
+    for (std::size_t i = 0; i < it->objects.size(); ++i) {
+      if (it->types[i] == SceneOperation::Type::kAddOrReplace) keys.push_back(it->objects[i].key);
+    }
+    pending_.erase(it);
+    break;
+  }
+  return keys;
+}
+
+CommitResult FrontendScene::commitReady() {
+  CommitResult result;
+  while (!pending_.empty()) {
+    QueuedBatch& batch = pending_.front();
+    bool complete = true;
+    for (bool done : batch.uploaded) complete = complete && done;
+    if (!complete) break;
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      SceneObject& incoming = batch.objects[i];
+      auto held = objects_.find(incoming.id);
+      if (held != objects_.end()) {
+        result.released.push_back(held->second.key);
+        polygons_ -= held->second.triangleCount;
+      }
+      if (batch.types[i] == SceneOperation::Type::kRemove) {
+        if (held == objects_.end()) {
+          ++result.missingRemovals;
+        } else {
+          objects_.erase(held);
+        }
+        continue;
+      }
+      result.activated.push_back(incoming.key);
+      polygons_ += incoming.triangleCount;
+      objects_[incoming.id] = std::move(incoming);
+    }
+    result.plans.push_back(batch.plan);
+    lastPlan_ = batch.plan;
+    pending_.pop_front();
+  }
+  return result;
+}
+
+const SceneObject* FrontendScene::find(ObjectId id) const {
+  auto it = objects_.find(id);
+  return it == objects_.end() ? nullptr : &it->second;
+}
+
+const SceneObject* FrontendScene::findPending(RepresentationKey key) const {
+  for (const QueuedBatch& batch : pending_) {
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (batch.types[i] == SceneOperation::Type::kAddOrReplace && batch.objects[i].key == key) {
+        return &batch.objects[i];
+      }
+    }
+  }
+  return nullptr;
+}
+
+std::size_t FrontendScene::pendingUploadBytes() const {
+  std::size_t bytes = 0;
+  for (const QueuedBatch& batch : pending_) {
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (!batch.uploaded[i]) bytes += batch.objects[i].uploadBytes;
+    }
+  }
+  return bytes;
+}
+
+}  // namespace thinlod::frontend

@@ -1,0 +1,78 @@
+#include "texture_fit.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cstdint>
+#include <cstring>
+
+namespace thinlod::frontend::detail {
+
+render::RgbaImage shrinkImage(const render::RgbaImage& source, int width, int height) {
+  assert(width >= 1 && height >= 1 && width <= source.width && height <= source.height &&
+         "shrinkImage: target must be non-empty and no larger than the source");
+  render::RgbaImage out(width, height);
+  for (int y = 0; y < height; ++y) {
+    const int y0 = static_cast<int>(static_cast<long long>(y) * source.height / height);
+    const int y1 =
+        std::max(y0 + 1, static_cast<int>(static_cast<long long>(y + 1) * source.height / height));
+    for (int x = 0; x < width; ++x) {
+      const int x0 = static_cast<int>(static_cast<long long>(x) * source.width / width);
+      const int x1 =
+          std::max(x0 + 1, static_cast<int>(static_cast<long long>(x + 1) * source.width / width));
+      // Premultiplied sums so transparent texels do not darken the edges.
+      std::uint64_t rgb[3] = {0, 0, 0};
+      std::uint64_t alpha = 0;
+      std::uint64_t count = 0;
+      for (int sy = y0; sy < y1; ++sy) {
+        for (int sx = x0; sx < x1; ++sx) {
+          const std::uint8_t* p = source.at(sx, sy);
+          for (int c = 0; c < 3; ++c) rgb[c] += static_cast<std::uint64_t>(p[c]) * p[3];
+          alpha += p[3];
+          ++count;
+        }
+      }
+      std::uint8_t* q = out.at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        q[c] = alpha == 0 ? 0 : static_cast<std::uint8_t>((rgb[c] + alpha / 2) / alpha);
+      }
+      q[3] = static_cast<std::uint8_t>((alpha + count / 2) / count);
+    }
+  }
+  return out;
+}
+
+FittedTexture fitTextureToLayer(const render::RgbaImage& source, int layerSize) {
+  assert(layerSize >= 1 && source.consistent() && !source.empty());
+  FittedTexture fitted;
+  if (source.width == layerSize && source.height == layerSize) {
+    fitted.useSource = true;
+    return fitted;
+  }
+  const render::RgbaImage* image = &source;
+  render::RgbaImage shrunk;
+  if (source.width > layerSize || source.height > layerSize) {
+    shrunk =
+        shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
+    image = &shrunk;
+  }
+  const int w = image->width;
+  const int h = image->height;
+  fitted.uvScale = glm::vec2(static_cast<float>(w) / layerSize, static_cast<float>(h) / layerSize);
+  const int padRight = w < layerSize ? 1 : 0;
+  const int padTop = h < layerSize ? 1 : 0;
+  if (padRight == 0 && padTop == 0) {
+    fitted.image = std::move(shrunk);
+    return fitted;
+  }
+  render::RgbaImage padded(w + padRight, h + padTop);
+  const std::size_t rowBytes = static_cast<std::size_t>(w) * 4;
+  for (int y = 0; y < padded.height; ++y) {
+    const int sourceRow = std::max(0, y - padTop);  // the extra top row repeats row 0
+    std::memcpy(padded.at(0, y), image->at(0, sourceRow), rowBytes);
+    if (padRight != 0) std::memcpy(padded.at(w, y), image->at(w - 1, sourceRow), 4);
+  }
+  fitted.image = std::move(padded);
+  return fitted;
+}
+
+}  // namespace thinlod::frontend::detail

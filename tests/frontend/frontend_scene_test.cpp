@@ -1,0 +1,294 @@
+// FrontendScene: validation, upload planning within a byte bound, atomic and
+// ordered commits (no GL).
+#include "thinlod/frontend/frontend_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "frontend_test_util.h"
+
+namespace thinlod::frontend {
+namespace {
+
+using testing::addOp;
+using testing::quadMesh;
+using testing::removeOp;
+using testing::solidImage;
+
+// A simple impostor whose upload is one 16x16 texture plus the unit quad.
+SceneOperation impostor(ObjectId id) {
+  return addOp(id, RepresentationKind::kSimpleImpostor, nullptr, solidImage(16, 16, 1, 2, 3));
+}
+const std::size_t kImpostorBytes = 16 * 16 * 4 + 4 * kGpuVertexBytes + 6 * kGpuIndexBytes;
+
+SceneBatch batchOf(std::uint64_t plan, std::vector<SceneOperation> ops) {
+  SceneBatch batch;
+  batch.plan = plan;
+  batch.operations = std::move(ops);
+  return batch;
+}
+
+// Uploads everything planned under `budget`; returns how many.
+std::size_t uploadFrame(FrontendScene& scene, std::size_t budget) {
+  const auto plan = scene.planUploads(budget);
+  for (const PendingUpload& upload : plan) EXPECT_TRUE(scene.markUploaded(upload.key).ok());
+  return plan.size();
+}
+
+TEST(FrontendScene, NothingIsHeldBeforeUploadAndCommit) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(7)})).ok());
+  EXPECT_EQ(scene.pendingBatches(), 1u);
+  EXPECT_FALSE(scene.commitReady().changed());
+  EXPECT_EQ(scene.find(7), nullptr);
+  EXPECT_EQ(scene.pendingUploadBytes(), kImpostorBytes);
+}
+
+TEST(FrontendScene, UploadedBatchCommitsWithItsPlan) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(42, {impostor(7)})).ok());
+  EXPECT_EQ(uploadFrame(scene, 1 << 20), 1u);
+  const CommitResult commit = scene.commitReady();
+  EXPECT_EQ(commit.plans, std::vector<std::uint64_t>{42});
+  ASSERT_EQ(commit.activated.size(), 1u);
+  ASSERT_NE(scene.find(7), nullptr);
+  EXPECT_EQ(scene.find(7)->key, commit.activated[0]);
+  EXPECT_EQ(scene.lastAppliedPlan(), 42u);
+  EXPECT_EQ(scene.pendingBatches(), 0u);
+}
+
+TEST(FrontendScene, SimpleImpostorWithoutMeshGetsTheUnitQuad) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(7)})).ok());
+  uploadFrame(scene, 1 << 20);
+  (void)scene.commitReady();
+  const SceneObject* object = scene.find(7);
+  ASSERT_NE(object, nullptr);
+  EXPECT_EQ(object->representation.mesh, unitQuadMesh());
+  EXPECT_EQ(object->triangleCount, 2u);
+  EXPECT_EQ(scene.polygons(), 2u);
+  EXPECT_EQ(object->uploadBytes, kImpostorBytes);
+}
+
+TEST(FrontendScene, HalfUploadedBatchDoesNotCommit) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1), impostor(2)})).ok());
+  EXPECT_EQ(uploadFrame(scene, kImpostorBytes), 1u);
+  EXPECT_FALSE(scene.commitReady().changed());
+  EXPECT_EQ(scene.objects().size(), 0u);
+  EXPECT_EQ(uploadFrame(scene, kImpostorBytes), 1u);
+  EXPECT_EQ(scene.commitReady().activated.size(), 2u);
+  EXPECT_EQ(scene.objects().size(), 2u);
+}
+
+TEST(FrontendScene, PlanStaysWithinTheByteBound) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1), impostor(2), impostor(3)})).ok());
+  const auto plan = scene.planUploads(2 * kImpostorBytes + 10);
+  ASSERT_EQ(plan.size(), 2u);
+  EXPECT_EQ(plan[0].object->id, 1u);
+  EXPECT_EQ(plan[1].object->id, 2u);
+}
+
+TEST(FrontendScene, OversizedItemGoesAlone) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1), impostor(2)})).ok());
+  EXPECT_EQ(uploadFrame(scene, kImpostorBytes / 2), 1u);
+  EXPECT_EQ(uploadFrame(scene, kImpostorBytes / 2), 1u);
+  EXPECT_EQ(uploadFrame(scene, kImpostorBytes / 2), 0u);
+}
+
+TEST(FrontendScene, BatchesCommitInArrivalOrder) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1)})).ok());
+  ASSERT_TRUE(scene.enqueue(batchOf(2, {impostor(2)})).ok());
+  // Only the second batch's item uploaded: the first holds it back.
+  const auto plan = scene.planUploads(1 << 20);
+  ASSERT_EQ(plan.size(), 2u);
+  ASSERT_TRUE(scene.markUploaded(plan[1].key).ok());
+  EXPECT_FALSE(scene.commitReady().changed());
+  ASSERT_TRUE(scene.markUploaded(plan[0].key).ok());
+  EXPECT_EQ(scene.commitReady().plans, (std::vector<std::uint64_t>{1, 2}));
+}
+
+TEST(FrontendScene, ReplaceReleasesTheOldRepresentation) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(5)})).ok());
+  uploadFrame(scene, 1 << 20);
+  const RepresentationKey first = scene.commitReady().activated.at(0);
+  ASSERT_TRUE(scene
+                  .enqueue(batchOf(
+                      2, {addOp(5, RepresentationKind::kMesh, quadMesh(0, 0, 1, 1, 0), nullptr)}))
+                  .ok());
+  EXPECT_EQ(scene.find(5)->key, first);  // still the old one while uploading
+  uploadFrame(scene, 1 << 20);
+  const CommitResult commit = scene.commitReady();
+  EXPECT_EQ(commit.released, std::vector<RepresentationKey>{first});
+  EXPECT_EQ(scene.find(5)->representation.kind, RepresentationKind::kMesh);
+  EXPECT_EQ(scene.polygons(), 2u);
+}
+
+TEST(FrontendScene, RemovalOnlyBatchCommitsAtOnce) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(5), impostor(6)})).ok());
+  uploadFrame(scene, 1 << 20);
+  (void)scene.commitReady();
+  ASSERT_TRUE(scene.enqueue(batchOf(2, {removeOp(5), removeOp(99)})).ok());
+  EXPECT_TRUE(scene.planUploads(1 << 20).empty());
+  const CommitResult commit = scene.commitReady();
+  EXPECT_EQ(commit.released.size(), 1u);
+  EXPECT_EQ(commit.missingRemovals, 1u);
+  EXPECT_EQ(scene.find(5), nullptr);
+  EXPECT_NE(scene.find(6), nullptr);
+  EXPECT_EQ(scene.polygons(), 2u);
+}
+
+TEST(FrontendScene, DropBatchReturnsItsKeys) {
+  FrontendScene scene;
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1), impostor(2), removeOp(3)})).ok());
+  const auto plan = scene.planUploads(1 << 20);
+  ASSERT_EQ(plan.size(), 2u);
+  const auto keys = scene.dropBatch(plan[0].batchSequence);
+  EXPECT_EQ(keys, (std::vector<RepresentationKey>{plan[0].key, plan[1].key}));
+  EXPECT_EQ(scene.pendingBatches(), 0u);
+  EXPECT_TRUE(scene.dropBatch(12345).empty());
+}
+
+TEST(FrontendScene, MarkUploadedRejectsUnknownAndRepeatedKeys) {
+  FrontendScene scene;
+  EXPECT_EQ(scene.markUploaded(3).code(), ErrorCode::kNotFound);
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1)})).ok());
+  const auto plan = scene.planUploads(1 << 20);
+  ASSERT_TRUE(scene.markUploaded(plan[0].key).ok());
+  EXPECT_EQ(scene.markUploaded(plan[0].key).code(), ErrorCode::kNotFound);
+  EXPECT_NE(scene.findPending(plan[0].key), nullptr);
+}
+
+// Each invalid operation rejects its whole batch, naming the object.
+void expectRejected(SceneOperation bad, const std::string& fragment) {
+  FrontendScene scene;
+  Status status = scene.enqueue(batchOf(9, {impostor(1), std::move(bad)}));
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidArgument) << status.toString();
+  EXPECT_NE(status.message().find("object 77"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find(fragment), std::string::npos) << status.message();
+  EXPECT_EQ(scene.pendingBatches(), 0u);
+}
+
+TEST(FrontendScene, RejectsDuplicateIds) {
+  FrontendScene scene;
+  Status status = scene.enqueue(batchOf(1, {impostor(1), removeOp(1)}));
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("twice"), std::string::npos);
+}
+
+TEST(FrontendScene, RejectsNonFiniteTransform) {
+  SceneOperation op = impostor(77);
+  op.representation.transform[3][0] = std::numeric_limits<float>::quiet_NaN();
+  expectRejected(op, "not finite");
+}
+
+TEST(FrontendScene, RejectsSingularTransform) {
+  SceneOperation op = impostor(77);
+  op.representation.transform[1][1] = 0.0f;
+  expectRejected(op, "singular");
+}
+
+TEST(FrontendScene, RejectsImpostorWithoutTexture) {
+  expectRejected(addOp(77, RepresentationKind::kSimpleImpostor, nullptr, nullptr), "texture");
+}
+
+TEST(FrontendScene, RejectsMeshedImpostorWithoutMesh) {
+  expectRejected(addOp(77, RepresentationKind::kMeshedImpostor, nullptr, solidImage(4, 4, 1, 1, 1)),
+                 "mesh");
+}
+
+TEST(FrontendScene, RejectsTexturedMeshWithoutUvs) {
+  auto mesh = std::make_shared<IndexedMesh>(*quadMesh(0, 0, 1, 1, 0));
+  mesh->uvs.clear();
+  expectRejected(addOp(77, RepresentationKind::kMesh, mesh, solidImage(4, 4, 1, 1, 1)), "uvs");
+}
+
+TEST(FrontendScene, RejectsMeshWithBadIndex) {
+  auto mesh = std::make_shared<IndexedMesh>(*quadMesh(0, 0, 1, 1, 0));
+  mesh->indices[4] = 40;
+  expectRejected(addOp(77, RepresentationKind::kMesh, mesh, nullptr), "mesh");
+}
+
+TEST(FrontendScene, RejectsNanPosition) {
+  auto mesh = std::make_shared<IndexedMesh>(*quadMesh(0, 0, 1, 1, 0));
+  mesh->positions[2].y = std::numeric_limits<float>::infinity();
+  expectRejected(addOp(77, RepresentationKind::kMesh, mesh, nullptr), "mesh");
+}
+
+TEST(FrontendScene, RejectsInconsistentTexture) {
+  auto texture = std::make_shared<render::RgbaImage>(4, 4);
+  texture->pixels.resize(7);
+  expectRejected(addOp(77, RepresentationKind::kSimpleImpostor, nullptr, texture), "inconsistent");
+}
+
+TEST(FrontendScene, RejectsColourOutsideUnitRange) {
+  SceneOperation op = impostor(77);
+  op.representation.color.g = 1.5f;
+  expectRejected(op, "colour");
+}
+
+TEST(FrontendScene, RejectsUnknownKind) {
+  SceneOperation op = impostor(77);
+  op.representation.kind = static_cast<RepresentationKind>(9);
+  expectRejected(op, "kind");
+}
+
+TEST(FrontendScene, LimitsPendingBatches) {
+  SceneLimits limits;
+  limits.maxPendingBatches = 2;
+  FrontendScene scene(limits);
+  ASSERT_TRUE(scene.enqueue(batchOf(1, {impostor(1)})).ok());
+  ASSERT_TRUE(scene.enqueue(batchOf(2, {impostor(2)})).ok());
+  EXPECT_EQ(scene.enqueue(batchOf(3, {impostor(3)})).code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(FrontendScene, RandomBatchesKeepPolygonCountConsistent) {
+  // Property: after any sequence of batches and budgets, polygons() equals the
+  // sum over held objects, and every batch eventually commits in order.
+  std::mt19937 rng(350);
+  FrontendScene scene;
+  std::uint64_t plan = 0;
+  std::vector<std::uint64_t> applied;
+  for (int step = 0; step < 200; ++step) {
+    if (rng() % 3 == 0) {
+      std::vector<SceneOperation> ops;
+      std::vector<bool> used(12, false);
+      const int count = 1 + static_cast<int>(rng() % 4);
+      for (int i = 0; i < count; ++i) {
+        const ObjectId id = rng() % 12;
+        if (used[id]) continue;
+        used[id] = true;
+        if (rng() % 4 == 0) {
+          ops.push_back(removeOp(id));
+        } else {
+          const float size = 0.1f + static_cast<float>(rng() % 5);
+          ops.push_back(addOp(id, RepresentationKind::kMesh, quadMesh(0, 0, size, size, 0),
+                              rng() % 2 ? solidImage(8, 8, 9, 9, 9) : nullptr));
+        }
+      }
+      ASSERT_TRUE(scene.enqueue(batchOf(++plan, ops)).ok());
+    }
+    uploadFrame(scene, 1 + rng() % 1500);
+    for (std::uint64_t p : scene.commitReady().plans) applied.push_back(p);
+    std::size_t sum = 0;
+    for (const auto& [id, object] : scene.objects()) sum += object.triangleCount;
+    ASSERT_EQ(scene.polygons(), sum);
+  }
+  while (scene.pendingBatches() > 0) {
+    uploadFrame(scene, 1 << 20);
+    for (std::uint64_t p : scene.commitReady().plans) applied.push_back(p);
+  }
+  ASSERT_EQ(applied.size(), plan);
+  for (std::size_t i = 0; i < applied.size(); ++i) EXPECT_EQ(applied[i], i + 1);
+}
+
+}  // namespace
+}  // namespace thinlod::frontend
