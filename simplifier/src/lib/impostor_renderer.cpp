@@ -88,8 +88,11 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
     THINLOD_RETURN_IF_ERROR(part.mesh->validate(name));
     triangles += part.mesh->triangleCount();
     // Only referenced vertices frame the texture: stray points would waste texels.
-    for (std::uint32_t index : part.mesh->indices) {
-      pointScratch_.push_back(glm::vec3(part.model * glm::vec4(part.mesh->positions[index], 1.0f)));
+    referencedScratch_.assign(part.mesh->vertexCount(), 0);
+    for (std::uint32_t index : part.mesh->indices) referencedScratch_[index] = 1;
+    for (std::size_t v = 0; v < part.mesh->vertexCount(); ++v) {
+      if (referencedScratch_[v] == 0) continue;
+      pointScratch_.push_back(glm::vec3(part.model * glm::vec4(part.mesh->positions[v], 1.0f)));
     }
   }
   if (triangles == 0) return Status(ErrorCode::kInvalidArgument, "impostor: no triangles");

@@ -193,6 +193,7 @@ class ImpostorRenderer {
   ImpostorTimings timings_;
   std::vector<float> depthScratch_;
   std::vector<glm::vec3> pointScratch_;
+  std::vector<unsigned char> referencedScratch_;
 };
 
 }  // namespace thinlod::simplifier

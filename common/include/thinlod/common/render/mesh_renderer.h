@@ -16,7 +16,8 @@
 //   call, put their textures in layers of one array texture and merge their
 //   triangles with MeshBatch (world space, per-vertex layer) into one mesh.
 // - Handles are plain ids; a deleted or unknown handle is kNotFound at draw
-//   time. Handle 0 means "none" (e.g. an untextured material).
+//   time. Handle 0 means "none" (e.g. an untextured material). deleteMesh /
+//   deleteTexture do nothing unless the context is current.
 // - Errors: invalid input is kInvalidArgument; GL errors are kInternal, GL
 //   out-of-memory is kResourceExhausted; the message names the GL call.
 #pragma once
