@@ -50,7 +50,10 @@ class AccuracyCurve {
  public:
   AccuracyCurve() = default;
 
-  // Validates the invariants above; the error names the offending triple.
+  // Validates the invariants above; the error (kInvalidArgument) names the
+  // offending triple/segment. Decreases or negative values within a few ulps
+  // of the caller's own rounding (R + K A) are repaired, not rejected.
+  // An empty list gives the empty curve.
   static Result<AccuracyCurve> fromTriples(const std::vector<CurveTriple>& triples,
                                            double maxAccuracy);
   static Result<AccuracyCurve> fromSegments(std::vector<CurveSegment> segments, double maxAccuracy);
