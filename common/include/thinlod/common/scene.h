@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/conic_range.h"
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/primitives.h"
 #include "thinlod/common/status.h"
@@ -83,18 +84,6 @@ struct Geometry {
   std::vector<std::string> loadWarnings;    // kMeshFile: from the mesh loader
 };
 
-// The fields of the paper's ConicRange node (Figure 8b), as parsed. The
-// region: distance from `center` in [minDistance, maxDistance] and angle to
-// `direction` (unit) at most `alpha` (pi = no direction limit). The default
-// is all of space (Figure 10 uses `ConicRange {}` for "no restriction").
-struct ConicRangeFields {
-  glm::vec3 center{0.0f};
-  float minDistance = 0.0f;
-  float maxDistance = std::numeric_limits<float>::infinity();
-  glm::vec3 direction{0.0f, 0.0f, 1.0f};
-  float alpha = 3.14159265f;
-};
-
 struct Node;
 using NodePtr = std::shared_ptr<Node>;
 
@@ -103,8 +92,8 @@ struct Node {
 
   NodeKind kind;
   std::uint32_t id = 0;
-  std::string defName;  // empty unless DEF'd
-  SourceLocation location;
+  std::string defName;            // empty unless DEF'd
+  SourceLocation sourceLocation;  // where the node starts in the scene file
   // Group, Transform, LOD (the levels, in order), imposters, SimplifiedPolygon.
   std::vector<NodePtr> children;
   // A curve supplied from outside (the simplifier's measured curve for a
@@ -157,10 +146,11 @@ struct LodNode : Node {
   static constexpr NodeKind kKind = NodeKind::kLod;
   LodNode() : Node(kKind) {}
   glm::vec3 center{0.0f};
-  // One per level (children.size()), in the LOD's content frame. A plain
+  // One per level (children.size()), in the LOD's content frame; a level
+  // without a range is everywhere (ConicRange {} in Figure 10). A plain
   // VRML `range [d1 d2 ...]` is converted: level i gets distances
-  // [d_{i-1}, d_i) around `center`, full angle.
-  std::vector<ConicRangeFields> ranges;
+  // [d_{i-1}, d_i] around `center`, full angle (0 and infinity at the ends).
+  std::vector<ConicRange> ranges;
 };
 
 // SimpleImposter, MeshedImposter, SimplifiedPolygon: "replace their children

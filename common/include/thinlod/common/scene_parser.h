@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,6 +38,8 @@ struct ParseLimits {
   std::size_t maxValuesPerField = 16'000'000;  // numbers in one MF field
   std::size_t maxTotalValues = 64'000'000;     // numbers in the whole file
   std::size_t maxStringLength = 4096;          // also names
+  // Node instances after DEF/USE expansion (what flattenInstances returns).
+  std::uint64_t maxInstances = 1'000'000;
 };
 
 Result<Scene> parseScene(std::string_view text, const std::string& sourceName,

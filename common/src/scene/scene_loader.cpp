@@ -1,0 +1,127 @@
+// File edge of the scene module: reads the scene file, then the mesh files
+// its Inline urls name.
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "thinlod/common/scene_parser.h"
+
+namespace thinlod::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Urls name files below a search directory: no scheme, no absolute path,
+// no "..".
+Status checkUrl(const std::string& url, const std::string& where) {
+  if (url.empty()) return Status(ErrorCode::kInvalidArgument, where + ": empty url");
+  if (url.find("://") != std::string::npos) {
+    return Status(ErrorCode::kUnsupported, where + ": url '" + url + "' has a scheme; only " +
+                                               "relative file names are supported");
+  }
+  const fs::path p(url);
+  if (p.is_absolute() || p.has_root_name()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  where + ": url '" + url + "' is absolute; use a relative name and a search path");
+  }
+  for (const fs::path& part : p) {
+    if (part == "..") {
+      return Status(ErrorCode::kInvalidArgument, where + ": url '" + url + "' contains '..'");
+    }
+  }
+  return Status();
+}
+
+void forEachShape(const Node& node, std::map<const Node*, bool>& seen,
+                  std::vector<ShapeNode*>& out) {
+  if (!seen.emplace(&node, true).second) return;
+  if (node.kind == NodeKind::kShape) out.push_back(const_cast<ShapeNode*>(node.as<ShapeNode>()));
+  for (const NodePtr& c : node.children) forEachShape(*c, seen, out);
+}
+
+}  // namespace
+
+Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
+                     const SceneLoadOptions& options) {
+  std::vector<std::string> directories = options.meshSearchPaths;
+  directories.push_back(sceneDirectory.empty() ? std::string(".") : sceneDirectory);
+  std::map<const Node*, bool> seen;
+  std::vector<ShapeNode*> shapes;
+  for (const NodePtr& root : scene.roots) forEachShape(*root, seen, shapes);
+
+  std::map<std::string, std::shared_ptr<const IndexedMesh>> loaded;  // by resolved path
+  std::map<std::string, std::vector<std::string>> warningsOf;
+  for (ShapeNode* shape : shapes) {
+    Geometry& g = shape->geometry;
+    if (g.kind != GeometryKind::kMeshFile || g.mesh) continue;
+    const std::string where = scene.sourceName + ":" + std::to_string(shape->sourceLocation.line) + ":" +
+                              std::to_string(shape->sourceLocation.column);
+    std::vector<std::string> tried;
+    for (const std::string& url : g.urls) {
+      THINLOD_RETURN_IF_ERROR(checkUrl(url, where));
+      if (!isSupportedMeshExtension(url)) {
+        return Status(ErrorCode::kUnsupported,
+                      where + ": url '" + url + "' is not a mesh file (obj, ply, off, stl)");
+      }
+      for (const std::string& dir : directories) {
+        const std::string candidate = (fs::path(dir) / url).lexically_normal().string();
+        std::error_code ec;
+        if (!fs::is_regular_file(candidate, ec)) {
+          tried.push_back(candidate);
+          continue;
+        }
+        auto cached = loaded.find(candidate);
+        if (cached == loaded.end()) {
+          Result<LoadedMesh> mesh = loadMeshFile(candidate, options.meshOptions);
+          if (!mesh.ok()) {
+            return Status(mesh.status().code(), where + ": " + mesh.status().message());
+          }
+          for (const std::string& w : mesh->warnings) scene.warnings.push_back(w);
+          warningsOf[candidate] = mesh->warnings;
+          cached =
+              loaded.emplace(candidate, std::make_shared<const IndexedMesh>(std::move(mesh->mesh)))
+                  .first;
+        }
+        g.mesh = cached->second;
+        g.resolvedPath = candidate;
+        g.loadWarnings = warningsOf[candidate];
+        break;
+      }
+      if (g.mesh) break;
+    }
+    if (!g.mesh) {
+      std::string list;
+      for (const std::string& t : tried) list += (list.empty() ? "" : ", ") + t;
+      return Status(ErrorCode::kNotFound, where + ": mesh not found (tried " + list + ")");
+    }
+  }
+  return Status();
+}
+
+Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& options) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status(ErrorCode::kNotFound, path + ": no such file");
+  if (!fs::is_regular_file(path, ec)) {
+    return Status(ErrorCode::kIoError, path + ": not a regular file");
+  }
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
+  if (size > options.limits.maxBytes) {
+    return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
+                                                     " bytes exceed the limit of " +
+                                                     std::to_string(options.limits.maxBytes));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size) {
+    return Status(ErrorCode::kIoError, path + ": short read");
+  }
+  Result<Scene> scene = parseScene(text, path, options.limits);
+  if (!scene.ok()) return scene.status();
+  THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  return scene;
+}
+
+}  // namespace thinlod::scene
