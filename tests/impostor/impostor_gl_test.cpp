@@ -66,6 +66,16 @@ TEST_F(ImpostorTest, SphereImpostorHasOpaqueObjectAndTransparentBackground) {
   for (auto [x, y] : {std::pair{0, 0}, {255, 0}, {0, 255}, {255, 255}, {10, 10}}) {
     EXPECT_EQ(t.at(x, y)[3], 0) << x << "," << y;
   }
+  // Transparent texels next to the sphere carry its colour (no dark fringe when filtered).
+  int bled = 0;
+  for (int y = 1; y < 255; ++y) {
+    for (int x = 1; x < 255; ++x) {
+      if (t.at(x, y)[3] != 0 || t.at(x + 1, y)[3] == 0) continue;
+      EXPECT_GT(t.at(x, y)[0], 0) << x << "," << y;
+      ++bled;
+    }
+  }
+  EXPECT_GT(bled, 50);
   // The one-pixel padding keeps the border rows and columns empty.
   for (int i = 0; i < 256; ++i) {
     EXPECT_EQ(t.at(i, 0)[3], 0);

@@ -38,6 +38,45 @@ double coverageOf(const render::RgbaImage& image) {
 
 }  // namespace
 
+void bleedColorIntoTransparent(render::RgbaImage& image, int pixels) {
+  if (image.empty() || !image.consistent()) return;
+  const int w = image.width;
+  const int h = image.height;
+  // filled: texel has a colour to spread (covered, or filled in an earlier ring).
+  std::vector<unsigned char> filled(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < filled.size(); ++i) filled[i] = image.pixels[i * 4 + 3] != 0;
+  std::vector<std::size_t> ring;
+  for (int pass = 0; pass < pixels; ++pass) {
+    ring.clear();
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        if (filled[i]) continue;
+        int sum[3] = {0, 0, 0};
+        int count = 0;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx;
+            const int ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            const std::size_t j = static_cast<std::size_t>(ny) * w + nx;
+            if (!filled[j]) continue;
+            for (int c = 0; c < 3; ++c) sum[c] += image.pixels[j * 4 + c];
+            ++count;
+          }
+        }
+        if (count == 0) continue;
+        for (int c = 0; c < 3; ++c) {
+          image.pixels[i * 4 + c] = static_cast<std::uint8_t>((sum[c] + count / 2) / count);
+        }
+        ring.push_back(i);
+      }
+    }
+    if (ring.empty()) break;
+    for (std::size_t i : ring) filled[i] = 1;  // after the pass: rings grow one pixel at a time
+  }
+}
+
 ImpostorRenderer::ImpostorRenderer(render::OffscreenContext& context) : context_(&context) {}
 
 ImpostorRenderer::~ImpostorRenderer() {
@@ -70,6 +109,9 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
   if (!context_->isCurrent()) {
     return Status(ErrorCode::kUnavailable,
                   "impostor: the GL context is not current on this thread");
+  }
+  if (options.bleedPixels < 0 || options.bleedPixels > 64) {
+    return Status(ErrorCode::kInvalidArgument, "impostor: bleedPixels outside 0..64");
   }
   if (!(options.maxAngularError > 0.0) || !std::isfinite(options.maxAngularError)) {
     return Status(ErrorCode::kInvalidArgument,
@@ -137,6 +179,7 @@ Result<SimpleImpostor> ImpostorRenderer::renderSimple(const ImpostorScene& scene
   THINLOD_RETURN_IF_ERROR(renderer_->beginFrame(*target_, glm::vec4(0.0f)));
   THINLOD_RETURN_IF_ERROR(renderer_->draw(items, impostor.framing.camera, scene.lighting));
   THINLOD_RETURN_IF_ERROR(target_->readColor(impostor.texture));
+  bleedColorIntoTransparent(impostor.texture, options.bleedPixels);
   timings_.renderMs = millisecondsSince(renderStart);
 
   // Simple impostor: every point is drawn on the quad plane, so the depth
@@ -170,6 +213,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   THINLOD_RETURN_IF_ERROR(renderer_->draw(items, f.camera, scene.lighting));
   THINLOD_RETURN_IF_ERROR(target_->readColor(impostor.texture));
   THINLOD_RETURN_IF_ERROR(target_->readDepth(depthScratch_));
+  bleedColorIntoTransparent(impostor.texture, options.bleedPixels);
   timings_.renderMs = millisecondsSince(renderStart);
 
   const auto meshStart = Clock::now();

@@ -12,8 +12,9 @@
 //   bounding-sphere centre perpendicular to the capture direction, and seen
 //   from the viewpoint it covers exactly what the texture shows. The texture
 //   is square; texels may be non-square when the quad is not.
-// - Texture rows are top-down (RgbaImage); quad/depth-mesh uvs use OpenGL's
-//   convention, v = 0 at the image bottom, as MeshRenderer expects.
+// - Texture rows are top-down (RgbaImage), non-premultiplied, alpha 0 where
+//   there is no object; quad/depth-mesh uvs use OpenGL's convention, v = 0 at
+//   the image bottom, as MeshRenderer expects.
 // - Validity: the cone of viewer positions around the capture direction in
 //   which the angular error bound stays <= maxAngularError (radians); see
 //   impostor_validity.cpp for the derivation. The capture viewpoint is inside.
@@ -59,6 +60,10 @@ struct ImpostorOptions {
   float paddingPixels = 1.0f;      // empty border so filtering never clips the object
   glm::vec3 up{0.0f, 1.0f, 0.0f};  // preferred image up; replaced when parallel to the view
   double maxAngularError = 1e-3;   // radians; the bound the validity range guarantees
+  // Transparent texels within this many pixels of the object take the colour
+  // of their covered neighbours (alpha stays 0), so bilinear filtering at the
+  // silhouette does not darken it towards the black background.
+  int bleedPixels = 2;
 };
 
 struct MeshedImpostorOptions : ImpostorOptions {
@@ -136,6 +141,10 @@ struct DepthMeshStats {
   std::size_t splitEdges = 0;  // grid edges dropped at a depth jump
   double maxDepthJump = 0.0;   // metres along the view, largest dropped edge between covered nodes
 };
+
+// Gives transparent texels near covered ones the mean colour of their covered
+// 8-neighbours, `pixels` rings deep; alpha is unchanged.
+void bleedColorIntoTransparent(render::RgbaImage& image, int pixels);
 
 // Builds the depth mesh from a top-down window-depth buffer (1 = background)
 // rendered with `framing.camera`. Vertices in object space with uvs into the
