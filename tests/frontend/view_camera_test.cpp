@@ -52,6 +52,22 @@ TEST(ViewCamera, VerticalFovSpansTheFrameHeight) {
   EXPECT_NEAR(render::projectToPixel(*camera, glm::vec3(0, y, -10), 640, 480).y, 0.0f, 1e-2f);
 }
 
+TEST(ViewCamera, TracePoseMatchesItsViewMatrix) {
+  Pose pose;
+  pose.position = glm::vec3(2, 1, 6);
+  pose.orientation = lookAtOrientation(pose.position, glm::vec3(0, 0.5f, 0));
+  pose.fovYDegrees = 50.0f;
+  auto camera = cameraFromPose(pose, 640, 480);
+  ASSERT_TRUE(camera.ok());
+  const glm::mat4 expected = viewMatrix(pose);
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(camera->view[c][r], expected[c][r], 1e-5f);
+  }
+  const glm::vec3 target = render::projectToPixel(*camera, glm::vec3(0, 0.5f, 0), 640, 480);
+  EXPECT_NEAR(target.x, 320.0f, 1e-2f);
+  EXPECT_NEAR(target.y, 240.0f, 1e-2f);
+}
+
 TEST(ViewCamera, RejectsBadInputs) {
   const glm::quat id(1, 0, 0, 0);
   const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -37,4 +37,9 @@ Result<render::Camera> cameraFromPose(const glm::vec3& position, const glm::quat
   return camera;
 }
 
+Result<render::Camera> cameraFromPose(const Pose& pose, int width, int height,
+                                      const ViewPlanes& planes) {
+  return cameraFromPose(pose.position, pose.orientation, pose.fovYRadians(), width, height, planes);
+}
+
 }  // namespace thinlod::frontend

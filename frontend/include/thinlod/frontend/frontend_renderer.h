@@ -44,8 +44,9 @@ namespace thinlod::frontend {
 struct FrontendRendererOptions {
   int width = 640;
   int height = 480;
-  std::size_t uploadBytesPerFrame = 512 * 1024;  // ~2 impostors of 256x256 per frame
-  int layerSize = 256;                           // edge of one texture layer, pixels
+  // Two 256x256 impostors (2 x 262,328 bytes with their quads) per frame.
+  std::size_t uploadBytesPerFrame = 600 * 1024;
+  int layerSize = 256;      // edge of one texture layer, pixels
   int layersPerPage = 128;  // layers per array texture; more pages are made on demand
   glm::vec4 clearColor{0.0f, 0.0f, 0.0f, 1.0f};
   render::AlphaMode impostorAlpha = render::AlphaMode::kMask;  // kMask or kBlend

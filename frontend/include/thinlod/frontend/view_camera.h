@@ -7,6 +7,7 @@
 //   +y up, as render::Camera expects. fovY: vertical field of view, radians,
 //   in (0, pi). width/height: the frame in pixels (aspect = width / height).
 // - nearPlane/farPlane: metres, 0 < near < far.
+// - The Pose overload takes a trace pose (common/trace.h: fov in degrees).
 // - Errors: any non-finite or out-of-range value is kInvalidArgument naming it.
 #pragma once
 
@@ -15,6 +16,7 @@
 
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/status.h"
+#include "thinlod/common/trace.h"
 
 namespace thinlod::frontend {
 
@@ -25,6 +27,8 @@ struct ViewPlanes {
 
 Result<render::Camera> cameraFromPose(const glm::vec3& position, const glm::quat& orientation,
                                       float fovY, int width, int height,
+                                      const ViewPlanes& planes = {});
+Result<render::Camera> cameraFromPose(const Pose& pose, int width, int height,
                                       const ViewPlanes& planes = {});
 
 }  // namespace thinlod::frontend
