@@ -76,8 +76,8 @@ std::string lowerExtension(const std::string& pathOrExtension) {
   const std::size_t slash = ext.find_last_of("/\\");
   if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) {
     ext = ext.substr(dot + 1);
-  } else if (pathOrExtension.find('/') != std::string::npos) {
-    ext.clear();
+  } else {
+    ext.clear();  // no extension
   }
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

@@ -17,7 +17,9 @@
 //   a human-readable line in `warnings`.
 // - Normals: unit length; taken from the file when present (normalised; all
 //   recomputed if one is zero), else computed (area-weighted) unless options
-//   say otherwise. Colours and uvs only when the file has them.
+//   say otherwise. Colours and uvs only when the file has them; uvs are per
+//   vertex, so an OBJ corner uv that differs from another corner's at the
+//   same vertex (a seam) is lost (OpenMesh keeps the last one).
 // - Thread-safe: calls are serialised internally (OpenMesh's reader
 //   singletons and error stream are process-global).
 #pragma once
