@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -242,6 +243,15 @@ TEST(Primitives, ChooseTessellationHitsBudgetWithinGranularity) {
                                   : (s.kind == PrimitiveKind::kCylinder ? 4 : 2);
       EXPECT_GT(got, budget - granularity) << primitiveKindName(s.kind) << " budget " << budget;
     }
+  }
+}
+
+TEST(Primitives, HugeBudgetsAreCapped) {
+  for (const PrimitiveShape& s :
+       {PrimitiveShape::sphere(1.0f), PrimitiveShape::cylinder(1.0f, 1.0f)}) {
+    const TessellationParams p = chooseTessellation(s, std::numeric_limits<int>::max());
+    EXPECT_LE(tessellationTriangles(s, p), kMaxPrimitiveTriangles);
+    EXPECT_GT(tessellationTriangles(s, p), kMaxPrimitiveTriangles / 2);
   }
 }
 

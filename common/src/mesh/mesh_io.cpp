@@ -1,6 +1,6 @@
 // OpenMesh wants MeshIO.hh included before any mesh kernel header.
+// clang-format off
 #include <OpenMesh/Core/IO/MeshIO.hh>
-// clang-format off: keep the include order above.
 #include "thinlod/common/mesh_io.h"
 // clang-format on
 

@@ -487,6 +487,7 @@ double tessellationAccuracy(const PrimitiveShape& s, const TessellationParams& p
 }
 
 TessellationParams chooseTessellation(const PrimitiveShape& s, int maxTriangles) {
+  maxTriangles = std::min(maxTriangles, kMaxPrimitiveTriangles);
   TessellationParams best;
   if (s.kind == PrimitiveKind::kBox) return best;
   if (s.kind == PrimitiveKind::kSphere) {
@@ -513,6 +514,7 @@ TessellationParams chooseTessellation(const PrimitiveShape& s, int maxTriangles)
 
 Result<TessellationParams> tessellationForAccuracy(const PrimitiveShape& s, double relativeAccuracy,
                                                    int maxTriangles) {
+  maxTriangles = std::min(maxTriangles, kMaxPrimitiveTriangles);
   const double diameter = primitiveDiameter(s);
   if (!(relativeAccuracy > 0.0)) return TessellationParams{};  // anything will do
   auto tooMany = [&]() {
@@ -572,6 +574,10 @@ Result<TessellationParams> tessellationForAccuracy(const PrimitiveShape& s, doub
 
 IndexedMesh tessellate(const PrimitiveShape& s, const TessellationParams& p) {
   assert(validatePrimitive(s).ok() && "tessellate: invalid primitive");
+  assert(p.segments >= 3 && p.rings >= 2 && p.segments <= kMaxSegments &&
+         (s.kind != PrimitiveKind::kSphere ||
+          static_cast<long long>(p.segments) * (p.rings - 1) * 2 <= kMaxPrimitiveTriangles) &&
+         "tessellate: params out of range");
   switch (s.kind) {
     case PrimitiveKind::kBox:
       return buildBox(s.boxSize);
@@ -588,6 +594,10 @@ IndexedMesh tessellate(const PrimitiveShape& s, const TessellationParams& p) {
 Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
                                              const PrimitiveCurveOptions& options) {
   THINLOD_RETURN_IF_ERROR(validatePrimitive(s));
+  if (options.maxTriangles > kMaxPrimitiveTriangles) {
+    return Status(ErrorCode::kResourceExhausted,
+                  "primitive curve: maxTriangles above " + std::to_string(kMaxPrimitiveTriangles));
+  }
   if (!(options.stepRatio > 1.0) || !std::isfinite(options.stepRatio)) {
     return Status(ErrorCode::kInvalidArgument, "primitive curve: stepRatio must be > 1");
   }

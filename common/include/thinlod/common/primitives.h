@@ -35,6 +35,9 @@ namespace thinlod {
 
 // Distortion 1e-6 of the diameter: below float precision of positions.
 inline constexpr double kExactRelativeAccuracy = 1e6;
+// Budgets above this are treated as this (bounds work and memory for
+// budgets that come from untrusted input).
+inline constexpr int kMaxPrimitiveTriangles = 1 << 22;
 
 enum class PrimitiveKind : std::uint8_t { kSphere, kCylinder, kBox, kCone };
 const char* primitiveKindName(PrimitiveKind kind);
@@ -71,14 +74,15 @@ double tessellationError(const PrimitiveShape& shape, const TessellationParams& 
 double tessellationAccuracy(const PrimitiveShape& shape, const TessellationParams& params);
 
 // Smallest-error tessellation with at most maxTriangles triangles (the
-// coarsest one when maxTriangles is below it). The sphere keeps
-// rings <= segments <= 4 rings.
+// coarsest one when maxTriangles is below it; kMaxPrimitiveTriangles when
+// above). The sphere keeps rings <= segments <= 4 rings.
 TessellationParams chooseTessellation(const PrimitiveShape& shape, int maxTriangles);
 // Cheapest tessellation whose accuracy is >= relativeAccuracy; an error
 // (kResourceExhausted) when that needs more than maxTriangles.
 Result<TessellationParams> tessellationForAccuracy(const PrimitiveShape& shape,
                                                    double relativeAccuracy, int maxTriangles);
 
+// Precondition (asserted): a valid shape and at most kMaxPrimitiveTriangles.
 IndexedMesh tessellate(const PrimitiveShape& shape, const TessellationParams& params);
 
 struct PrimitiveCurveOptions {
