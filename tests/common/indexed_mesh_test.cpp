@@ -1,9 +1,9 @@
 #include "thinlod/common/indexed_mesh.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 namespace thinlod {
 namespace {

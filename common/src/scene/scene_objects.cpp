@@ -17,8 +17,8 @@ Result<std::shared_ptr<const IndexedMesh>> shapeMesh(const ShapeNode& shape,
     case GeometryKind::kIndexedFaceSet:
       if (!geometry.mesh) {
         const std::string url = geometry.urls.empty() ? std::string("?") : geometry.urls.front();
-        return Status(ErrorCode::kNotFound, "Shape " + std::to_string(shape.id) + ": mesh '" +
-                                                url + "' is not loaded");
+        return Status(ErrorCode::kNotFound,
+                      "Shape " + std::to_string(shape.id) + ": mesh '" + url + "' is not loaded");
       }
       return geometry.mesh;
     case GeometryKind::kPrimitive: {

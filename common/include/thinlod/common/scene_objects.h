@@ -18,10 +18,9 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/mat4x4.hpp>
 #include <memory>
 #include <vector>
-
-#include <glm/mat4x4.hpp>
 
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/scene.h"
