@@ -7,7 +7,8 @@
 //   error names why each back-end failed. kEgl / kOsMesa try only that one.
 // - width/height size the context's own default surface (pbuffer / OSMesa
 //   buffer); real drawing goes to RenderTarget FBOs of any size up to
-//   maxRenderTargetSize(). Both must be in [1, 16384]; else kInvalidArgument.
+//   maxRenderTargetSize(). Each edge in [1, 16384] and at most 2^26 pixels;
+//   else kInvalidArgument naming the size. Unavailable back-ends: kUnavailable.
 // - Every GL entry point is loaded through the back-end's own
 //   getProcAddress into a table owned by the context, so EGL and OSMesa
 //   contexts may coexist in one process (libOSMesa and libGL both export gl*).
@@ -17,7 +18,8 @@
 //   thread. Objects created from a context (RenderTarget, MeshRenderer) must be
 //   used and destroyed while that context is current on the calling thread,
 //   and must be destroyed before the context.
-// - Destroying the context releases it and frees all its GL objects.
+// - Destroying the context releases it and frees all its GL objects. Drawing
+//   uses only the context's own table: never call gl* directly on it.
 #pragma once
 
 #include <memory>
