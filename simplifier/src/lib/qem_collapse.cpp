@@ -12,6 +12,12 @@ namespace thinlod::simplifier::qem {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// A collapse may turn a triangle's normal by at most acos(0.1) ~ 84 degrees
+// (bound on the squared cosine); beyond that the triangle counts as flipped.
+constexpr double kMinFlipCos2 = 0.01;
+// Weight of the fan term (see fanCost) relative to the quadric. 1 lowered
+// both the max and the mean surface error on the shared models.
+constexpr double kFanWeight = 1.0;
 
 // Corners and removal step in one 16-byte record: the adjacency walks read
 // both, one cache line instead of two.
@@ -21,6 +27,14 @@ struct Triangle {
 
   bool has(std::uint32_t x) const { return v[0] == x || v[1] == x || v[2] == x; }
 };
+
+// Adjacency entries name a corner: triangle << 2 | k, where v[k] is the
+// owner of the list. Renaming u to w keeps k, so entries move between lists
+// unchanged, and the two other corners are found without searching.
+constexpr std::uint32_t kNextCorner[3] = {1, 2, 0};
+constexpr std::uint32_t kPrevCorner[3] = {2, 0, 1};
+inline std::uint32_t triangleOf(std::uint32_t entry) { return entry >> 2; }
+inline std::uint32_t cornerOf(std::uint32_t entry) { return entry & 3u; }
 
 struct Neighbor {
   std::uint32_t vertex;
@@ -61,33 +75,45 @@ class Collapser {
     removed_.assign(vertexCount, 0);
     kind_.assign(vertexCount, VertexKind::kUnknown);
     target_.assign(vertexCount, kNone);
+    exact_.assign(vertexCount, 0);
     mark_.assign(vertexCount, 0);
     buildAdjacency(vertexCount);
     buildQuadrics();
     heap_.reset(vertexCount);
   }
 
+  // Greedy by cost. Heap keys are estimates (cheapest quadric cost plus the
+  // fan term of that target, no legality check); the vertex at the top gets
+  // its exact key (all candidates, full cost, legal only) and is collapsed
+  // once an exact key is the smallest.
   CollapseRecord run() {
     for (std::uint32_t v = 0; v < position_.size(); ++v) {
-      const double key = chooseTarget(v, /*validate=*/false);
+      const double key = chooseTarget(v, /*exact=*/false);
       if (key < kInfinity) heap_.push(v, key);
     }
     while (!heap_.empty() && liveTriangles_ > options_.stopAtTriangles) {
       const std::uint32_t u = heap_.top();
-      const std::uint32_t w = target_[u];
-      const double key = heap_.topKey();
-      gather(u, neighborsU_);
-      if (!isValidCollapse(u, w)) {
-        // The optimistic choice was illegal: look for the cheapest legal one.
-        const double validKey = chooseTarget(u, /*validate=*/true);
-        if (validKey < kInfinity) {
-          heap_.update(u, validKey);
-        } else {
-          heap_.remove(u);
+      if (exact_[u]) {
+        // Changes nearby since the key was computed may have made the move
+        // illegal or dearer: re-check, collapse only at no more than the key.
+        const std::uint32_t w = target_[u];
+        const double key = heap_.topKey();
+        compact(u);
+        if (isValidCollapse(u, w)) {
+          const double cost = fullCost(u, w);
+          if (cost <= key) {
+            collapse(u, w, cost);
+          } else {
+            heap_.update(u, cost);
+          }
+          continue;
         }
-        continue;
       }
-      collapse(u, w, key);
+      // Replace the estimate by the exact key; collapse right away when it
+      // stays at the top (it was just validated).
+      const double key = chooseTarget(u, /*exact=*/true);
+      rekey(u, key);
+      if (key < kInfinity && heap_.top() == u) collapse(u, target_[u], key);
     }
     CollapseRecord record = std::move(record_);
     record.triangleRemovedAtStep.resize(triangle_.size());
@@ -109,33 +135,31 @@ class Collapser {
     pool_.reserve(triangle_.size() * 9);
     pool_.resize(triangle_.size() * 3);
     for (std::uint32_t t = 0; t < triangle_.size(); ++t) {
-      for (std::uint32_t v : triangle_[t].v) pool_[listStart_[v] + listSize_[v]++] = t;
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        const std::uint32_t v = triangle_[t].v[k];
+        pool_[listStart_[v] + listSize_[v]++] = t << 2 | k;
+      }
     }
     listStart_.resize(vertexCount);
   }
 
   void buildQuadrics() {
     quadric_.assign(position_.size(), Quadric());
-    areaWeight_.assign(position_.size(), 0.0);
     // Plane weights are area / mean area: area weighting resists uneven
     // sampling, the normalisation keeps costs in squared length units.
     double totalArea = 0.0;
     for (const Triangle& t : triangle_) totalArea += 0.5 * glm::length(areaNormal(t));
-    const double meanArea =
-        totalArea > 0.0 ? totalArea / static_cast<double>(triangle_.size()) : 1.0;
+    meanArea_ = totalArea > 0.0 ? totalArea / static_cast<double>(triangle_.size()) : 1.0;
     for (const Triangle& t : triangle_) {
       const glm::dvec3 n2 = areaNormal(t);
       const double length = glm::length(n2);
       if (!(length > 0.0)) continue;  // zero area: no plane
       const glm::dvec3 n = n2 / length;
-      const double weight = 0.5 * length / meanArea;
-      const Quadric q = Quadric::fromPlane(n, -glm::dot(n, position_[t.v[0]]), weight);
-      for (std::uint32_t v : t.v) {
-        quadric_[v] += q;
-        areaWeight_[v] += weight / 3.0;
-      }
+      const Quadric q =
+          Quadric::fromPlane(n, -glm::dot(n, position_[t.v[0]]), 0.5 * length / meanArea_);
+      for (std::uint32_t v : t.v) quadric_[v] += q;
     }
-    if (options_.preserveBoundaries) addBoundaryPlanes(meanArea);
+    if (options_.preserveBoundaries) addBoundaryPlanes();
     selfCost_.resize(position_.size());
     for (std::size_t v = 0; v < position_.size(); ++v)
       selfCost_[v] = quadric_[v].eval(position_[v]);
@@ -143,23 +167,35 @@ class Collapser {
 
   // Garland-Heckbert boundary constraint: a plane through each border edge,
   // perpendicular to its triangle, so that collapses keep the border in place.
-  void addBoundaryPlanes(double meanArea) {
+  // Every triangle edge is visited once, from its first corner's list.
+  void addBoundaryPlanes() {
     for (std::uint32_t v = 0; v < position_.size(); ++v) {
-      gather(v, neighborsU_);
-      for (const Neighbor& nb : neighborsU_) {
-        if (nb.triangles != 1 || nb.vertex < v) continue;  // each border edge once
-        const Triangle& t = triangle_[triangleOnEdge(v, nb.vertex)];
-        const glm::dvec3 edge = position_[nb.vertex] - position_[v];
+      for (std::uint32_t i = listStart_[v], end = i + listSize_[v]; i < end; ++i) {
+        const std::uint32_t entry = pool_[i];
+        const Triangle& t = triangle_[triangleOf(entry)];
+        const std::uint32_t next = t.v[kNextCorner[cornerOf(entry)]];
+        if (edgeTriangleCount(v, next) != 1) continue;  // each border edge once: from v to next
+        const glm::dvec3 edge = position_[next] - position_[v];
         glm::dvec3 n = glm::cross(edge, areaNormal(t));
         const double length = glm::length(n);
         if (!(length > 0.0)) continue;
         n /= length;
-        const double weight = options_.boundaryWeight * glm::dot(edge, edge) / meanArea;
+        const double weight = options_.boundaryWeight * glm::dot(edge, edge) / meanArea_;
         const Quadric q = Quadric::fromPlane(n, -glm::dot(n, position_[v]), weight);
         quadric_[v] += q;
-        quadric_[nb.vertex] += q;
+        quadric_[next] += q;
       }
     }
+  }
+
+  // Live triangles on edge ab.
+  std::uint32_t edgeTriangleCount(std::uint32_t a, std::uint32_t b) const {
+    std::uint32_t count = 0;
+    for (std::uint32_t i = listStart_[a], end = i + listSize_[a]; i < end; ++i) {
+      const Triangle& t = triangle_[triangleOf(pool_[i])];
+      count += t.removedAt == 0 && t.has(b) ? 1u : 0u;
+    }
+    return count;
   }
 
   glm::dvec3 areaNormal(const Triangle& t) const {
@@ -167,34 +203,40 @@ class Collapser {
     return glm::cross(position_[t.v[1]] - a, position_[t.v[2]] - a);
   }
 
-  // A live triangle with corners a and b (they are known to share one).
-  std::uint32_t triangleOnEdge(std::uint32_t a, std::uint32_t b) const {
-    std::uint32_t i = listStart_[a];
-    while (triangle_[pool_[i]].removedAt != 0 || !triangle_[pool_[i]].has(b)) ++i;
-    return pool_[i];
+  // Drops dead triangles from v's list (lazy deletion).
+  void compact(std::uint32_t v) {
+    const std::uint32_t start = listStart_[v];
+    std::uint32_t write = start;
+    for (std::uint32_t i = start, end = start + listSize_[v]; i < end; ++i) {
+      const std::uint32_t entry = pool_[i];
+      pool_[write] = entry;
+      write += triangle_[triangleOf(entry)].removedAt == 0 ? 1u : 0u;
+    }
+    listSize_[v] = write - start;
   }
 
-  // Drops dead triangles from v's list (lazy deletion) and lists v's
-  // neighbours with the number of live triangles on each edge.
+  // compact(v), then lists v's neighbours with the number of live triangles
+  // on each edge (quadratic in the valence: for classification and borders).
   void gather(std::uint32_t v, std::vector<Neighbor>& out) {
     out.clear();
     const std::uint32_t start = listStart_[v];
     std::uint32_t write = start;
-    for (std::uint32_t i = start, end = start + listSize_[v]; i < end; ++i) {
-      const std::uint32_t t = pool_[i];
-      const Triangle& tri = triangle_[t];
-      if (tri.removedAt != 0) continue;
-      pool_[write++] = t;
-      for (std::uint32_t x : tri.v) {
-        if (x == v) continue;
-        auto it =
-            std::find_if(out.begin(), out.end(), [x](const Neighbor& n) { return n.vertex == x; });
-        if (it == out.end()) {
-          out.push_back({x, 1});
-        } else {
-          ++it->triangles;
+    auto add = [&out](std::uint32_t x) {
+      for (Neighbor& n : out) {
+        if (n.vertex == x) {
+          ++n.triangles;
+          return;
         }
       }
+      out.push_back({x, 1});
+    };
+    for (std::uint32_t i = start, end = start + listSize_[v]; i < end; ++i) {
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      if (t.removedAt != 0) continue;
+      pool_[write++] = entry;
+      add(t.v[kNextCorner[cornerOf(entry)]]);
+      add(t.v[kPrevCorner[cornerOf(entry)]]);
     }
     listSize_[v] = write - start;
   }
@@ -206,16 +248,44 @@ class Collapser {
       const double diff = attributes_.values[u * d + k] - attributes_.values[w * d + k];
       sum += diff * diff;
     }
-    // Attributes are in [0, 1]: scale to squared length so that the weight
-    // is relative to geometric error over the region u stands for.
-    return options_.attributeWeight * diagonal_ * diagonal_ * areaWeight_[u] * sum;
+    // Attributes are in [0, 1]: scale to squared length (diagonal^2) over the
+    // area u's quadric stands for, so the weight is relative to geometry.
+    return options_.attributeWeight * diagonal_ * diagonal_ * quadric_[u].weight * sum;
   }
 
-  // (Q_u + Q_w)(p_w): w keeps its position.
-  double collapseCost(std::uint32_t u, std::uint32_t w) const {
+  // Quadric part of the cost of u -> w: (Q_u + Q_w)(p_w); w keeps its place.
+  double quadricCost(std::uint32_t u, std::uint32_t w) const {
     double cost = quadric_[u].eval(position_[w]) + selfCost_[w];
     if (attributes_.dimension > 0) cost += attributeCost(u, w);
     return std::max(cost, 0.0);  // rounding can make a zero cost slightly negative
+  }
+
+  // Area-weighted squared distances from p_u to the planes of the triangles
+  // u's fan becomes. This is what the quadric misses when u is the tip of a
+  // thin feature: all of u's planes pass near p_w, yet the tip is cut off.
+  // Skips dead triangles, so u's list need not be compacted.
+  double fanCost(std::uint32_t u, std::uint32_t w) const {
+    const glm::dvec3 pu = position_[u];
+    const glm::dvec3 pw = position_[w];
+    double fan = 0.0;
+    for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
+      const std::uint32_t b = t.v[kPrevCorner[cornerOf(entry)]];
+      if (t.removedAt != 0 || a == w || b == w) continue;
+      const glm::dvec3 after = glm::cross(position_[a] - pw, position_[b] - pw);
+      const double afterLength2 = glm::dot(after, after);
+      if (afterLength2 > 0.0) {
+        const double d = glm::dot(after, pu - pw);
+        fan += 0.5 * std::sqrt(afterLength2) * (d * d / afterLength2);
+      }
+    }
+    return kFanWeight * fan / meanArea_;
+  }
+
+  double fullCost(std::uint32_t u, std::uint32_t w) const {
+    return quadricCost(u, w) + fanCost(u, w);
   }
 
   static VertexKind classify(const std::vector<Neighbor>& neighbors) {
@@ -228,26 +298,45 @@ class Collapser {
     return borderEdges > 0 ? VertexKind::kBoundary : VertexKind::kInterior;
   }
 
-  // Picks target_[u] and returns its cost (infinity when u must stay).
-  // Leaves u's gather in neighborsU_. Without `validate` only the cheap rules
-  // apply; the top of the heap is validated before it is collapsed.
-  double chooseTarget(std::uint32_t u, bool validate) {
-    gather(u, neighborsU_);
+  // Picks target_[u] and returns its key (infinity when u must stay) and
+  // compacts u's list. Estimate (exact == false): the cheapest quadric cost
+  // among the moves u's kind allows, plus that move's fan term. Exact: the
+  // cheapest full cost among the legal moves.
+  double chooseTarget(std::uint32_t u, bool exact) {
     target_[u] = kNone;
-    if (kind_[u] == VertexKind::kUnknown) kind_[u] = classify(neighborsU_);
+    exact_[u] = exact;
+    if (kind_[u] == VertexKind::kUnknown) {
+      gather(u, neighborsU_);
+      kind_[u] = classify(neighborsU_);
+    }
     const VertexKind kind = kind_[u];
     if (kind == VertexKind::kLocked) return kInfinity;
     candidates_.clear();
-    for (const Neighbor& nb : neighborsU_) {
-      if (kind == VertexKind::kBoundary && nb.triangles != 1) continue;  // stay on the border
-      candidates_.push_back({collapseCost(u, nb.vertex), nb.vertex});
+    if (kind == VertexKind::kBoundary) {
+      gather(u, neighborsU_);
+      for (const Neighbor& nb : neighborsU_) {
+        // Stay on the border: only along border edges.
+        if (nb.triangles == 1) candidates_.push_back({quadricCost(u, nb.vertex), nb.vertex});
+      }
+    } else {
+      // Interior of an oriented manifold: every neighbour is the next
+      // corner of exactly one triangle of the fan, no deduplication needed.
+      compact(u);
+      for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
+        const std::uint32_t entry = pool_[i];
+        const std::uint32_t x = triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]];
+        candidates_.push_back({quadricCost(u, x), x});
+      }
     }
     if (candidates_.empty()) return kInfinity;
-    if (!validate) {
+    if (!exact) {
       const auto best = std::min_element(candidates_.begin(), candidates_.end());
       target_[u] = best->second;
-      return best->first;
+      return best->first + fanCost(u, best->second);
     }
+    // Full costs first (the fan term needs only u's list), then validate in
+    // cost order: usually the first candidate passes.
+    for (auto& [cost, w] : candidates_) cost += fanCost(u, w);
     std::sort(candidates_.begin(), candidates_.end());
     for (const auto& [cost, w] : candidates_) {
       if (isValidCollapse(u, w)) {
@@ -258,60 +347,72 @@ class Collapser {
     return kInfinity;
   }
 
-  // Topology and geometry checks for u -> w; neighborsU_ holds u's gather.
+  // Topology and geometry checks for u -> w; u's list is compacted.
   bool isValidCollapse(std::uint32_t u, std::uint32_t w) {
     if (w == kNone) return false;
     // Opposite corners of the triangles on edge uw (they die with it).
     opposite_.clear();
     const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
-      const Triangle& t = triangle_[pool_[i]];
-      if (!t.has(w)) continue;
-      for (std::uint32_t x : t.v) {
-        if (x != u && x != w) opposite_.push_back(x);
-      }
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
+      const std::uint32_t b = t.v[kPrevCorner[cornerOf(entry)]];
+      if (a == w) opposite_.push_back(b);
+      if (b == w) opposite_.push_back(a);
     }
     if (opposite_.empty()) return false;  // not an edge any more
     // Link condition: every common neighbour of u and w must be the opposite
     // corner of a triangle on uw; otherwise the collapse would glue two
-    // sheets (non-manifold edge) or close a hole.
-    gather(w, neighborsW_);
-    ++stamp_;
-    for (const Neighbor& nb : neighborsW_) mark_[nb.vertex] = stamp_;
-    for (const Neighbor& nb : neighborsU_) {
-      if (nb.vertex == w || mark_[nb.vertex] != stamp_) continue;
-      if (std::find(opposite_.begin(), opposite_.end(), nb.vertex) == opposite_.end()) return false;
-    }
-    const glm::dvec3& pu = position_[u];
-    const glm::dvec3& pw = position_[w];
+    // sheets (non-manifold edge) or close a hole. Common neighbours are the
+    // corners of w's triangles marked as u's neighbours.
+    const std::uint32_t neighborOfU = ++stamp_;
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
-      const Triangle& t = triangle_[pool_[i]];
-      if (t.has(w)) continue;
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      mark_[t.v[kNextCorner[cornerOf(entry)]]] = neighborOfU;
+      mark_[t.v[kPrevCorner[cornerOf(entry)]]] = neighborOfU;
+    }
+    const std::uint32_t common = ++stamp_;
+    for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      if (t.removedAt != 0) continue;
+      for (std::uint32_t x :
+           {t.v[kNextCorner[cornerOf(entry)]], t.v[kPrevCorner[cornerOf(entry)]]}) {
+        if (x == u || mark_[x] != neighborOfU) continue;
+        if (std::find(opposite_.begin(), opposite_.end(), x) == opposite_.end()) return false;
+        mark_[x] = common;
+      }
+    }
+    const glm::dvec3 pu = position_[u];
+    const glm::dvec3 pw = position_[w];
+    for (std::uint32_t i = uStart; i < uEnd; ++i) {
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
       // The triangle (u, a, b) becomes (w, a, b) in the same winding.
-      const int k = t.v[0] == u ? 0 : (t.v[1] == u ? 1 : 2);
-      const std::uint32_t a = t.v[(k + 1) % 3];
-      const std::uint32_t b = t.v[(k + 2) % 3];
+      const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
+      const std::uint32_t b = t.v[kPrevCorner[cornerOf(entry)]];
+      if (a == w || b == w) continue;
       // A triangle w already has on a and b would be duplicated (the last
       // collapse of a tetrahedron). Needs a and b both common neighbours.
-      if (mark_[a] == stamp_ && mark_[b] == stamp_ && hasTriangleOn(w, a, b)) return false;
-      if (options_.preventFlips) {
-        const glm::dvec3& pa = position_[a];
-        const glm::dvec3& pb = position_[b];
-        const glm::dvec3 before = glm::cross(pa - pu, pb - pu);
-        const glm::dvec3 after = glm::cross(pa - pw, pb - pw);
-        const double beforeLength2 = glm::dot(before, before);
-        if (beforeLength2 == 0.0) continue;  // a zero-area input triangle has no orientation
-        // Reject flips and near-flips: the normal may turn by at most ~84 deg.
-        const double d = glm::dot(before, after);
-        if (d <= 0.0 || d * d < 0.01 * beforeLength2 * glm::dot(after, after)) return false;
-      }
+      if (mark_[a] == common && mark_[b] == common && hasTriangleOn(w, a, b)) return false;
+      if (!options_.preventFlips) continue;
+      const glm::dvec3& pa = position_[a];
+      const glm::dvec3& pb = position_[b];
+      const glm::dvec3 before = glm::cross(pa - pu, pb - pu);
+      const double beforeLength2 = glm::dot(before, before);
+      if (beforeLength2 == 0.0) continue;  // a zero-area input triangle has no orientation
+      const glm::dvec3 after = glm::cross(pa - pw, pb - pw);
+      const double d = glm::dot(before, after);
+      if (d <= 0.0 || d * d < kMinFlipCos2 * beforeLength2 * glm::dot(after, after)) return false;
     }
     return true;
   }
 
   bool hasTriangleOn(std::uint32_t w, std::uint32_t a, std::uint32_t b) const {
     for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
-      const Triangle& t = triangle_[pool_[i]];
+      const Triangle& t = triangle_[triangleOf(pool_[i])];
       if (t.removedAt == 0 && t.has(a) && t.has(b)) return true;
     }
     return false;
@@ -319,7 +420,7 @@ class Collapser {
 
   bool hasLiveTriangle(std::uint32_t v) const {
     for (std::uint32_t i = listStart_[v], end = i + listSize_[v]; i < end; ++i) {
-      if (triangle_[pool_[i]].removedAt == 0) return true;
+      if (triangle_[triangleOf(pool_[i])].removedAt == 0) return true;
     }
     return false;
   }
@@ -331,19 +432,21 @@ class Collapser {
     heap_.remove(v);
   }
 
+  // u's list is compacted (every caller gathered u since the last change).
   void collapse(std::uint32_t u, std::uint32_t w, double cost) {
     const std::uint32_t step = static_cast<std::uint32_t>(record_.costOfStep.size()) + 1;
     // Kill the triangles on edge uw first so that w's new list skips them.
     opposite_.clear();
     const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
-      Triangle& t = triangle_[pool_[i]];
-      if (!t.has(w)) continue;
+      const std::uint32_t entry = pool_[i];
+      Triangle& t = triangle_[triangleOf(entry)];
+      const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
+      const std::uint32_t b = t.v[kPrevCorner[cornerOf(entry)]];
+      if (t.removedAt != 0 || (a != w && b != w)) continue;
       t.removedAt = step;
       --liveTriangles_;
-      for (std::uint32_t x : t.v) {
-        if (x != u && x != w) opposite_.push_back(x);
-      }
+      opposite_.push_back(a == w ? b : a);
     }
     // w's new list: its live triangles, then u's survivors renamed to w.
     // Written at the end of the pool (in place when w's list is already last).
@@ -352,32 +455,29 @@ class Collapser {
     if (wEnd == pool_.size()) {
       std::uint32_t write = wStart;
       for (std::uint32_t i = wStart; i < wEnd; ++i) {
-        if (triangle_[pool_[i]].removedAt == 0) pool_[write++] = pool_[i];
+        if (triangle_[triangleOf(pool_[i])].removedAt == 0) pool_[write++] = pool_[i];
       }
       pool_.resize(write);
       newStart = wStart;
     } else {
       newStart = static_cast<std::uint32_t>(pool_.size());
       for (std::uint32_t i = wStart; i < wEnd; ++i) {
-        const std::uint32_t t = pool_[i];
-        if (triangle_[t].removedAt == 0) pool_.push_back(t);
+        const std::uint32_t entry = pool_[i];
+        if (triangle_[triangleOf(entry)].removedAt == 0) pool_.push_back(entry);
       }
     }
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
-      const std::uint32_t t = pool_[i];
-      Triangle& tri = triangle_[t];
-      if (tri.removedAt != 0) continue;
-      for (std::uint32_t& x : tri.v) {
-        if (x == u) x = w;
-      }
-      pool_.push_back(t);
+      const std::uint32_t entry = pool_[i];
+      Triangle& t = triangle_[triangleOf(entry)];
+      if (t.removedAt != 0) continue;
+      t.v[cornerOf(entry)] = w;
+      pool_.push_back(entry);
     }
     listStart_[w] = newStart;
     listSize_[w] = static_cast<std::uint32_t>(pool_.size()) - newStart;
     listSize_[u] = 0;
 
     quadric_[w] += quadric_[u];
-    areaWeight_[w] += areaWeight_[u];
     selfCost_[w] = quadric_[w].eval(position_[w]);
     removeVertex(u, w);
     // Vertices left without triangles leave the mesh too (parent kNone).
@@ -391,26 +491,33 @@ class Collapser {
     if (!removed_[w]) rekeyAround(u, w);
   }
 
-  // After u -> w only w's quadric and fan changed. A neighbour x of w whose
-  // best target was neither u nor w keeps that target's cost; its only new
-  // option is x -> w. Everything else is recomputed.
+  // After u -> w only w's quadric and w's fan changed. Re-choose w and the
+  // vertices that targeted u or w. Any other neighbour x of w keeps its key
+  // (its target's quadric cost is unchanged; a changed fan term is caught
+  // when x reaches the top) unless its new option x -> w is cheaper.
   void rekeyAround(std::uint32_t u, std::uint32_t w) {
-    rekey(w, chooseTarget(w, /*validate=*/false));
-    std::swap(neighborsW_, neighborsU_);  // w's gather, kept while the neighbours are re-keyed
-    for (const Neighbor& nb : neighborsW_) {
-      const std::uint32_t x = nb.vertex;
-      const std::uint32_t old = target_[x];
-      if (old == u || old == w || old == kNone || kind_[x] == VertexKind::kUnknown ||
-          !heap_.contains(x)) {
-        rekey(x, chooseTarget(x, /*validate=*/false));
-        continue;
-      }
-      if (kind_[x] == VertexKind::kLocked) continue;
-      if (kind_[x] == VertexKind::kBoundary && nb.triangles != 1) continue;
-      const double cost = collapseCost(x, w);
-      if (cost < heap_.key(x)) {
-        target_[x] = w;
-        heap_.update(x, cost);
+    rekey(w, chooseTarget(w, /*exact=*/false));  // also compacts w's list
+    const std::uint32_t seen = ++stamp_;
+    for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
+      const std::uint32_t entry = pool_[i];
+      const Triangle& t = triangle_[triangleOf(entry)];
+      for (std::uint32_t x :
+           {t.v[kNextCorner[cornerOf(entry)]], t.v[kPrevCorner[cornerOf(entry)]]}) {
+        if (mark_[x] == seen) continue;
+        mark_[x] = seen;
+        if (target_[x] == u || target_[x] == w || target_[x] == kNone || !heap_.contains(x)) {
+          rekey(x, chooseTarget(x, /*exact=*/false));
+          continue;
+        }
+        if (kind_[x] == VertexKind::kLocked) continue;
+        if (kind_[x] == VertexKind::kBoundary && edgeTriangleCount(x, w) != 1) continue;
+        double cost = quadricCost(x, w);
+        if (cost < heap_.key(x)) cost += fanCost(x, w);
+        if (cost < heap_.key(x)) {
+          target_[x] = w;
+          exact_[x] = false;
+          heap_.update(x, cost);
+        }
       }
     }
   }
@@ -426,25 +533,25 @@ class Collapser {
   const BuildOptions& options_;
   const VertexAttributes& attributes_;
   double diagonal_ = 0.0;
+  double meanArea_ = 1.0;
   std::vector<glm::dvec3> position_;
   std::vector<Quadric> quadric_;
-  std::vector<double> selfCost_;    // quadric_[v].eval(position_[v])
-  std::vector<double> areaWeight_;  // area (in mean-area units) each vertex stands for
+  std::vector<double> selfCost_;  // quadric_[v].eval(position_[v])
   std::vector<Triangle> triangle_;
   std::size_t liveTriangles_ = 0;
-  // Vertex -> triangle lists: pool_[listStart_[v] .. + listSize_[v]], may
-  // hold dead triangles until the next gather of v.
+  // Vertex -> corner lists: pool_[listStart_[v] .. + listSize_[v]], may hold
+  // dead triangles until the next gather of v.
   std::vector<std::uint32_t> listStart_;
   std::vector<std::uint32_t> listSize_;
   std::vector<std::uint32_t> pool_;
   std::vector<std::uint8_t> removed_;
   std::vector<VertexKind> kind_;
   std::vector<std::uint32_t> target_;
+  std::vector<std::uint8_t> exact_;  // heap key is the exact, validated cost of target_
   IndexedMinHeap heap_;
   CollapseRecord record_;
   // Scratch, reused to avoid allocation per collapse.
   std::vector<Neighbor> neighborsU_;
-  std::vector<Neighbor> neighborsW_;
   std::vector<std::uint32_t> opposite_;
   std::vector<std::pair<double, std::uint32_t>> candidates_;
   std::vector<std::uint32_t> mark_;

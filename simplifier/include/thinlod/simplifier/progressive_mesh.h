@@ -8,7 +8,9 @@
 //   degenerate and duplicate triangles and unreferenced vertices (error when no
 //   triangle is left), then collapses down to stopAtTriangles (0: as far as the
 //   topology rules allow) and stores the collapse order.
-// - Collapses keep original vertex positions (vertex substitution), keep
+// - Greedy by cost: QEM (Garland-Heckbert, area-weighted planes) plus a fan
+//   term that keeps thin tips. Collapses keep original vertex positions
+//   (vertex substitution, see progressive_mesh.cpp for why), keep
 //   boundary vertices on the boundary, reject face flips (preventFlips), never
 //   create a non-manifold edge or close a hole, and never move a vertex that
 //   lies on a non-manifold edge of the input.
@@ -60,9 +62,10 @@ class ProgressiveMesh {
   IndexedMesh extract(std::size_t targetTriangles) const;
   void extractInto(std::size_t targetTriangles, IndexedMesh& out) const;
 
-  // Largest QEM collapse cost among the collapses that reach targetTriangles
-  // (monotone in n; 0 at full resolution). Units: squared mesh units, face
-  // planes weighted by area / mean face area.
+  // Largest collapse cost among the collapses that reach targetTriangles
+  // (monotone in n; 0 at full resolution). A cost is the QEM error plus the
+  // distance of the removed vertex to its new fan, both sums of squared
+  // distances weighted by area / mean triangle area: squared mesh units.
   double quadricErrorAt(std::size_t targetTriangles) const;
   std::size_t memoryBytes() const;  // heap bytes held by this object
 
