@@ -246,7 +246,9 @@ TEST(MeshIo, TruncatedPrefixesNeverCrash) {
     const std::string ext = std::string(file).substr(std::string(file).rfind('.') + 1);
     for (std::size_t n = 0; n < bytes.size(); ++n) {
       Result<LoadedMesh> r = loadMeshFromMemory(std::string_view(bytes).substr(0, n), ext, file);
-      if (r.ok()) EXPECT_TRUE(r->mesh.validate(file).ok());
+      if (r.ok()) {
+        EXPECT_TRUE(r->mesh.validate(file).ok());
+      }
     }
   }
 }
@@ -270,7 +272,9 @@ TEST(MeshIo, RandomCorruptionsNeverCrash) {
         bytes[next() % bytes.size()] = static_cast<char>(next() & 0xff);
       }
       Result<LoadedMesh> r = loadMeshFromMemory(bytes, ext, file);
-      if (r.ok()) EXPECT_TRUE(r->mesh.validate(file).ok());
+      if (r.ok()) {
+        EXPECT_TRUE(r->mesh.validate(file).ok());
+      }
     }
   }
 }

@@ -112,6 +112,12 @@ TEST(SceneParser, ThinlodHeaderWithKnownVersion) {
   EXPECT_EQ(r->header, "thinlod 1");
 }
 
+TEST(SceneParser, ByteOrderMarkIsSkipped) {
+  Result<Scene> r = parse("\xEF\xBB\xBF" + kHeader + "Group {}\n");
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->roots.size(), 1u);
+}
+
 TEST(SceneParser, UnknownVersionsAreRejected) {
   expectError("#thinlod scene 2\nGroup {}\n", ErrorCode::kVersionMismatch, 1, 16, "version 2");
   expectError("#VRML V1.0 ascii\n", ErrorCode::kVersionMismatch, 1, 1, "V1.0");
@@ -323,7 +329,9 @@ TEST(SceneParser, TruncatedPrefixesAndCorruptionsNeverCrash) {
   ASSERT_TRUE(parse(good).ok()) << parse(good).status().toString();
   for (std::size_t n = 0; n < good.size(); ++n) {
     Result<Scene> r = parse(good.substr(0, n));
-    if (!r.ok()) EXPECT_NE(r.status().message().find("t.wrl:"), std::string::npos);
+    if (!r.ok()) {
+      EXPECT_NE(r.status().message().find("t.wrl:"), std::string::npos);
+    }
   }
   std::uint32_t state = 7u;  // fixed seed
   auto next = [&state]() {
@@ -339,7 +347,9 @@ TEST(SceneParser, TruncatedPrefixesAndCorruptionsNeverCrash) {
       text[at] = alphabet[next() % (sizeof(alphabet) - 1)];
     }
     Result<Scene> r = parse(text);
-    if (!r.ok()) EXPECT_NE(r.status().message().find("t.wrl:"), std::string::npos);
+    if (!r.ok()) {
+      EXPECT_NE(r.status().message().find("t.wrl:"), std::string::npos);
+    }
   }
 }
 

@@ -88,6 +88,8 @@ class Parser {
                     source_ + ":1:1: file has " + std::to_string(text_.size()) + " bytes, limit " +
                         std::to_string(limits_.maxBytes));
     }
+    // A UTF-8 byte-order mark is not part of the header.
+    if (text_.substr(0, 3) == "\xEF\xBB\xBF") text_.remove_prefix(3);
     if (!parseHeader()) return status_;
     advance();
     while (tok_.kind != TokenKind::kEnd) {
