@@ -145,6 +145,8 @@ inline SchedulerConfig exactConfig() {
   c.mergeDistanceFactor = kInf;
   c.cacheDistanceMargin = 0.0;
   c.cacheAngleMargin = 0.0;
+  c.curveTolerance = 0.0;
+  c.maxParetoPasses = 100000;
   c.budgetReserveShare = 0.0;
   c.preferCurrentShare = 0.0;
   c.switchDelaySteps = 0;

@@ -49,6 +49,52 @@ AccuracyCurve restrictTo(const AccuracyCurve& curve, double maxAccuracy) {
   return AccuracyCurve::point(maxAccuracy, curve.resourcesFor(maxAccuracy));
 }
 
+// An upper bound of `curve` with fewer pieces: r <= r_s <= (1 + tolerance) r
+// everywhere on the domain. One pass: each piece is a line anchored at its
+// left end whose slope is the least that stays above every knot (values and
+// left limits; a line over a linear piece is above it iff above both ends)
+// and at most what keeps every covered knot within tolerance.
+AccuracyCurve simplifyUpper(const AccuracyCurve& curve, double tolerance) {
+  const std::vector<CurveSegment>& in = curve.segments();
+  if (tolerance <= 0.0 || in.size() <= 8) return curve;
+  std::vector<CurveSegment> out;
+  double anchor = in[0].start;
+  double base = in[0].value;
+  double slope = 0.0;     // least slope above every covered point
+  double allowed = kInf;  // largest slope within tolerance of them
+  auto cover = [&](double x, double r, double& needed, double& room) {
+    if (x <= anchor) return base <= (1.0 + tolerance) * r;
+    needed = std::max(needed, (r - base) / (x - anchor));
+    room = std::min(room, ((1.0 + tolerance) * r - base) / (x - anchor));
+    return needed <= room;
+  };
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const double end = i + 1 < in.size() ? in[i + 1].start : curve.maxAccuracy();
+    const double left = in[i].value + in[i].slope * (end - in[i].start);
+    double needed = slope;
+    double room = allowed;
+    if (cover(in[i].start, in[i].value, needed, room) && cover(end, left, needed, room)) {
+      slope = needed;
+      allowed = room;
+      continue;
+    }
+    // Close the piece before segment i; restart at its start, never below
+    // the line so far (monotone, still an upper bound).
+    out.push_back({anchor, base, slope});
+    base = std::max(in[i].value, base + slope * (in[i].start - anchor));
+    anchor = in[i].start;
+    needed = 0.0;
+    room = kInf;
+    cover(end, left, needed, room);
+    slope = std::max(0.0, needed);
+    allowed = room;
+  }
+  out.push_back({anchor, base, slope});
+  Result<AccuracyCurve> simplified =
+      AccuracyCurve::fromSegments(std::move(out), curve.maxAccuracy());
+  return simplified.ok() ? std::move(simplified).value() : curve;
+}
+
 const AccuracyCurve& curveOf(const RepresentationOption& option, Resource resource) {
   return resource == Resource::kTriangles ? option.relativeTriangles : option.relativeLinkBytes;
 }
@@ -152,8 +198,9 @@ const AccuracyCurve& CurvePropagator::evaluateAbsolute(std::uint32_t n, bool par
     const AccuracyCurve& child = evaluateAbsolute(scene_.children[slot], inside);
     if (!child.empty()) parts.push_back(&child);
   }
-  e.curve = node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
-                                               : AccuracyCurve::lowerEnvelope(parts);
+  e.curve = simplifyUpper(node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
+                                                             : AccuracyCurve::lowerEnvelope(parts),
+                          config_.curveTolerance);
   return e.curve;
 }
 
@@ -193,8 +240,9 @@ const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
     std::vector<const AccuracyCurve*> parts;
     parts.reserve(scaled.size());
     for (const AccuracyCurve& s : scaled) parts.push_back(&s);
-    curve = node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
-                                               : AccuracyCurve::lowerEnvelope(parts);
+    curve = simplifyUpper(node.kind == SceneNodeKind::kGroup ? AccuracyCurve::sum(parts)
+                                                             : AccuracyCurve::lowerEnvelope(parts),
+                          config_.curveTolerance);
   }
   RelativeEntry& entry = cache_.relative[n];
   entry.valid = true;

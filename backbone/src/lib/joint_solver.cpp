@@ -35,6 +35,14 @@ JointSolver::JointSolver(const SchedulingScene& scene, const SchedulerConfig& co
       stats_(stats) {
   root_ = build(0, false);
   nodeSet_.assign(nodes_.size(), Span{});
+  minTriangles_.assign(nodes_.size(), 0.0);
+  minLink_.assign(nodes_.size(), 0.0);
+  scalarT_.assign(nodes_.size(), 0.0);
+  scalarL_.assign(nodes_.size(), 0.0);
+  scalarPick_.assign(nodes_.size(), -1);
+  costTriangles_.assign(candidates_.size(), 0.0);
+  costLink_.assign(candidates_.size(), 0.0);
+  levelOk_.assign(children_.size(), 0);
   refreshAccuracyBounds();
 }
 
@@ -119,13 +127,14 @@ double JointSolver::highestAccuracy() const {
   return root_ < 0 ? -kInf : nodes_[root_].maxAccuracy;
 }
 
-JointSolver::Span JointSolver::finish(std::uint32_t begin) {
+JointSolver::Span JointSolver::finish(std::uint32_t begin, double limitTriangles,
+                                      double limitLink) {
   const std::uint32_t end = static_cast<std::uint32_t>(arena_.size());
   std::uint32_t out = begin;
   for (std::uint32_t i = begin; i < end; ++i) {
     const Point& p = arena_[i];
-    if (budget_.useTriangles && !(p.triangles <= budget_.triangles)) continue;
-    if (budget_.useLink && !(p.link <= budget_.linkBytes)) continue;
+    if (budget_.useTriangles && !(p.triangles <= limitTriangles)) continue;
+    if (budget_.useLink && !(p.link <= limitLink)) continue;
     arena_[out++] = p;
   }
   arena_.resize(out);
@@ -178,7 +187,207 @@ JointSolver::Span JointSolver::finish(std::uint32_t begin) {
   return {begin, 1};
 }
 
-JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
+void JointSolver::prepareCosts(std::uint32_t k, double accuracy) {
+  const Node& n = nodes_[k];
+  if (n.maxAccuracy == -kInf) return;
+  const double clamped = std::min(accuracy, n.maxAccuracy);
+  if (n.kind == SceneNodeKind::kLeaf) {
+    const double x = clamped * n.diameter / n.distance;
+    for (std::uint32_t i = 0; i < n.candidateCount; ++i) {
+      const std::uint32_t c = n.firstCandidate + i;
+      const LeafCandidate& candidate = candidates_[c];
+      if (!(candidate.maxRelativeAccuracy >= x * (1.0 - kAccuracyTolerance))) {
+        costTriangles_[c] = std::nan("");
+        continue;
+      }
+      const CandidateCost cost =
+          candidateCost(candidate, std::min(x, candidate.maxRelativeAccuracy));
+      costTriangles_[c] = cost.triangles;
+      costLink_[c] = cost.linkBytes;
+    }
+    return;
+  }
+  for (std::uint32_t c = 0; c < n.childCount; ++c) {
+    const std::uint32_t child = children_[n.firstChild + c];
+    if (n.kind == SceneNodeKind::kLod) {
+      const bool ok = nodes_[child].maxAccuracy >= clamped * (1.0 - kAccuracyTolerance);
+      levelOk_[n.firstChild + c] = ok;
+      if (ok) prepareCosts(child, clamped);
+    } else {
+      prepareCosts(child, accuracy);
+    }
+  }
+}
+
+void JointSolver::computeMinima(std::uint32_t k) {
+  const Node& n = nodes_[k];
+  double t = 0.0;
+  double l = 0.0;
+  if (n.maxAccuracy != -kInf) {
+    if (n.kind == SceneNodeKind::kLeaf) {
+      t = kInf;
+      l = kInf;
+      for (std::uint32_t i = 0; i < n.candidateCount; ++i) {
+        const std::uint32_t c = n.firstCandidate + i;
+        if (std::isnan(costTriangles_[c])) continue;
+        t = std::min(t, costTriangles_[c]);
+        l = std::min(l, costLink_[c]);
+      }
+    } else if (n.kind == SceneNodeKind::kLod) {
+      t = kInf;
+      l = kInf;
+      for (std::uint32_t c = 0; c < n.childCount; ++c) {
+        if (!levelOk_[n.firstChild + c]) continue;
+        const std::uint32_t child = children_[n.firstChild + c];
+        computeMinima(child);
+        t = std::min(t, minTriangles_[child]);
+        l = std::min(l, minLink_[child]);
+      }
+    } else {
+      for (std::uint32_t c = 0; c < n.childCount; ++c) {
+        const std::uint32_t child = children_[n.firstChild + c];
+        computeMinima(child);
+        t += minTriangles_[child];
+        l += minLink_[child];
+      }
+    }
+  }
+  minTriangles_[k] = t;
+  minLink_[k] = l;
+}
+
+namespace {
+// Is (t1, l1) a strictly better choice than (t2, l2) for weight w?
+bool scalarBetter(double t1, double l1, double t2, double l2, double w) {
+  if (std::isinf(w)) return l1 < l2 || (l1 == l2 && t1 < t2);
+  const double v1 = t1 + w * l1;
+  const double v2 = t2 + w * l2;
+  return v1 < v2 || (v1 == v2 && (t1 < t2 || (t1 == t2 && l1 < l2)));
+}
+}  // namespace
+
+void JointSolver::scalarPass(std::uint32_t k, double weight, double& triangles, double& link) {
+  const Node& n = nodes_[k];
+  double t = 0.0;
+  double l = 0.0;
+  std::int32_t pick = -1;
+  if (n.maxAccuracy != -kInf) {
+    if (n.kind == SceneNodeKind::kLeaf) {
+      t = kInf;
+      l = kInf;
+      for (std::uint32_t i = 0; i < n.candidateCount; ++i) {
+        const std::uint32_t c = n.firstCandidate + i;
+        if (std::isnan(costTriangles_[c])) continue;
+        if (pick < 0 || scalarBetter(costTriangles_[c], costLink_[c], t, l, weight)) {
+          t = costTriangles_[c];
+          l = costLink_[c];
+          pick = static_cast<std::int32_t>(i);
+        }
+      }
+    } else if (n.kind == SceneNodeKind::kLod) {
+      t = kInf;
+      l = kInf;
+      for (std::uint32_t c = 0; c < n.childCount; ++c) {
+        if (!levelOk_[n.firstChild + c]) continue;
+        double ct = 0.0;
+        double cl = 0.0;
+        scalarPass(children_[n.firstChild + c], weight, ct, cl);
+        if (pick < 0 || scalarBetter(ct, cl, t, l, weight)) {
+          t = ct;
+          l = cl;
+          pick = static_cast<std::int32_t>(c);
+        }
+      }
+    } else {
+      for (std::uint32_t c = 0; c < n.childCount; ++c) {
+        double ct = 0.0;
+        double cl = 0.0;
+        scalarPass(children_[n.firstChild + c], weight, ct, cl);
+        t += ct;
+        l += cl;
+      }
+    }
+  }
+  scalarPick_[k] = pick;
+  triangles = t;
+  link = l;
+}
+
+JointSolver::Verdict JointSolver::lagrangianScreen(double& certificateWeight) {
+  const std::uint32_t root = static_cast<std::uint32_t>(root_);
+  const double bt = budget_.triangles;
+  const double bl = budget_.linkBytes;
+  auto fits = [&](double t, double l) { return t <= bt && l <= bl; };
+  double t = 0.0;
+  double l = 0.0;
+  scalarPass(root, 0.0, t, l);  // fewest triangles
+  if (!(t <= bt)) return Verdict::kInfeasible;
+  if (fits(t, l)) {
+    certificateWeight = 0.0;
+    return Verdict::kFeasible;
+  }
+  scalarPass(root, kInf, t, l);  // fewest bytes
+  if (!(l <= bl)) return Verdict::kInfeasible;
+  if (fits(t, l)) {
+    certificateWeight = kInf;
+    return Verdict::kFeasible;
+  }
+  // Bisect the weight (log scale around budgetT / budgetL): too many bytes
+  // -> weigh bytes more; too many triangles -> less.
+  const double scale = bl > 0.0 ? std::max(bt, 1e-300) / bl : 1.0;
+  double lo = std::log(scale) - 40.0;
+  double hi = std::log(scale) + 40.0;
+  for (int i = 0; i < 48; ++i) {
+    const double w = std::exp(0.5 * (lo + hi));
+    scalarPass(root, w, t, l);
+    if (fits(t, l)) {
+      certificateWeight = w;
+      return Verdict::kFeasible;
+    }
+    // Every feasible choice has t + w l <= bt + w bl; the minimum above
+    // that bound (with a rounding margin) proves that none exists.
+    if (t + w * l > (bt + w * bl) * (1.0 + 1e-12)) return Verdict::kInfeasible;
+    if (l > bl) {
+      lo = std::log(w);
+    } else {
+      hi = std::log(w);
+    }
+  }
+  return Verdict::kUnknown;
+}
+
+void JointSolver::extractScalar(std::uint32_t k, double accuracy, double weight,
+                                std::vector<LeafSelection>& out) {
+  const Node& n = nodes_[k];
+  if (n.maxAccuracy == -kInf) {
+    reportNothing(k, false, out);
+    return;
+  }
+  const double clamped = std::min(accuracy, n.maxAccuracy);
+  const std::int32_t pick = scalarPick_[k];
+  if (n.kind == SceneNodeKind::kLeaf) {
+    const LeafCandidate& c = candidates_[n.firstCandidate + pick];
+    const double x = clamped * n.diameter / n.distance;
+    out.push_back(makeSelection(n.sceneNode, scene_.nodes[n.sceneNode].object, c,
+                                std::min(x, c.maxRelativeAccuracy), n.distance, n.diameter));
+  } else if (n.kind == SceneNodeKind::kLod) {
+    extractScalar(children_[n.firstChild + pick], clamped, weight, out);
+  } else {
+    for (std::uint32_t c = 0; c < n.childCount; ++c)
+      extractScalar(children_[n.firstChild + c], accuracy, weight, out);
+  }
+}
+
+bool JointSolver::paretoFeasible(double accuracy) {
+  ++stats_.paretoPasses;
+  ++paretoPasses_;
+  arena_.clear();
+  return evaluate(static_cast<std::uint32_t>(root_), accuracy, budget_.triangles, budget_.linkBytes)
+             .size > 0;
+}
+
+JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy, double limitTriangles,
+                                        double limitLink) {
   const Node n = nodes_[k];
   if (n.maxAccuracy == -kInf) {
     const std::uint32_t begin = static_cast<std::uint32_t>(arena_.size());
@@ -197,7 +406,7 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
       arena_.push_back(
           {cost.triangles, cost.linkBytes, static_cast<std::int32_t>(i), -1, sourceTie(c.source)});
     }
-    nodeSet_[k] = finish(begin);
+    nodeSet_[k] = finish(begin, limitTriangles, limitLink);
     return nodeSet_[k];
   }
   if (n.kind == SceneNodeKind::kLod) {
@@ -205,7 +414,7 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
     for (std::uint32_t c = 0; c < n.childCount; ++c) {
       const std::uint32_t child = children_[n.firstChild + c];
       if (!(nodes_[child].maxAccuracy >= clamped * (1.0 - kAccuracyTolerance))) continue;
-      const Span s = evaluate(child, clamped);
+      const Span s = evaluate(child, clamped, limitTriangles, limitLink);
       if (s.size > 0) levels.push_back({c, s});
     }
     const std::uint32_t begin = static_cast<std::uint32_t>(arena_.size());
@@ -216,16 +425,34 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
                           static_cast<std::int32_t>(j), 0});
       }
     }
-    nodeSet_[k] = finish(begin);
+    nodeSet_[k] = finish(begin, limitTriangles, limitLink);
     return nodeSet_[k];
   }
   // Group: fold the children's sets with pairwise sums, one stage per child.
+  // A partial sum over children 0..c leaves room only for what children
+  // c+1.. need at least; a child's own set leaves room for all its siblings.
+  double restTriangles = 0.0;
+  double restLink = 0.0;
+  for (std::uint32_t c = 0; c < n.childCount; ++c) {
+    const std::uint32_t child = children_[n.firstChild + c];
+    restTriangles += minTriangles_[child];
+    restLink += minLink_[child];
+  }
   Span previous{0, 0};
   for (std::uint32_t c = 0; c < n.childCount; ++c) {
-    const Span s = evaluate(children_[n.firstChild + c], accuracy);
+    const std::uint32_t child = children_[n.firstChild + c];
+    const double siblingsT = restTriangles - minTriangles_[child];
+    const double siblingsL = restLink - minLink_[child];
+    const Span s = evaluate(child, accuracy, limitTriangles - siblingsT, limitLink - siblingsL);
     if (s.size == 0) {
       nodeSet_[k] = {0, 0};
       return nodeSet_[k];
+    }
+    double laterT = 0.0;
+    double laterL = 0.0;
+    for (std::uint32_t j = c + 1; j < n.childCount; ++j) {
+      laterT += minTriangles_[children_[n.firstChild + j]];
+      laterL += minLink_[children_[n.firstChild + j]];
     }
     const std::uint32_t begin = static_cast<std::uint32_t>(arena_.size());
     if (c == 0) {
@@ -245,7 +472,7 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
         }
       }
     }
-    previous = finish(begin);
+    previous = finish(begin, limitTriangles - laterT, limitLink - laterL);
     stages_[n.firstStage + c] = previous;
     if (previous.size == 0) {
       nodeSet_[k] = previous;
@@ -258,9 +485,37 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy) {
 
 bool JointSolver::feasible(double accuracy) {
   ++stats_.solverEvaluations;
+  lastByScalar_ = false;
   if (root_ < 0) return true;
-  arena_.clear();
-  return evaluate(static_cast<std::uint32_t>(root_), accuracy).size > 0;
+  const std::uint32_t root = static_cast<std::uint32_t>(root_);
+  prepareCosts(root, accuracy);
+  computeMinima(root);
+  if (budget_.useTriangles && !(minTriangles_[root] <= budget_.triangles)) return false;
+  if (budget_.useLink && !(minLink_[root] <= budget_.linkBytes)) return false;
+  if (!(budget_.useTriangles && budget_.useLink)) {
+    // One budget (or none): the cheapest choice decides.
+    lastByScalar_ = true;
+    lastWeight_ = budget_.useLink && !budget_.useTriangles ? kInf : 0.0;
+    return true;
+  }
+  double weight = 0.0;
+  switch (lagrangianScreen(weight)) {
+    case Verdict::kFeasible:
+      ++stats_.lagrangianDecisions;
+      lastByScalar_ = true;
+      lastWeight_ = weight;
+      return true;
+    case Verdict::kInfeasible:
+      ++stats_.lagrangianDecisions;
+      return false;
+    case Verdict::kUnknown:
+      break;
+  }
+  if (paretoPasses_ >= config_.maxParetoPasses) {
+    ++stats_.undecidedAccuracies;  // treated as infeasible: lower, never over budget
+    return false;
+  }
+  return paretoFeasible(accuracy);
 }
 
 std::size_t JointSolver::dropUntilFeasible() {
@@ -294,18 +549,9 @@ std::size_t JointSolver::dropUntilFeasible() {
   return hi;
 }
 
-std::optional<double> JointSolver::maximise(std::optional<double> cap, std::optional<double> hint) {
-  double hi = highestAccuracy();
-  if (hi == -kInf) return cap ? *cap : kInf;  // nothing renderable constrains the target
-  double lo = lowestAccuracy();
-  if (cap) {
-    hi = std::min(hi, *cap);
-    lo = std::min(lo, hi);
-  }
+std::optional<double> JointSolver::search(double lo, double hi, std::optional<double> hint) {
   if (!feasible(lo)) return std::nullopt;
-  // Above the best any object reaches nothing costs more: a reachable cap
-  // (fixed accuracy) is the target itself.
-  if (feasible(hi)) return cap ? *cap : hi;
+  if (feasible(hi)) return hi;
   if (hint && *hint > lo && *hint < hi) {
     if (feasible(*hint)) {
       lo = *hint;
@@ -325,12 +571,36 @@ std::optional<double> JointSolver::maximise(std::optional<double> cap, std::opti
   return lo;
 }
 
+std::optional<double> JointSolver::maximise(std::optional<double> cap, std::optional<double> hint) {
+  const double top = highestAccuracy();
+  if (top == -kInf) return cap ? *cap : kInf;  // nothing renderable constrains the target
+  const double ceiling = cap ? std::min(top, *cap) : top;
+  const double lo = std::min(lowestAccuracy(), ceiling);
+  const double hi = ceiling;
+  const std::optional<double> best = search(lo, hi, hint);
+  if (!best) return std::nullopt;
+  // Above the best any object reaches nothing costs more: a reachable cap
+  // (fixed accuracy) is the target itself.
+  if (cap && *best >= ceiling) return *cap;
+  return best;
+}
+
 void JointSolver::extract(double accuracy, std::vector<LeafSelection>& out) {
   if (root_ < 0) return;
-  arena_.clear();
-  ++stats_.solverEvaluations;
-  const Span root = evaluate(static_cast<std::uint32_t>(root_), accuracy);
-  if (root.size == 0) return;  // caller only extracts feasible accuracies
+  const std::uint32_t rootNode = static_cast<std::uint32_t>(root_);
+  const int savedPasses = paretoPasses_;
+  paretoPasses_ = std::min(paretoPasses_, config_.maxParetoPasses - 1);  // allow one more pass
+  const bool ok = feasible(accuracy);
+  paretoPasses_ = std::max(paretoPasses_, savedPasses);
+  if (!ok) return;  // callers extract accuracies found feasible
+  if (lastByScalar_) {
+    double t = 0.0;
+    double l = 0.0;
+    scalarPass(rootNode, lastWeight_, t, l);
+    extractScalar(rootNode, accuracy, lastWeight_, out);
+    return;
+  }
+  const Span root{nodeSet_[rootNode]};
   std::uint32_t best = 0;
   double bestScore = kInf;
   for (std::uint32_t i = 0; i < root.size; ++i) {
@@ -344,7 +614,7 @@ void JointSolver::extract(double accuracy, std::vector<LeafSelection>& out) {
       best = i;
     }
   }
-  extractNode(static_cast<std::uint32_t>(root_), accuracy, best, out);
+  extractNode(rootNode, accuracy, best, out);
 }
 
 void JointSolver::reportNothing(std::uint32_t k, bool underLod,

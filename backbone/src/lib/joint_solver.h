@@ -10,7 +10,14 @@
 // (exact while no set exceeds paretoCap; larger sets are thinned, which can
 // only make the answer lower, never over budget). Feasibility is monotone in
 // a, so maximise() bisects (geometric, relative tolerance 1e-11). With a
-// single budget the sets are single points and a pass is O(visible nodes).
+// single budget feasibility is "the cheapest choice fits": O(visible nodes).
+// With two, a Lagrangian screen first: the choice minimising
+// triangles + w * link for a weight w either fits both budgets (a feasible
+// certificate) or its value exceeds budgetT + w * budgetL (a proof that
+// nothing fits); only accuracies it leaves undecided get a Pareto pass.
+// With two, the single-budget optima bound the answer from above first, and
+// Pareto partial sums are pruned against the budget minus the least the rest
+// of the tree needs (exact: such points cannot be part of a feasible choice).
 #pragma once
 
 #include <optional>
@@ -75,8 +82,24 @@ class JointSolver {
 
   std::int32_t build(std::uint32_t sceneNode, bool parentInside);
   void refreshAccuracyBounds();
-  Span evaluate(std::uint32_t k, double accuracy);
-  Span finish(std::uint32_t begin);
+  // Fewest triangles / bytes of each subtree at `accuracy` (each resource
+  // alone): the rest of the tree needs at least that much, which bounds
+  // what a partial sum may use.
+  // Per-accuracy preparation: each leaf candidate's cost (NaN when it does
+  // not reach what the clamping asks) and which LOD levels qualify.
+  void prepareCosts(std::uint32_t k, double accuracy);
+  void computeMinima(std::uint32_t k);
+  // Totals of the choice minimising triangles + weight * link (weight
+  // +infinity: link first); from prepared costs.
+  void scalarPass(std::uint32_t k, double weight, double& triangles, double& link);
+  void extractScalar(std::uint32_t k, double accuracy, double weight,
+                     std::vector<LeafSelection>& out);
+  enum class Verdict : std::uint8_t { kFeasible, kInfeasible, kUnknown };
+  Verdict lagrangianScreen(double& certificateWeight);
+  bool paretoFeasible(double accuracy);
+  Span evaluate(std::uint32_t k, double accuracy, double limitTriangles, double limitLink);
+  Span finish(std::uint32_t begin, double limitTriangles, double limitLink);
+  std::optional<double> search(double lo, double hi, std::optional<double> hint);
   void reportNothing(std::uint32_t k, bool underLod, std::vector<LeafSelection>& out) const;
   void extractNode(std::uint32_t k, double accuracy, std::uint32_t index,
                    std::vector<LeafSelection>& out);
@@ -93,6 +116,18 @@ class JointSolver {
   std::vector<Point> arena_;
   std::vector<Span> nodeSet_;
   std::vector<Span> stages_;
+  std::vector<double> minTriangles_;
+  std::vector<double> minLink_;
+  std::vector<double> costTriangles_;  // per candidate, for the prepared accuracy
+  std::vector<double> costLink_;
+  std::vector<std::uint8_t> levelOk_;  // per children_ entry of LODs
+  std::vector<double> scalarT_;
+  std::vector<double> scalarL_;
+  std::vector<std::int32_t> scalarPick_;  // leaf: candidate; LOD: child position
+  int paretoPasses_ = 0;
+  // How the last feasible() call decided: a scalar weight, or Pareto.
+  bool lastByScalar_ = false;
+  double lastWeight_ = 0.0;
   std::size_t leafCount_ = 0;
   std::int32_t root_ = -1;
 };

@@ -50,6 +50,8 @@ Status validateConfig(const SchedulerConfig& c) {
     return invalidField(o, "cacheDistanceMargin", "must be finite and >= 0");
   if (!nonNegative(c.cacheAngleMargin))
     return invalidField(o, "cacheAngleMargin", "must be finite and >= 0");
+  if (!nonNegative(c.curveTolerance) || c.curveTolerance > 1.0)
+    return invalidField(o, "curveTolerance", "must be in [0, 1]");
   if (!nonNegative(c.budgetReserveShare) || c.budgetReserveShare >= 1.0)
     return invalidField(o, "budgetReserveShare", "must be in [0, 1)");
   if (!nonNegative(c.preferCurrentShare))
@@ -62,6 +64,8 @@ Status validateConfig(const SchedulerConfig& c) {
     return invalidField(o, "rangeHysteresis", "must be finite and >= 0");
   if (c.paretoCap < 2 || c.paretoCap > 100000)
     return invalidField(o, "paretoCap", "must be in [2, 100000]");
+  if (c.maxParetoPasses < 0 || c.maxParetoPasses > 100000)
+    return invalidField(o, "maxParetoPasses", "must be in [0, 100000]");
   return Status::okStatus();
 }
 

@@ -38,7 +38,8 @@ std::uint64_t fingerprint(const SchedulerConfig& c) {
                            c.mergeDistanceFactor,
                            c.cacheDistanceMargin,
                            c.cacheAngleMargin,
-                           c.rangeHysteresis};
+                           c.rangeHysteresis,
+                           c.curveTolerance};
   std::uint64_t h = 1469598103934665603ULL;
   for (double f : fields) {
     std::uint64_t bits;

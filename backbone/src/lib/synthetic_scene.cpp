@@ -9,6 +9,8 @@
 namespace thinlod::backbone {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 // Piecewise-linear curve through (accuracy, resources) knots.
 AccuracyCurve through(const std::vector<double>& a, const std::vector<double>& r) {
   std::vector<CurveSegment> segments;
@@ -107,10 +109,9 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
         meshed.relativeTriangles = through(ma, mt);
         meshed.relativeLinkBytes =
             through(ma, {6000.0 + 4 * mt[0], 6000.0 + 4 * mt[1], 6000.0 + 4 * mt[2]});
-        meshed.validity =
-            ConicRange::make(bounds.center, 4.0 * bounds.radius,
-                             std::numeric_limits<double>::infinity(), {0, 0, 1}, 3.14159265358979)
-                .value();
+        meshed.validity = ConicRange::make(bounds.center, 4.0 * bounds.radius,
+                                           std::numeric_limits<double>::infinity(), {0, 0, 1}, kPi)
+                              .value();
         scene.options.push_back(std::move(meshed));
       }
       if (o.simpleImpostor) {
@@ -118,10 +119,9 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
         simple.kind = RepresentationKind::kSimpleImpostor;
         simple.relativeTriangles = AccuracyCurve::point(30.0, 2.0);
         simple.relativeLinkBytes = AccuracyCurve::point(30.0, 6000.0);
-        simple.validity =
-            ConicRange::make(bounds.center, 10.0 * bounds.radius,
-                             std::numeric_limits<double>::infinity(), {0, 0, 1}, 3.14159265358979)
-                .value();
+        simple.validity = ConicRange::make(bounds.center, 10.0 * bounds.radius,
+                                           std::numeric_limits<double>::infinity(), {0, 0, 1}, kPi)
+                              .value();
         scene.options.push_back(std::move(simple));
       }
     }
@@ -151,11 +151,10 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
     level.kind = SceneNodeKind::kLod;
     level.bounds = bounds;
     level.children = {detailed, coarse};
-    level.ranges = {
-        ConicRange::everywhere(),
-        ConicRange::make(bounds.center, 6.0 * bounds.radius,
-                         std::numeric_limits<double>::infinity(), {0, 0, 1}, 3.14159265358979)
-            .value()};
+    level.ranges = {ConicRange::everywhere(),
+                    ConicRange::make(bounds.center, 6.0 * bounds.radius,
+                                     std::numeric_limits<double>::infinity(), {0, 0, 1}, kPi)
+                        .value()};
     drafts.push_back(std::move(level));
     tops.push_back(static_cast<std::uint32_t>(drafts.size() - 1));
   }

@@ -50,22 +50,32 @@ struct SchedulerConfig {
   double minimalDistance = 0.1;  // m, lower clamp of D
   double maxViewDistance = std::numeric_limits<double>::infinity();  // m
   // Curve propagation: a group converts relative -> absolute once when
-  // D >= mergeDistanceFactor * its diameter (paper 3.4; infinity disables).
-  double mergeDistanceFactor = 1.0;
+  // D >= mergeDistanceFactor * its diameter (paper 3.4 suggests ~1; the
+  // guarantee then understates a child's accuracy by at most a factor
+  // 1 + 1/mergeDistanceFactor; infinity disables).
+  double mergeDistanceFactor = 4.0;
   // Reuse: merged subtree curves are computed for the region grown by
   // cacheDistanceMargin * D (and the cone by cacheAngleMargin) and reused
   // while the predicted region stays inside. 0 disables the growth.
   double cacheDistanceMargin = 0.05;
   double cacheAngleMargin = 0.05;  // rad
+  // Group and LOD curves with many knots are replaced by an upper bound
+  // within (1 + curveTolerance) of the exact resources (per tree level), so
+  // a curve stays small however many leaves are below it. 0: exact curves.
+  double curveTolerance = 0.002;
   // Stability (docs/scheduling.md, "Hysteresis"). All keep budgets hard.
   double budgetReserveShare = 0.05;  // share of each budget kept for keeping copies
   double preferCurrentShare = 0.15;  // keep a copy costing <= (1+share) x the best
   int switchDelaySteps = 2;          // keep a valid copy this many steps before a voluntary switch
   double targetHysteresis = 0.02;    // ignore target increases below this fraction
   double rangeHysteresis = 0.0;      // m: a new kind must fit the region grown by this
-  // Two-resource solver: Pareto sets per node are thinned above this size
-  // (then the result is still within budget but may be below the optimum).
+  // Two-resource solver (docs/scheduling.md): a Lagrangian screen decides
+  // most accuracies; the rest get an exact Pareto pass, at most
+  // maxParetoPasses per plan, with per-node sets thinned above paretoCap.
+  // Either limit can only lower the answer (never break a budget); both are
+  // counted in PlanStats.
   int paretoCap = 64;
+  int maxParetoPasses = 16;
 };
 
 Status validateConfig(const SchedulerConfig& config);

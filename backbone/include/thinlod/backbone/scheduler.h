@@ -92,12 +92,15 @@ struct PlanStats {
   std::uint32_t visitedNodes = 0;
   std::uint32_t culledNodes = 0;
   std::uint32_t visibleObjects = 0;
-  std::uint32_t mergedGroups = 0;       // subtrees converted relative -> absolute once
-  std::uint32_t curveReuses = 0;        // node curves taken from the cache
-  std::uint32_t curveComputes = 0;      // node curves computed this step
-  std::uint32_t solverEvaluations = 0;  // two-resource / fallback feasibility passes
-  std::uint32_t paretoThinnings = 0;    // > 0: the two-resource result may be below optimal
-  std::uint32_t hysteresisKeeps = 0;    // copies kept although a cheaper one was chosen
+  std::uint32_t mergedGroups = 0;         // subtrees converted relative -> absolute once
+  std::uint32_t curveReuses = 0;          // node curves taken from the cache
+  std::uint32_t curveComputes = 0;        // node curves computed this step
+  std::uint32_t solverEvaluations = 0;    // two-resource / fallback feasibility passes
+  std::uint32_t lagrangianDecisions = 0;  // accuracies decided by the Lagrangian screen
+  std::uint32_t paretoPasses = 0;         // exact two-resource passes
+  std::uint32_t paretoThinnings = 0;      // > 0: the two-resource result may be below optimal
+  std::uint32_t undecidedAccuracies = 0;  // > 0: pass limit hit, result may be below optimal
+  std::uint32_t hysteresisKeeps = 0;      // copies kept although a cheaper one was chosen
   bool usedExactSolver = false;
 };
 

@@ -25,7 +25,8 @@ struct Sphere {
 };
 
 inline bool containsBall(const ValidityRange& range, const Sphere& ball) {
-  return range.containsSphere(ball.center, ball.radius);
+  // Most ranges are unrestricted: skip the geometry (regions are finite).
+  return range.isEverywhere() || range.containsSphere(ball.center, ball.radius);
 }
 
 }  // namespace thinlod::backbone
