@@ -211,6 +211,43 @@ TEST(Trace, SharedDefaultFlightPathParses) {
   EXPECT_EQ(t->poses.size(), 3u);
 }
 
+// --- Untrusted input ------------------------------------------------------------------
+
+TEST(Trace, EveryPrefixAndRandomCorruptionParsesOrFailsCleanly) {
+  Trace trace;
+  for (int i = 0; i < 20; ++i) {
+    trace.poses.push_back(Pose{0.1 * i, {float(i), 1.5f, -2.0f * i}, {1, 0, 0, 0}, 60.0f});
+  }
+  const std::string valid = writeTrace(trace) + "3 0 0 0 lookat 1 1 1 70 # tail\n";
+  auto check = [](const std::string& text) {
+    const Result<Trace> t = parseTrace(text);
+    if (t.ok()) {
+      ASSERT_FALSE(t->poses.empty());
+      for (std::size_t i = 1; i < t->poses.size(); ++i) {
+        ASSERT_GT(t->poses[i].time, t->poses[i - 1].time);
+      }
+    } else {
+      ASSERT_EQ(t.status().message().rfind("line ", 0), 0u) << t.status().message();
+    }
+  };
+  for (std::size_t n = 0; n <= valid.size(); ++n) check(valid.substr(0, n));
+  std::mt19937_64 rng(123);
+  std::string alphabet = "0123456789.-+eE #\n\tnaifquatlook\r";
+  alphabet.push_back('\0');
+  alphabet.push_back('\xff');
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string corrupted = valid;
+    const int edits = std::uniform_int_distribution<int>(1, 8)(rng);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at =
+          std::uniform_int_distribution<std::size_t>(0, corrupted.size() - 1)(rng);
+      corrupted[at] =
+          alphabet[std::uniform_int_distribution<std::size_t>(0, alphabet.size() - 1)(rng)];
+    }
+    check(corrupted);
+  }
+}
+
 // --- Sampling --------------------------------------------------------------------------
 
 TEST(Trace, SamplePoseInterpolatesAndClamps) {
