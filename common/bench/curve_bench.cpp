@@ -1,4 +1,4 @@
-// Accuracy-curve benchmarks: sum / lower envelope / inversion of single
+// Accuracy-curve (and conic-range) benchmarks: sum / lower envelope / inversion of single
 // curves with 2-64 knots, and propagation through balanced Group/LOD trees
 // of 10^3-10^6 random leaf curves (fixed seed). Items are knots (per-curve
 // benchmarks), queries (inversion), or leaves (trees).
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/conic_range.h"
 
 namespace thinlod {
 namespace {
@@ -132,6 +133,32 @@ BENCHMARK(BM_FitConservative)
     ->RangeMultiplier(10)
     ->Range(10, 100000)
     ->Unit(benchmark::kMicrosecond);
+
+void BM_ConicIntersect(benchmark::State& state) {
+  // range(0) = 0: nested ranges (exact path); 1: partly overlapping cones
+  // with different centres (the ball fallback). Items are intersections.
+  const bool fallback = state.range(0) == 1;
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<std::pair<ConicRange, ConicRange>> pairs;
+  for (int i = 0; i < 256; ++i) {
+    const glm::dvec3 c(unit(rng), unit(rng), unit(rng));
+    const ConicRange a = ConicRange::make(c, 1.0, 20.0, {0, 0, 1}, 0.8).value();
+    const ConicRange b =
+        fallback ? ConicRange::make(c + glm::dvec3(3, 0, 0), 2.0, 15.0, {0.3, 0, 1}, 0.7).value()
+                 : ConicRange::ball(c + glm::dvec3(0, 0, 8), 1.0);
+    pairs.emplace_back(a, b);
+  }
+  std::size_t i = 0;
+  double checksum = 0.0;
+  for (auto _ : state) {
+    const auto& [a, b] = pairs[i++ & 255];
+    checksum += a.intersect(b).maxDistance();
+  }
+  benchmark::DoNotOptimize(checksum);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ConicIntersect)->Arg(0)->Arg(1);
 
 // Balanced tree, fan-out 4; levels alternate LOD (lowest level: 4 versions
 // of an object) and Group. Propagates level by level, freeing the children.

@@ -89,8 +89,10 @@ ConicRange fallbackBall(const ConicRange& a, const ConicRange& b) {
 
   // Pattern search: move the centre while the ball grows.
   const glm::dvec3 moves[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  // Stops once the step is a small fraction of the ball: the radius is then
+  // within about that fraction of what this local search can reach.
   double step = std::max(bestScore, 0.05 * scale);
-  for (int iteration = 0; iteration < 200 && step > 1e-9 * scale; ++iteration) {
+  for (int iteration = 0; iteration < 80 && step > 1e-3 * bestScore; ++iteration) {
     bool improved = false;
     for (const glm::dvec3& m : moves) {
       const glm::dvec3 q = best + m * step;
