@@ -11,9 +11,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/trigonometric.hpp>
-#include <iterator>
 #include <optional>
-#include <sstream>
 #include <system_error>
 
 namespace thinlod {
