@@ -1,6 +1,9 @@
 // OpenMesh wants MeshIO.hh included before any mesh kernel header.
 // clang-format off
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // see tri_mesh.h
 #include <OpenMesh/Core/IO/MeshIO.hh>
+#pragma GCC diagnostic pop
 #include "thinlod/common/mesh_io.h"
 // clang-format on
 

@@ -16,7 +16,13 @@
 // - Pure functions, no I/O; safe from any thread on distinct meshes.
 #pragma once
 
+// OpenMesh's VectorT leaves its default-constructed data uninitialised on
+// purpose; GCC then warns (-Wmaybe-uninitialized) wherever property vectors
+// grow. The warning is about OpenMesh's code, so it is silenced for it only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#pragma GCC diagnostic pop
 #include <cstddef>
 
 #include "thinlod/common/indexed_mesh.h"
