@@ -174,14 +174,21 @@ void collectLeafCandidates(const SchedulingScene& scene, std::uint32_t object,
   const bool exact = context == CandidateContext::kExact;
   // A displayed copy is judged over the keep ball: credit it, in the leaf's
   // frame (a_abs = a_rel * D_reach / diameter), with D_keep / D_reach >= 1.
-  double keepCredit = 1.0;
-  if (exact) {
-    const double dReach =
-        conversionDistance(region.center, region.reachRadius, bounds, config.minimalDistance);
-    const double dKeep =
-        conversionDistance(region.center, region.keepRadius, bounds, config.minimalDistance);
-    keepCredit = dKeep / dReach;
-  }
+  // Computed only when some copy needs it (most leaves have none).
+  double keepCredit = -1.0;
+  auto credit = [&]() {
+    if (keepCredit < 0.0) {
+      keepCredit = 1.0;
+      if (exact) {
+        const double dReach =
+            conversionDistance(region.center, region.reachRadius, bounds, config.minimalDistance);
+        const double dKeep =
+            conversionDistance(region.center, region.keepRadius, bounds, config.minimalDistance);
+        keepCredit = dKeep / dReach;
+      }
+    }
+    return keepCredit;
+  };
   for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
     const std::uint32_t index = obj.firstOption + k;
     const RepresentationOption& option = scene.options[index];
@@ -209,7 +216,7 @@ void collectLeafCandidates(const SchedulingScene& scene, std::uint32_t object,
       c.option = index;
       c.source = CandidateSource::kFrontendCopy;
       c.representation = &option;
-      c.maxRelativeAccuracy = front.relativeAccuracy * keepCredit;
+      c.maxRelativeAccuracy = front.relativeAccuracy * credit();
       c.fixedTriangles = front.triangles;
       c.fixedLinkBytes = 0.0;
       c.copyId = front.id;
@@ -236,7 +243,7 @@ void collectLeafCandidates(const SchedulingScene& scene, std::uint32_t object,
         c.option = index;
         c.source = CandidateSource::kPending;
         c.representation = &option;
-        c.maxRelativeAccuracy = p.relativeAccuracy * keepCredit;
+        c.maxRelativeAccuracy = p.relativeAccuracy * credit();
         c.fixedTriangles = p.triangles;
         c.fixedLinkBytes = 0.0;
         c.copyId = p.requestId;
