@@ -46,13 +46,13 @@ Result<CurveLevel> measureLevel(const IndexedMesh& original, double diagonal, st
   const double d = std::max(out.relativeMaxError, options.minRelativeError);
   out.accuracy = 1.0 / d;
   if (options.measureEncodedBytes) {
-    MeshEncodeOptions encode = options.encode;
-    encode.positionBits = positionBitsForAccuracy(out.accuracy, options.quantizationBudgetFraction);
-    Result<std::vector<std::uint8_t>> frame = encodeMesh(level, encode);
+    codec::MeshEncodeOptions encode = options.encode;
+    encode.positionBits = codec::positionBitsForAccuracy(out.accuracy, options.quantizationBudgetFraction);
+    Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(level, encode);
     if (!frame.ok()) return frame.status();
     out.encodedBytes = frame->size();
     out.positionBits = encode.positionBits;
-    out.encodedAccuracy = 1.0 / (d + positionErrorBound(level, encode.positionBits) / diagonal);
+    out.encodedAccuracy = 1.0 / (d + codec::positionErrorBound(level, encode.positionBits) / diagonal);
   }
   return out;
 }

@@ -162,7 +162,7 @@ std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& pr
   KeyHasher h;
   h.text(kFormatName);
   h.number(kMeshCurveFormatVersion);
-  h.number(kFrameVersion);  // encoded sizes depend on the frame layout
+  h.number(codec::kFrameVersion);  // encoded sizes depend on the frame layout
   h.text(producer);
   h.number(static_cast<std::uint64_t>(minTriangles));
   h.number(static_cast<std::uint64_t>(maxTriangles));

@@ -36,7 +36,7 @@
 #include "thinlod/common/accuracy_curve.h"
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/status.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/surface_error.h"
 
@@ -51,7 +51,7 @@ struct MeshCurveOptions {
   SurfaceErrorOptions error{};
   bool measureEncodedBytes = true;
   double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
-  MeshEncodeOptions encode{};               // positionBits is chosen per level
+  codec::MeshEncodeOptions encode{};              // positionBits is chosen per level
 };
 
 struct CurveLevel {

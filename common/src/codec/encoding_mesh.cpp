@@ -11,9 +11,9 @@
 #include <string>
 
 #include "encoding_frame.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 namespace {
 
 constexpr std::uint8_t kCodecDraco = 1;
@@ -268,4 +268,4 @@ Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
   }
 }
 
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

@@ -4,10 +4,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace thinlod::simplifier;
+  using namespace thinlod::codec;
   DecodeLimits limits;
   limits.maxPayloadBytes = 1u << 20;
   limits.maxVertices = 1u << 16;

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "test_meshes.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
 namespace {
 
 using namespace thinlod;
-using namespace thinlod::simplifier;
+using namespace thinlod::codec;
 
 double medianMillis(const std::function<void()>& work) {
   std::vector<double> times;

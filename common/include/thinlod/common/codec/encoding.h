@@ -33,7 +33,7 @@
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/status.h"
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 
 inline constexpr std::uint16_t kFrameVersion = 1;
 inline constexpr std::size_t kFrameHeaderBytes = 32;
@@ -106,4 +106,4 @@ Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
 // the link, not forgery).
 std::uint64_t frameChecksum(const std::uint8_t* data, std::size_t size);
 
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

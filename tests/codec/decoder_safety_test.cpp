@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "test_meshes.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
@@ -192,4 +192,4 @@ TEST(FuzzEntry, ReplaysSeedCorpus) {
 }
 
 }  // namespace
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "encoding_frame.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 namespace {
 
 // A file name only selects OpenImageIO's format plugin; bytes go through
@@ -266,4 +266,4 @@ Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
   }
 }
 
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

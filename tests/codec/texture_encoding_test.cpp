@@ -3,9 +3,9 @@
 #include <cmath>
 #include <random>
 
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 namespace {
 
 // A smooth, impostor-like image: a shaded disc on transparent black.
@@ -142,4 +142,4 @@ TEST(TextureEncoding, DimensionsBeyondTheLimitAreRejectedBeforeDecoding) {
 }
 
 }  // namespace
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

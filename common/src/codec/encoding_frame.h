@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "thinlod/common/status.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 
-namespace thinlod::simplifier::detail {
+namespace thinlod::codec::detail {
 
 struct FrameHeader {
   std::array<char, 4> magic{};
@@ -37,4 +37,4 @@ Result<FrameHeader> parseFrame(const std::uint8_t* data, std::size_t size,
                                const std::array<char, 4>& magic, const DecodeLimits& limits,
                                const char* what);
 
-}  // namespace thinlod::simplifier::detail
+}  // namespace thinlod::codec::detail

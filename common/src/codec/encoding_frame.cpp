@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 
 std::uint64_t frameChecksum(const std::uint8_t* data, std::size_t size) {
   std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a 64 offset basis
@@ -98,4 +98,4 @@ Result<FrameHeader> parseFrame(const std::uint8_t* data, std::size_t size,
 }
 
 }  // namespace detail
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec

@@ -8,12 +8,15 @@
 #include <tuple>
 
 #include "test_meshes.h"
-#include "thinlod/simplifier/encoding.h"
+#include "thinlod/common/codec/encoding.h"
 #include "thinlod/simplifier/surface_error.h"
 
-namespace thinlod::simplifier {
+namespace thinlod::codec {
 namespace {
 
+using simplifier::measureSurfaceError;
+using simplifier::SurfaceError;
+using simplifier::SurfaceErrorOptions;
 using thinlod::testing::makeIcosphere;
 using thinlod::testing::readObjPositions;
 using thinlod::testing::sharedModelPath;
@@ -185,4 +188,4 @@ TEST(MeshEncoding, OutOfRangeOptionsAreRejected) {
 }
 
 }  // namespace
-}  // namespace thinlod::simplifier
+}  // namespace thinlod::codec
