@@ -95,6 +95,21 @@ Result<Plan> AccuracyCurveScheduler::plan(const SchedulingScene& scene, const Vi
       solver.extract(target, selections);
     }
   }
+  // Solver sums and plan sums round differently; the cap is hard, so step
+  // the target down by a hair until the plan itself fits (never seen in
+  // tests, bounded here).
+  for (int retry = 0; retry < 8 && useSolver && !withinBudget(selections, hard); ++retry) {
+    target *= 1.0 - 1e-9 * double(1 << (2 * retry));
+    selections.clear();
+    JointSolver again(scene, config_, region, state, hard, plan.stats);
+    if (again.feasible(target)) again.extract(target, selections);
+  }
+  if (!withinBudget(selections, hard)) {
+    for (LeafSelection& s : selections) {
+      s.rendered = false;  // last resort: render nothing, report as dropped
+      s.dropped = true;
+    }
+  }
   preferCurrentCopies(scene, config_, region, state, hard, trianglesFirst, selections, plan.stats);
   state.previousTarget = target;
 
