@@ -1,0 +1,93 @@
+// SimplifierService: answers the backbone's SimplifyRequest / ImpostorRequest
+// with protocol results (the library behind `thinlod-simplifier serve`).
+//
+// Contract:
+// - Scenes are loaded on demand from SimplifyRequest.sourcePath, which must
+//   resolve (realpath) inside options.sceneRoot; objects are numbered by
+//   scene::collectSceneObjects. ImpostorRequests carry no path: they use
+//   options.defaultScenePath when set, else the scene loaded most recently.
+// - Meshes: one ProgressiveMesh per object, built once and cached; every
+//   resolution is extracted from it. Its measured curve (MeshCurveCache on
+//   options.curveCacheDir, in memory only when empty) gives the accuracy:
+//   a level is credited with the worst error measured at its ladder rung or
+//   any finer one, plus the Draco quantization bound (docs/simplifier.md).
+//   Primitives use the analytic tessellation error instead.
+// - Mesh bytes are codec frames (encodeMesh: Draco inside); textures are
+//   raw RGBA8 for kRawRgba8, else encodeTextureWith frames. JPEG needs an
+//   opaque texture: impostors have alpha, so a JPEG request gets PNG (the
+//   texture's codec says which).
+// - Impostors: world-space geometry, identity transform, world validity;
+//   representationId/generation stay 0 (the backbone numbers them).
+// - Errors are returned in the result's status, never thrown: kInvalidArgument
+//   (bad path, ids, sizes, kinds, NaN), kNotFound (file, object), kUnsupported
+//   (non-square texture), kResourceExhausted (limits), kUnavailable (no GL,
+//   no scene), kInternal. A failed request leaves the service usable.
+// - Not thread-safe: call from one thread. The GL context is created lazily
+//   by the first impostor request and must only be used from that thread.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/render/offscreen_context.h"
+#include "thinlod/common/status.h"
+#include "thinlod/protocol/messages.h"
+#include "thinlod/simplifier/mesh_curve.h"
+
+namespace thinlod::simplifier {
+
+struct ServiceOptions {
+  std::vector<std::string> modelSearchPaths;  // where scene Inline urls are looked up
+  std::string sceneRoot;         // request paths must lie inside (empty: no path accepted)
+  std::string defaultScenePath;  // optional; must lie inside sceneRoot too
+  std::string curveCacheDir;     // measured-curve files; empty: keep curves in memory only
+  render::Backend backend = render::Backend::kAuto;
+  std::uint32_t defaultTextureSize = 256;    // impostor requests with width = height = 0
+  std::uint32_t maxTextureSize = 2048;       // larger requests: kResourceExhausted
+  std::size_t maxCachedScenes = 4;           // least recently used scenes are dropped
+  int maxPrimitiveTriangles = 65536;         // finest primitive tessellation served
+  std::size_t meshedImpostorTriangles = 64;  // depth-mesh target (QEM) of meshed impostors
+  MeshCurveOptions curve = defaultCurveOptions();
+
+  static MeshCurveOptions defaultCurveOptions();
+};
+
+// Counters for tests and logs (monotone over the service's life).
+struct ServiceStats {
+  std::uint64_t sceneLoads = 0;
+  std::uint64_t progressiveMeshBuilds = 0;
+  std::uint64_t curvesMeasured = 0;  // computed (disk cache miss or no cache)
+  std::uint64_t curvesFromDisk = 0;  // read from the curve cache directory
+  std::uint64_t simplifyRequests = 0;
+  std::uint64_t impostorRequests = 0;
+  std::uint64_t failedRequests = 0;
+};
+
+class SimplifierService {
+ public:
+  explicit SimplifierService(ServiceOptions options);
+  ~SimplifierService();
+  SimplifierService(const SimplifierService&) = delete;
+  SimplifierService& operator=(const SimplifierService&) = delete;
+
+  protocol::SimplifyResult simplify(const protocol::SimplifyRequest& request);
+  protocol::ImpostorResult renderImpostor(const protocol::ImpostorRequest& request);
+
+  // Loads (or finds cached) the scene at `path` and returns its object count.
+  Result<std::size_t> loadScene(const std::string& path);
+  // Creates the GL context now (on the calling thread) instead of on the
+  // first impostor request; kUnavailable names why each back-end failed.
+  Status initializeRendering();
+
+  const ServiceStats& stats() const;
+  const ServiceOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace thinlod::simplifier

@@ -1,0 +1,418 @@
+// SimplifierService (service.h): request validation, the scene cache and the
+// progressive-mesh cache, and SimplifyRequest handling. Impostors are in
+// service_impostor.cpp, level bookkeeping in service_levels.cpp.
+#include "thinlod/simplifier/service.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <new>
+#include <system_error>
+#include <utility>
+
+#include "service_internal.h"
+#include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene_render.h"
+#include "thinlod/protocol/codec.h"
+
+namespace thinlod::simplifier {
+
+using namespace service_detail;
+using codec::MeshEncodeOptions;
+namespace fs = std::filesystem;
+
+namespace {
+
+Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
+
+// Triangle count stored in an encodeMesh frame (header offset 12, u32 LE).
+std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
+  if (frame.size() < codec::kFrameHeaderBytes) return 0;
+  return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |
+         (static_cast<std::uint32_t>(frame[14]) << 16) |
+         (static_cast<std::uint32_t>(frame[15]) << 24);
+}
+
+// True when `path` lies strictly inside `root` (both canonical).
+bool isInside(const fs::path& path, const fs::path& root) {
+  const fs::path relative = path.lexically_relative(root);
+  if (relative.empty() || relative == ".") return false;
+  return *relative.begin() != "..";
+}
+
+template <typename ResultT>
+ResultT failure(std::uint64_t requestId, const Status& status) {
+  ResultT result;
+  result.requestId = requestId;
+  result.status = status;
+  return result;
+}
+
+}  // namespace
+
+MeshCurveOptions ServiceOptions::defaultCurveOptions() {
+  MeshCurveOptions curve;
+  curve.levels = 12;
+  // The service only needs the triangles curve; 30k samples per direction
+  // keep a first measurement of a 6k-triangle mesh well under a second.
+  curve.measureEncodedBytes = false;
+  curve.error.samplesPerMesh = 30000;
+  return curve;
+}
+
+SimplifierService::Impl::Impl(ServiceOptions o) : options(std::move(o)) {
+  if (!options.sceneRoot.empty()) {
+    std::error_code ec;
+    const fs::path root = fs::canonical(options.sceneRoot, ec);
+    if (!ec && fs::is_directory(root, ec)) sceneRootCanonical = root.string();
+  }
+  if (!options.curveCacheDir.empty()) {
+    curveCache = std::make_unique<MeshCurveCache>(options.curveCacheDir);
+  }
+}
+
+SimplifierService::Impl::~Impl() {
+  // GL objects die while the context is current on this thread.
+  if (context) (void)context->makeCurrent();
+  impostors.reset();
+  context.reset();
+}
+
+Result<LoadedScene*> SimplifierService::Impl::scene(const std::string& path) {
+  if (path.empty()) return invalid("scene path is empty");
+  if (sceneRootCanonical.empty()) {
+    return invalid("scene " + path + ": no scene root configured (or it does not exist)");
+  }
+  std::error_code ec;
+  const fs::path lexical = fs::weakly_canonical(fs::path(path), ec);
+  if (ec) return invalid("scene " + path + ": cannot resolve the path: " + ec.message());
+  if (!isInside(lexical, fs::path(sceneRootCanonical))) {
+    return invalid("scene " + path + ": outside the allowed scene root " + sceneRootCanonical);
+  }
+  const fs::path canonical = fs::canonical(lexical, ec);
+  if (ec || !fs::is_regular_file(canonical, ec)) {
+    return Status(ErrorCode::kNotFound, "scene " + path + ": no such file");
+  }
+  // Symlinks inside the root may point outside it: check the real path too.
+  if (!isInside(canonical, fs::path(sceneRootCanonical))) {
+    return invalid("scene " + path + ": resolves outside the allowed scene root " +
+                   sceneRootCanonical);
+  }
+  const std::string key = canonical.string();
+  for (auto& loaded : scenes) {
+    if (loaded->path == key) {
+      loaded->lastUse = ++useClock;
+      lastScene = loaded.get();
+      return loaded.get();
+    }
+  }
+
+  scene::SceneLoadOptions loadOptions;
+  loadOptions.meshSearchPaths = options.modelSearchPaths;
+  Result<scene::Scene> parsed = scene::loadSceneFile(key, loadOptions);
+  if (!parsed.ok()) return parsed.status();
+  auto loaded = std::make_unique<LoadedScene>();
+  loaded->path = key;
+  loaded->scene = std::move(parsed).value();
+  Result<std::vector<scene::SceneObject>> objects = scene::collectSceneObjects(loaded->scene);
+  if (!objects.ok()) return objects.status();
+  loaded->objects = std::move(objects).value();
+  loaded->lighting = scene::sceneLighting(loaded->scene);
+  loaded->lastUse = ++useClock;
+  ++stats.sceneLoads;
+
+  const std::size_t capacity = std::max<std::size_t>(1, options.maxCachedScenes);
+  while (scenes.size() >= capacity) {
+    auto oldest = std::min_element(scenes.begin(), scenes.end(), [](const auto& a, const auto& b) {
+      return a->lastUse < b->lastUse;
+    });
+    if (lastScene == oldest->get()) lastScene = nullptr;
+    scenes.erase(oldest);
+    // Keys of primitive levels point at shapes of the dropped scene. (Their
+    // GPU copies go at the next impostor render, when the renderer sees the
+    // meshes expired.)
+    primitiveLevels.clear();
+    dropUnusedModels();
+  }
+  scenes.push_back(std::move(loaded));
+  lastScene = scenes.back().get();
+  return scenes.back().get();
+}
+
+void SimplifierService::Impl::dropUnusedModels() {
+  for (auto it = meshModels.begin(); it != meshModels.end();) {
+    // Only the model still holds the mesh: its scene is gone.
+    if (it->second->original.use_count() == 1) {
+      it = meshModels.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const IndexedMesh> mesh,
+                                                       const std::string& what) {
+  auto model = std::make_unique<MeshModel>();
+  Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh);
+  if (!pm.ok()) return Status(pm.status().code(), what + ": " + pm.status().message());
+  ++stats.progressiveMeshBuilds;
+  model->pm = std::move(pm).value();
+  model->diameter = mesh->diameter();
+  model->original = std::move(mesh);
+  if (model->pm.maxTriangles() == 0 || !(model->diameter > 0.0)) {
+    return invalid(what + ": no triangles or zero size after cleanup");
+  }
+  MeshModel* raw = model.get();
+  meshModels.emplace(raw->original.get(), std::move(model));
+  return raw;
+}
+
+Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObject& object) {
+  if (!object.fullMesh) return invalid("object " + std::to_string(object.id) + " has no mesh");
+  auto found = meshModels.find(object.fullMesh.get());
+  if (found != meshModels.end()) return found->second.get();
+  return buildModel(object.fullMesh, "object " + std::to_string(object.id));
+}
+
+Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::Bytes& bytes) {
+  const std::uint64_t key =
+      codec::frameChecksum(bytes.data(), bytes.size()) ^ (bytes.size() * 0x9e37u);
+  auto found = sourceMeshModels.find(key);
+  if (found != sourceMeshModels.end()) return found->second.get();
+  Result<IndexedMesh> decoded = codec::decodeMesh(bytes.data(), bytes.size());
+  if (!decoded.ok()) {
+    return Status(decoded.status().code(), "sourceMesh: " + decoded.status().message());
+  }
+  auto mesh = std::make_shared<const IndexedMesh>(std::move(decoded).value());
+  Result<MeshModel*> built = buildModel(mesh, "sourceMesh");
+  if (!built.ok()) return built.status();
+  // Move it from the scene-mesh map into the source map (bounded).
+  auto node = meshModels.extract(mesh.get());
+  constexpr std::size_t kMaxSourceMeshes = 16;
+  if (sourceMeshModels.size() >= kMaxSourceMeshes) sourceMeshModels.erase(sourceMeshModels.begin());
+  MeshModel* raw = node.mapped().get();
+  sourceMeshModels.emplace(key, std::move(node.mapped()));
+  return raw;
+}
+
+Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
+  if (model.curveReady) return Status();
+  Result<MeshCurves> curves = Status(ErrorCode::kInternal, "not measured");
+  if (curveCache) {
+    const int hitsBefore = curveCache->stats().hits;
+    curves = curveCache->getOrMeasure(*model.original, kCurveProducer, model.pm, options.curve);
+    if (curves.ok()) {
+      if (curveCache->stats().hits > hitsBefore) {
+        ++stats.curvesFromDisk;
+      } else {
+        ++stats.curvesMeasured;
+      }
+    }
+  } else {
+    curves = measureMeshCurves(*model.original, model.pm, options.curve);
+    if (curves.ok()) ++stats.curvesMeasured;
+  }
+  if (!curves.ok()) return curves.status();
+  if (curves->levels.empty()) return Status(ErrorCode::kInternal, "measured curve has no levels");
+  model.ladder = creditLevels(curves->levels, options.curve.minRelativeError);
+  model.curveReady = true;
+  return Status();
+}
+
+Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
+    const protocol::SimplifyRequest& request, MeshModel& model) {
+  THINLOD_RETURN_IF_ERROR(ensureCurve(model));
+  const ProgressiveMesh& pm = model.pm;
+  std::size_t target = pm.maxTriangles();
+  if (request.target == protocol::SimplifyRequest::Target::kTriangles) {
+    target = std::min<std::size_t>(request.targetTriangles, pm.maxTriangles());
+  } else {
+    for (const LevelCredit& rung : model.ladder) {
+      if (deliveredLevel(rung.relativeError).accuracy >= request.targetAccuracy) {
+        target = rung.requestedTriangles;
+        break;
+      }
+    }
+  }
+  const IndexedMesh mesh = pm.extract(target);
+  const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
+  const DeliveredLevel delivered = deliveredLevel(credit.relativeError);
+  MeshEncodeOptions encode;
+  encode.positionBits = delivered.positionBits;
+  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
+  if (!frame.ok()) return frame.status();
+
+  protocol::SimplifyResult result;
+  result.mesh = std::move(frame).value();
+  result.triangleCount = frameTriangles(result.mesh);
+  result.accuracy = delivered.accuracy;
+  if (request.curvePoints > 0) {
+    std::vector<AccuracySample> points;
+    for (const LevelCredit& rung : model.ladder) {
+      points.push_back(AccuracySample{deliveredLevel(rung.relativeError).accuracy,
+                                      static_cast<double>(rung.triangles)});
+    }
+    result.curve = curveSamples(std::move(points), request.curvePoints);
+  }
+  return result;
+}
+
+Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyPrimitive(
+    const protocol::SimplifyRequest& request, const PrimitiveShape& shape) {
+  THINLOD_RETURN_IF_ERROR(validatePrimitive(shape));
+  const int maxTriangles = std::clamp(options.maxPrimitiveTriangles, 12, kMaxPrimitiveTriangles);
+  auto delivered = [&](const TessellationParams& p) {
+    return deliveredLevel(tessellationError(shape, p) / primitiveDiameter(shape));
+  };
+  TessellationParams params = chooseTessellation(shape, maxTriangles);
+  if (request.target == protocol::SimplifyRequest::Target::kTriangles) {
+    params = chooseTessellation(
+        shape, static_cast<int>(std::min<std::uint32_t>(request.targetTriangles,
+                                                        static_cast<std::uint32_t>(maxTriangles))));
+  } else {
+    // Ask the tessellation for a little more than the target so that the
+    // quantization the encoder adds still leaves the target reached.
+    double wanted = request.targetAccuracy;
+    for (int attempt = 0; attempt < 8; ++attempt) {
+      Result<TessellationParams> found = tessellationForAccuracy(shape, wanted, maxTriangles);
+      if (!found.ok()) break;  // not reachable within the budget: the finest allowed
+      params = *found;
+      if (delivered(params).accuracy >= request.targetAccuracy) break;
+      wanted *= 1.0 + kQuantizationBudget;
+    }
+  }
+  const IndexedMesh mesh = tessellate(shape, params);
+  const DeliveredLevel level = delivered(params);
+  MeshEncodeOptions encode;
+  encode.positionBits = level.positionBits;
+  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
+  if (!frame.ok()) return frame.status();
+
+  protocol::SimplifyResult result;
+  result.mesh = std::move(frame).value();
+  result.triangleCount = frameTriangles(result.mesh);
+  result.accuracy = level.accuracy;
+  if (request.curvePoints > 0) {
+    const int coarsest = tessellationTriangles(shape, chooseTessellation(shape, 0));
+    const int finest = std::min(maxTriangles, 16384);
+    std::vector<AccuracySample> points;
+    const int rungs = std::max(16, static_cast<int>(request.curvePoints));
+    for (std::size_t count : geometricLadder(static_cast<std::size_t>(coarsest),
+                                             static_cast<std::size_t>(std::max(coarsest, finest)),
+                                             std::min(rungs, 64))) {
+      const TessellationParams p = chooseTessellation(shape, static_cast<int>(count));
+      points.push_back(AccuracySample{delivered(p).accuracy,
+                                      static_cast<double>(tessellationTriangles(shape, p))});
+    }
+    result.curve = curveSamples(std::move(points), request.curvePoints);
+  }
+  return result;
+}
+
+SimplifierService::SimplifierService(ServiceOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {}
+
+SimplifierService::~SimplifierService() = default;
+
+const ServiceStats& SimplifierService::stats() const { return impl_->stats; }
+const ServiceOptions& SimplifierService::options() const { return impl_->options; }
+
+Result<std::size_t> SimplifierService::loadScene(const std::string& path) {
+  try {
+    Result<LoadedScene*> loaded = impl_->scene(path);
+    if (!loaded.ok()) return loaded.status();
+    return (*loaded)->objects.size();
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kResourceExhausted, "scene " + path + ": out of memory");
+  } catch (const std::exception& e) {
+    return Status(ErrorCode::kInternal, "scene " + path + ": " + e.what());
+  }
+}
+
+protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyRequest& request) {
+  ++impl_->stats.simplifyRequests;
+  Result<protocol::SimplifyResult> result = Status(ErrorCode::kInternal, "not handled");
+  try {
+    const Status valid = protocol::validate(protocol::Message(request));
+    if (!valid.ok()) {
+      result = valid;
+    } else if (!request.sourceMesh.empty()) {
+      Result<MeshModel*> model = impl_->meshModelForSource(request.sourceMesh);
+      result = model.ok() ? impl_->simplifyMesh(request, **model)
+                          : Result<protocol::SimplifyResult>(model.status());
+    } else {
+      Result<LoadedScene*> loaded = impl_->scene(request.sourcePath);
+      if (!loaded.ok()) {
+        result = loaded.status();
+      } else if (const scene::SceneObject* object =
+                     scene::findSceneObject((*loaded)->objects, request.objectId)) {
+        if (object->shape != nullptr &&
+            object->shape->geometry.kind == scene::GeometryKind::kPrimitive) {
+          result = impl_->simplifyPrimitive(request, object->shape->geometry.primitive);
+        } else {
+          Result<MeshModel*> model = impl_->meshModelFor(*object);
+          result = model.ok() ? impl_->simplifyMesh(request, **model)
+                              : Result<protocol::SimplifyResult>(model.status());
+        }
+      } else {
+        result = Status(ErrorCode::kNotFound, "object " + std::to_string(request.objectId) +
+                                                  " not in scene " + (*loaded)->path + " (" +
+                                                  std::to_string((*loaded)->objects.size()) +
+                                                  " objects)");
+      }
+    }
+  } catch (const std::bad_alloc&) {
+    result = Status(ErrorCode::kResourceExhausted, "simplify: out of memory");
+  } catch (const std::exception& e) {
+    result = Status(ErrorCode::kInternal, std::string("simplify: ") + e.what());
+  }
+  if (result.ok()) {
+    result->requestId = request.requestId;
+    result->objectId = request.objectId;
+    // What we answer must pass the peer's decoder.
+    const Status sendable = protocol::validate(protocol::Message(*result));
+    if (!sendable.ok()) result = sendable;
+  }
+  if (!result.ok()) {
+    ++impl_->stats.failedRequests;
+    protocol::SimplifyResult failed =
+        failure<protocol::SimplifyResult>(request.requestId, result.status());
+    failed.objectId = request.objectId;
+    return failed;
+  }
+  return std::move(result).value();
+}
+
+protocol::ImpostorResult SimplifierService::renderImpostor(
+    const protocol::ImpostorRequest& request) {
+  ++impl_->stats.impostorRequests;
+  Result<protocol::Representation> representation = Status(ErrorCode::kInternal, "not handled");
+  try {
+    const Status valid = protocol::validate(protocol::Message(request));
+    representation =
+        valid.ok() ? impl_->impostor(request) : Result<protocol::Representation>(valid);
+  } catch (const std::bad_alloc&) {
+    representation = Status(ErrorCode::kResourceExhausted, "impostor: out of memory");
+  } catch (const std::exception& e) {
+    representation = Status(ErrorCode::kInternal, std::string("impostor: ") + e.what());
+  }
+  protocol::ImpostorResult result;
+  result.requestId = request.requestId;
+  result.objectIds = request.objectIds;
+  if (representation.ok()) {
+    result.representation = std::move(representation).value();
+    const Status sendable = protocol::validate(protocol::Message(result));
+    if (!sendable.ok()) {
+      result.representation = protocol::Representation();
+      result.status = sendable;
+    }
+  } else {
+    result.status = representation.status();
+  }
+  if (!result.status.ok()) ++impl_->stats.failedRequests;
+  return result;
+}
+
+}  // namespace thinlod::simplifier

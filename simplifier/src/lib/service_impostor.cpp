@@ -1,0 +1,309 @@
+// SimplifierService: ImpostorRequest handling (service.h). Objects are drawn
+// in world space from the coarsest level whose error stays under half a
+// texel, then the quad / depth mesh and the texture are encoded.
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <set>
+#include <string>
+
+#include "service_internal.h"
+#include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/scene_render.h"
+
+namespace thinlod::simplifier {
+
+using namespace service_detail;
+
+namespace {
+
+// Levels kept per mesh for impostor rendering (each holds a GPU copy).
+constexpr std::size_t kMaxRenderLevelsPerMesh = 4;
+// Share of a texel that Draco may move a quad / depth-mesh vertex.
+constexpr double kImpostorQuantizationTexels = 0.25;
+
+Status invalid(const std::string& message) {
+  return Status(ErrorCode::kInvalidArgument, "impostor: " + message);
+}
+
+std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
+  if (frame.size() < codec::kFrameHeaderBytes) return 0;
+  return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |
+         (static_cast<std::uint32_t>(frame[14]) << 16) |
+         (static_cast<std::uint32_t>(frame[15]) << 24);
+}
+
+bool opaque(const render::RgbaImage& image) {
+  for (std::size_t i = 3; i < image.pixels.size(); i += 4) {
+    if (image.pixels[i] != 255) return false;
+  }
+  return true;
+}
+
+Result<protocol::Texture> encodeTexture(const render::RgbaImage& image,
+                                        protocol::TextureCodec requested) {
+  protocol::Texture texture;
+  texture.width = static_cast<std::uint32_t>(image.width);
+  texture.height = static_cast<std::uint32_t>(image.height);
+  if (requested == protocol::TextureCodec::kRawRgba8) {
+    texture.codec = requested;
+    texture.data = image.pixels;
+    return texture;
+  }
+  codec::TextureRGBA8 pixels;
+  pixels.width = texture.width;
+  pixels.height = texture.height;
+  pixels.pixels = image.pixels;
+  codec::TextureCodec used = codec::TextureCodec::kPng;
+  texture.codec = protocol::TextureCodec::kPng;
+  if (requested == protocol::TextureCodec::kZstdRgba8) {
+    used = codec::TextureCodec::kZstd;
+    texture.codec = requested;
+  } else if (requested == protocol::TextureCodec::kJpeg && opaque(image)) {
+    used = codec::TextureCodec::kJpeg;
+    texture.codec = requested;
+  }
+  Result<std::vector<std::uint8_t>> bytes = codec::encodeTextureWith(pixels, used);
+  if (!bytes.ok()) return bytes.status();
+  texture.data = std::move(bytes).value();
+  return texture;
+}
+
+// thinlod::ConicRange (double) -> wire ConicRange (float), rounded outwards
+// so that the capture viewpoint stays inside after the conversion.
+protocol::ConicRange toWire(const ConicRange& range) {
+  protocol::ConicRange wire;
+  wire.center = glm::vec3(range.center());
+  wire.distanceMin = std::max(0.0f, std::nextafter(static_cast<float>(range.minDistance()), 0.0f));
+  wire.distanceMax = std::isfinite(range.maxDistance())
+                         ? std::nextafter(static_cast<float>(range.maxDistance()), INFINITY)
+                         : INFINITY;
+  wire.direction = glm::vec3(glm::normalize(range.direction()));
+  const float pi = 3.14159265358979f;
+  wire.halfAngle = std::min(pi, std::nextafter(static_cast<float>(range.alpha()), pi));
+  return wire;
+}
+
+}  // namespace
+
+Status SimplifierService::Impl::ensureRendering() {
+  if (impostors) return context->isCurrent() ? Status() : context->makeCurrent();
+  Result<std::unique_ptr<render::OffscreenContext>> created =
+      render::createOffscreenContext(options.backend, 16, 16);
+  if (!created.ok()) {
+    return Status(ErrorCode::kUnavailable,
+                  "impostor rendering unavailable: " + created.status().message());
+  }
+  context = std::move(created).value();
+  Result<std::unique_ptr<ImpostorRenderer>> renderer = ImpostorRenderer::create(*context);
+  if (!renderer.ok()) {
+    context.reset();
+    return Status(ErrorCode::kUnavailable,
+                  "impostor rendering unavailable: " + renderer.status().message());
+  }
+  impostors = std::move(renderer).value();
+  return Status();
+}
+
+Result<protocol::Representation> SimplifierService::Impl::impostor(
+    const protocol::ImpostorRequest& request) {
+  // --- Request checks beyond the wire rules (validate() ran already). ---
+  if (request.kind == protocol::RepresentationKind::kMesh) {
+    return invalid("kind must be an impostor kind, not mesh");
+  }
+  if (request.textureCodec == protocol::TextureCodec::kNone) {
+    return invalid("texture codec must not be none");
+  }
+  if (!(request.accuracyBound > 0.0) || !std::isfinite(request.accuracyBound)) {
+    return invalid("accuracyBound (largest angular error, rad) must be positive and finite");
+  }
+  if (!std::isfinite(request.eye.x) || !std::isfinite(request.eye.y) ||
+      !std::isfinite(request.eye.z)) {
+    return invalid("eye is not finite");
+  }
+  std::uint32_t size = request.textureWidth;
+  if (request.textureWidth == 0 && request.textureHeight == 0) size = options.defaultTextureSize;
+  if (request.textureWidth != request.textureHeight) {
+    return Status(ErrorCode::kUnsupported, "impostor: textures are square; asked for " +
+                                               std::to_string(request.textureWidth) + "x" +
+                                               std::to_string(request.textureHeight));
+  }
+  const std::uint32_t maxSize = std::min<std::uint32_t>(options.maxTextureSize, 4096);
+  if (size < 8) return invalid("texture size " + std::to_string(size) + " below 8");
+  if (size > maxSize) {
+    return Status(ErrorCode::kResourceExhausted, "impostor: texture size " + std::to_string(size) +
+                                                     " above the limit " + std::to_string(maxSize));
+  }
+  if (request.objectIds.empty()) return invalid("no object ids");
+  std::set<std::uint64_t> unique(request.objectIds.begin(), request.objectIds.end());
+  if (unique.size() != request.objectIds.size()) return invalid("object ids repeat");
+
+  // --- Scene and objects. ---
+  const LoadedScene* loaded = lastScene;
+  if (!options.defaultScenePath.empty()) {
+    Result<LoadedScene*> found = scene(options.defaultScenePath);
+    if (!found.ok()) return found.status();
+    loaded = *found;
+  }
+  if (loaded == nullptr) {
+    return Status(ErrorCode::kUnavailable,
+                  "impostor: no scene loaded (configure a default scene or send a "
+                  "SimplifyRequest with the scene path first)");
+  }
+  std::vector<const scene::SceneObject*> objects;
+  for (std::uint64_t id : request.objectIds) {
+    const scene::SceneObject* object = scene::findSceneObject(loaded->objects, id);
+    if (object == nullptr || object->shape == nullptr || !object->fullMesh) {
+      return Status(ErrorCode::kNotFound,
+                    "impostor: object " + std::to_string(id) + " not in scene " + loaded->path);
+    }
+    objects.push_back(object);
+  }
+  THINLOD_RETURN_IF_ERROR(ensureRendering());
+
+  // --- Texel size from a framing of the full meshes. ---
+  ImpostorOptions base;
+  base.textureSize = static_cast<int>(size);
+  base.maxAngularError = request.accuracyBound;
+  base.up = request.orientation * glm::vec3(0.0f, 1.0f, 0.0f);
+  std::vector<glm::vec3> points;
+  Bounds worldBounds;
+  for (const scene::SceneObject* object : objects) {
+    std::vector<unsigned char> referenced(object->fullMesh->vertexCount(), 0);
+    for (std::uint32_t index : object->fullMesh->indices) referenced[index] = 1;
+    for (std::size_t v = 0; v < referenced.size(); ++v) {
+      if (!referenced[v]) continue;
+      const glm::vec3 p =
+          glm::vec3(object->objectToWorld * glm::vec4(object->fullMesh->positions[v], 1.0f));
+      points.push_back(p);
+      worldBounds.extend(p);
+    }
+  }
+  Result<ImpostorFraming> framing = frameImpostor(points, request.eye, base);
+  if (!framing.ok()) return framing.status();
+  // Smallest texel footprint on the object: at its nearest depth.
+  const double texelAtPlane =
+      std::min(framing->quad.width, framing->quad.height) / static_cast<double>(size);
+  const double nearScale = framing->planeDistance > 0.0f
+                               ? std::max(0.0f, framing->nearDepth) / framing->planeDistance
+                               : 1.0;
+  const double allowedError = 0.5 * texelAtPlane * nearScale;
+
+  // --- The coarsest level of each object within half a texel. ---
+  ImpostorScene impostorScene;
+  impostorScene.lighting = loaded->lighting;
+  double levelError = 0.0;  // world metres, largest over the objects
+  const int maxPrimitiveTriangles =
+      std::clamp(options.maxPrimitiveTriangles, 12, kMaxPrimitiveTriangles);
+  for (const scene::SceneObject* object : objects) {
+    const double scale = scene::maxScale(object->objectToWorld);
+    std::shared_ptr<const IndexedMesh> mesh;
+    const scene::Geometry& geometry = object->shape->geometry;
+    if (geometry.kind == scene::GeometryKind::kPrimitive) {
+      const PrimitiveShape& shape = geometry.primitive;
+      THINLOD_RETURN_IF_ERROR(validatePrimitive(shape));
+      TessellationParams params = chooseTessellation(shape, maxPrimitiveTriangles);
+      if (allowedError > 0.0 && scale > 0.0) {
+        const double needed = primitiveDiameter(shape) * scale / allowedError;
+        Result<TessellationParams> found =
+            tessellationForAccuracy(shape, needed, maxPrimitiveTriangles);
+        if (found.ok()) params = *found;
+      }
+      const PrimitiveLevelKey key{object->shape, params.segments, params.rings};
+      auto cached = primitiveLevels.find(key);
+      if (cached == primitiveLevels.end()) {
+        cached = primitiveLevels
+                     .emplace(key, std::make_shared<const IndexedMesh>(tessellate(shape, params)))
+                     .first;
+      }
+      mesh = cached->second;
+      levelError = std::max(levelError, tessellationError(shape, params) * scale);
+    } else {
+      Result<MeshModel*> model = meshModelFor(*object);
+      if (!model.ok()) return model.status();
+      THINLOD_RETURN_IF_ERROR(ensureCurve(**model));
+      MeshModel& m = **model;
+      const double allowedRelative = allowedError / (m.diameter * scale);
+      const LevelCredit* chosen = nullptr;
+      for (const LevelCredit& rung : m.ladder) {
+        if (rung.relativeError <= allowedRelative) {
+          chosen = &rung;
+          break;
+        }
+      }
+      if (chosen == nullptr) {
+        mesh = m.original;  // nothing coarser is fine enough: the full mesh (error 0)
+      } else {
+        auto cached = m.renderLevels.find(chosen->requestedTriangles);
+        if (cached == m.renderLevels.end()) {
+          if (m.renderLevels.size() >= kMaxRenderLevelsPerMesh) {
+            m.renderLevels.erase(m.renderLevels.begin());
+          }
+          cached =
+              m.renderLevels
+                  .emplace(
+                      chosen->requestedTriangles,
+                      std::make_shared<const IndexedMesh>(m.pm.extract(chosen->requestedTriangles)))
+                  .first;
+        }
+        mesh = cached->second;
+        levelError = std::max(levelError, chosen->relativeError * m.diameter * scale);
+      }
+    }
+    impostorScene.parts.push_back(
+        ImpostorPart{mesh, object->objectToWorld, scene::shapeMaterial(*object->shape)});
+  }
+
+  // --- Render. ---
+  protocol::Representation representation;
+  representation.kind = request.kind;
+  render::RgbaImage image;
+  IndexedMesh geometry;
+  ImpostorFraming rendered;
+  if (request.kind == protocol::RepresentationKind::kSimpleImpostor) {
+    Result<SimpleImpostor> simple = impostors->renderSimple(impostorScene, request.eye, base);
+    if (!simple.ok()) return simple.status();
+    image = std::move(simple->texture);
+    geometry = simple->quad.mesh();
+    rendered = simple->framing;
+    representation.validity = toWire(simple->validity);
+  } else {
+    MeshedImpostorOptions meshed;
+    static_cast<ImpostorOptions&>(meshed) = base;
+    meshed.gridStep = std::clamp(static_cast<int>(size) / 32, 2, 16);
+    meshed.targetTriangles = options.meshedImpostorTriangles;
+    Result<MeshedImpostor> result = impostors->renderMeshed(impostorScene, request.eye, meshed);
+    if (!result.ok()) return result.status();
+    image = std::move(result->texture);
+    geometry = std::move(result->mesh);
+    rendered = result->framing;
+    representation.validity = toWire(result->validity);
+  }
+
+  // --- Encode. ---
+  const double texel =
+      std::max(rendered.quad.width, rendered.quad.height) / static_cast<double>(size);
+  codec::MeshEncodeOptions encode;
+  const double meshDiagonal = geometry.diameter();
+  encode.positionBits = codec::positionBitsForAccuracy(
+      texel > 0.0 ? meshDiagonal / texel : kExactRelativeAccuracy, kImpostorQuantizationTexels);
+  // uv steps of at most 1/16 texel.
+  encode.texcoordBits =
+      std::clamp(static_cast<int>(std::ceil(std::log2(static_cast<double>(size)))) + 4, 12, 20);
+  Result<std::vector<std::uint8_t>> meshBytes = codec::encodeMesh(geometry, encode);
+  if (!meshBytes.ok()) return meshBytes.status();
+  representation.mesh = std::move(meshBytes).value();
+  representation.triangleCount = frameTriangles(representation.mesh);
+  Result<protocol::Texture> texture = encodeTexture(image, request.textureCodec);
+  if (!texture.ok()) return texture.status();
+  representation.texture = std::move(texture).value();
+  representation.transform = glm::mat4(1.0f);
+  // Relative accuracy the texture supports: detail finer than two texels is
+  // lost, plus the error of the level it was rendered from (docs/simplifier.md).
+  const double diameter = worldBounds.diagonal();
+  representation.accuracy = diameter / (2.0 * texel + levelError);
+  return representation;
+}
+
+}  // namespace thinlod::simplifier

@@ -1,0 +1,134 @@
+// Private parts of SimplifierService (service.h): caches and the level
+// bookkeeping shared by service.cpp, service_levels.cpp and
+// service_impostor.cpp.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/primitives.h"
+#include "thinlod/common/render/camera.h"
+#include "thinlod/common/scene.h"
+#include "thinlod/common/scene_objects.h"
+#include "thinlod/simplifier/impostor.h"
+#include "thinlod/simplifier/mesh_curve.h"
+#include "thinlod/simplifier/progressive_mesh.h"
+#include "thinlod/simplifier/service.h"
+
+namespace thinlod::simplifier::service_detail {
+
+// Tag of the progressive-mesh producer in curve cache keys: change it when
+// BuildOptions or the simplifier's behaviour change.
+inline constexpr const char* kCurveProducer = "qem-service v1 boundaries=1 flips=1";
+// Share of a level's error budget that Draco quantization may add.
+inline constexpr double kQuantizationBudget = 0.1;
+
+// One rung of a measured ladder with the error we credit it with.
+struct LevelCredit {
+  std::size_t requestedTriangles = 0;  // what to pass to ProgressiveMesh::extract
+  std::size_t triangles = 0;           // what extraction returns
+  double relativeError = 0.0;          // max over this and every finer rung of max(d, floor)
+};
+
+// Worst relative displacement (fraction of the bbox diagonal) of Draco
+// quantization with `bits` position bits: half a step per axis, step <=
+// diagonal / (2^bits - 1).
+double quantizationError(int bits);
+// Relative accuracy the client decodes: 1 / (geometric d + quantization),
+// with the position bits positionBitsForAccuracy chooses for 1/d.
+struct DeliveredLevel {
+  int positionBits = 0;
+  double accuracy = 0.0;
+};
+DeliveredLevel deliveredLevel(double relativeError);
+
+// Credits from measured levels (increasing triangles): each rung gets the
+// worst error measured at it or any finer rung, so credits never improve by
+// coarsening and never exceed what was measured at or above the rung.
+std::vector<LevelCredit> creditLevels(const std::vector<CurveLevel>& levels,
+                                      double minRelativeError);
+// Index of the rung that bounds a level of `triangles` triangles: the finest
+// rung with at most that many (0 when none: rung 0 has the largest credit).
+std::size_t creditFor(const std::vector<LevelCredit>& ladder, std::size_t triangles);
+
+// (accuracy, triangles) points, strictly increasing in both, subsampled to at
+// most `count` (first and last kept). count == 0: none.
+std::vector<AccuracySample> curveSamples(std::vector<AccuracySample> points, std::size_t count);
+
+// A mesh object's simplification state, shared by every object that uses
+// the same full mesh.
+struct MeshModel {
+  std::shared_ptr<const IndexedMesh> original;
+  double diameter = 0.0;  // original's bbox diagonal (relative accuracy's size)
+  ProgressiveMesh pm;
+  bool curveReady = false;
+  std::vector<LevelCredit> ladder;
+  // Levels kept for impostor rendering (their GPU copies live as long as these).
+  std::map<std::size_t, std::shared_ptr<const IndexedMesh>> renderLevels;
+};
+
+struct LoadedScene {
+  std::string path;  // canonical
+  scene::Scene scene;
+  std::vector<scene::SceneObject> objects;
+  render::Lighting lighting;
+  std::uint64_t lastUse = 0;
+};
+
+// A primitive tessellation kept for impostor rendering.
+struct PrimitiveLevelKey {
+  const scene::ShapeNode* shape = nullptr;
+  int segments = 0;
+  int rings = 0;
+  bool operator<(const PrimitiveLevelKey& o) const {
+    if (shape != o.shape) return shape < o.shape;
+    if (segments != o.segments) return segments < o.segments;
+    return rings < o.rings;
+  }
+};
+
+}  // namespace thinlod::simplifier::service_detail
+
+namespace thinlod::simplifier {
+
+struct SimplifierService::Impl {
+  ServiceOptions options;
+  ServiceStats stats;
+  std::string sceneRootCanonical;  // empty: no root configured or it does not exist
+  std::vector<std::unique_ptr<service_detail::LoadedScene>> scenes;
+  std::uint64_t useClock = 0;
+  const service_detail::LoadedScene* lastScene = nullptr;
+  std::map<const IndexedMesh*, std::unique_ptr<service_detail::MeshModel>> meshModels;
+  std::map<std::uint64_t, std::unique_ptr<service_detail::MeshModel>> sourceMeshModels;
+  std::map<service_detail::PrimitiveLevelKey, std::shared_ptr<const IndexedMesh>> primitiveLevels;
+  std::unique_ptr<MeshCurveCache> curveCache;
+  // Rendering (created lazily on the calling thread; renderer before context).
+  std::unique_ptr<render::OffscreenContext> context;
+  std::unique_ptr<ImpostorRenderer> impostors;
+
+  explicit Impl(ServiceOptions o);
+  ~Impl();
+
+  Result<service_detail::LoadedScene*> scene(const std::string& path);
+  Result<service_detail::MeshModel*> meshModelFor(const scene::SceneObject& object);
+  Result<service_detail::MeshModel*> meshModelForSource(const protocol::Bytes& bytes);
+  Result<service_detail::MeshModel*> buildModel(std::shared_ptr<const IndexedMesh> mesh,
+                                                const std::string& what);
+  Status ensureCurve(service_detail::MeshModel& model);
+  Status ensureRendering();
+  void dropUnusedModels();
+
+  Result<protocol::SimplifyResult> simplifyMesh(const protocol::SimplifyRequest& request,
+                                                service_detail::MeshModel& model);
+  Result<protocol::SimplifyResult> simplifyPrimitive(const protocol::SimplifyRequest& request,
+                                                     const PrimitiveShape& shape);
+  Result<protocol::Representation> impostor(const protocol::ImpostorRequest& request);
+};
+
+}  // namespace thinlod::simplifier

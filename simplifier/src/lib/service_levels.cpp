@@ -1,0 +1,78 @@
+// Level bookkeeping of SimplifierService: how much accuracy a progressive-mesh
+// level or a tessellation is credited with, and the curve samples sent to the
+// backbone. Pure functions (service_internal.h).
+#include <algorithm>
+#include <cmath>
+
+#include "service_internal.h"
+#include "thinlod/common/codec/encoding.h"
+
+namespace thinlod::simplifier::service_detail {
+
+double quantizationError(int bits) {
+  const double steps = std::ldexp(1.0, bits) - 1.0;
+  return 0.5 * std::sqrt(3.0) / steps;
+}
+
+DeliveredLevel deliveredLevel(double relativeError) {
+  DeliveredLevel out;
+  const double d = std::max(relativeError, 0.0);
+  // A zero error (exact primitive) still asks for the finest bits.
+  const double accuracy = d > 0.0 ? 1.0 / d : kExactRelativeAccuracy;
+  out.positionBits = codec::positionBitsForAccuracy(accuracy, kQuantizationBudget);
+  out.accuracy = 1.0 / (d + quantizationError(out.positionBits));
+  return out;
+}
+
+std::vector<LevelCredit> creditLevels(const std::vector<CurveLevel>& levels,
+                                      double minRelativeError) {
+  std::vector<LevelCredit> ladder(levels.size());
+  double worstFiner = 0.0;
+  for (std::size_t i = levels.size(); i-- > 0;) {
+    const double d = std::max(levels[i].relativeMaxError, minRelativeError);
+    worstFiner = std::max(worstFiner, d);
+    ladder[i].requestedTriangles = levels[i].requestedTriangles;
+    ladder[i].triangles = levels[i].triangles;
+    ladder[i].relativeError = worstFiner;
+  }
+  return ladder;
+}
+
+std::size_t creditFor(const std::vector<LevelCredit>& ladder, std::size_t triangles) {
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < ladder.size(); ++i) {
+    if (ladder[i].triangles <= triangles) best = i;
+  }
+  return best;
+}
+
+std::vector<AccuracySample> curveSamples(std::vector<AccuracySample> points, std::size_t count) {
+  std::sort(points.begin(), points.end(), [](const AccuracySample& a, const AccuracySample& b) {
+    return a.resources < b.resources || (a.resources == b.resources && a.accuracy > b.accuracy);
+  });
+  // Keep a point only if it buys more accuracy than every cheaper one: a
+  // dominated level is never the cheapest way to reach an accuracy.
+  std::vector<AccuracySample> front;
+  for (const AccuracySample& p : points) {
+    if (!std::isfinite(p.accuracy) || !(p.accuracy > 0.0)) continue;
+    if (!front.empty() && (p.accuracy <= front.back().accuracy)) continue;
+    if (!front.empty() && p.resources == front.back().resources) continue;
+    front.push_back(p);
+  }
+  if (count == 0) return {};
+  if (front.size() <= count) return front;
+  if (count == 1) return {front.back()};
+  std::vector<AccuracySample> picked;
+  picked.reserve(count);
+  const double last = static_cast<double>(front.size() - 1);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto index = static_cast<std::size_t>(
+        std::llround(last * static_cast<double>(i) / static_cast<double>(count - 1)));
+    if (picked.empty() || front[index].resources > picked.back().resources) {
+      picked.push_back(front[index]);
+    }
+  }
+  return picked;
+}
+
+}  // namespace thinlod::simplifier::service_detail
