@@ -1,0 +1,50 @@
+// BackboneLink over a protocol::Channel (role kFrontend): waits on the
+// channel and the runtime's wake fd together, so a signal ends any wait at
+// once; logs connection changes. The Channel reconnects by itself.
+// One thread; the wake fd must outlive the link.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "replay_loop.h"
+#include "thinlod/protocol/transport.h"
+
+namespace thinlod::frontend::daemon {
+
+class ChannelLink final : public BackboneLink {
+ public:
+  // `name` must be unique among the backbone's frontends (docs/protocol.md).
+  static Result<std::unique_ptr<ChannelLink>> connect(const std::string& address,
+                                                      const std::string& name,
+                                                      const protocol::TransportOptions& transport,
+                                                      int wakeFd);
+
+  bool connected() const override;
+  Status send(const protocol::Message& message) override;
+  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout) override;
+  std::uint64_t bytesReceived() const override;
+
+  // Polls until the handshake is done, `timeout` passes or stop() is true,
+  // logging progress every `progressEvery`. SceneUpdates arriving meanwhile
+  // are kept for the next poll(). True when connected.
+  bool waitConnected(std::chrono::milliseconds timeout, std::chrono::milliseconds progressEvery,
+                     const std::function<bool()>& stop);
+
+ private:
+  explicit ChannelLink(std::unique_ptr<protocol::Channel> channel, int wakeFd);
+  void drain(std::chrono::milliseconds timeout);
+
+  std::unique_ptr<protocol::Channel> channel_;
+  protocol::Poller poller_;
+  std::string address_;
+  std::vector<protocol::SceneUpdate> received_;
+};
+
+// "frontend@<host>#<pid>": unique per process on a host.
+std::string defaultPeerName();
+
+}  // namespace thinlod::frontend::daemon

@@ -1,0 +1,73 @@
+#include "daemon_options.h"
+
+#include <cmath>
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+Status invalid(const std::string& option, const std::string& problem) {
+  return Status(ErrorCode::kInvalidArgument, "--" + option + ": " + problem);
+}
+
+}  // namespace
+
+void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
+  runtime.addOption("backbone.address", &o->backboneAddress, "backbone address to connect to");
+  runtime.addOption("scene", &o->scenePath,
+                    "scene file (object ids, reference frames, lights, mesh colours); required "
+                    "unless --no-reference");
+  runtime.addOption("models-dir", &o->modelsDir, "directory searched for the scene's mesh files");
+  runtime.addOption("trace", &o->tracePath, "flight path to replay (docs/trace-format.md)");
+  runtime.addOption("width", &o->width, "frame width, pixels");
+  runtime.addOption("height", &o->height, "frame height, pixels");
+  runtime.addOption("backend", &o->backend, "offscreen GL: auto|egl|osmesa");
+  runtime.addOption("rate", &o->rate,
+                    "replay speed, frames per second; 0 = the trace's own timing; negative = "
+                    "unpaced (each frame as soon as the previous one is done)");
+  runtime.addOption("lockstep", &o->lockstep,
+                    "wait for the backbone's SceneUpdate of each frame before rendering it");
+  runtime.addOption("lockstep-timeout-ms", &o->lockstepTimeoutMs,
+                    "longest lockstep wait per frame, ms");
+  runtime.addOption("max-upload-bytes-per-frame", &o->maxUploadBytesPerFrame,
+                    "representation bytes uploaded to the GPU per frame; 0 = unbounded");
+  runtime.addOption("csv", &o->csvPath, "per-frame CSV output (empty: none)");
+  runtime.addOption("summary-json", &o->summaryJsonPath, "run summary JSON output (empty: none)");
+  runtime.addOption("frames-dir", &o->framesDir,
+                    "directory for frame_NNNN.png / reference_NNNN.png dumps (empty: none)");
+  runtime.addOption("dump-every", &o->dumpEvery, "dump every Nth frame (with --frames-dir)");
+  runtime.addOption("no-reference", &o->noReference,
+                    "skip the full-quality reference and SNR (pure latency runs)");
+  runtime.addOption("frames", &o->frames, "stop after N frames; 0 = the whole trace");
+  runtime.addOption("label", &o->label, "run name written into the summary");
+  runtime.addOption("connect-timeout-ms", &o->connectTimeoutMs,
+                    "how long to wait for the backbone handshake before replaying anyway, ms");
+  runtime.addTransportOptions(&o->transport);
+}
+
+Result<render::Backend> parseBackend(const std::string& name) {
+  if (name == "auto") return render::Backend::kAuto;
+  if (name == "egl") return render::Backend::kEgl;
+  if (name == "osmesa") return render::Backend::kOsMesa;
+  return invalid("backend", "'" + name + "' is not one of auto, egl, osmesa");
+}
+
+Status validateOptions(const DaemonOptions& o) {
+  if (o.tracePath.empty()) return invalid("trace", "a flight path is required");
+  if (o.scenePath.empty() && !o.noReference) {
+    return invalid("scene",
+                   "a scene file is required for the reference frames (or --no-reference)");
+  }
+  if (o.backboneAddress.empty()) return invalid("backbone.address", "empty");
+  if (o.width < 1 || o.width > 16384) return invalid("width", "outside 1..16384");
+  if (o.height < 1 || o.height > 16384) return invalid("height", "outside 1..16384");
+  if (!parseBackend(o.backend).ok()) return parseBackend(o.backend).status();
+  if (!std::isfinite(o.rate)) return invalid("rate", "not finite");
+  if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
+  if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");
+  if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");
+  if (o.frames < 0) return invalid("frames", "negative");
+  if (o.connectTimeoutMs < 0) return invalid("connect-timeout-ms", "negative");
+  return Status();
+}
+
+}  // namespace thinlod::frontend::daemon

@@ -1,0 +1,250 @@
+// thinlod-frontend: replays a flight path against the backbone, renders what
+// it holds every frame, measures each frame against the full-quality
+// reference and writes the per-frame CSV and a run summary (docs/frontend.md,
+// "Daemon"). Exits 0 at the end of the trace or on SIGINT/SIGTERM (outputs
+// written either way), 1 on a setup or rendering failure, 2 on bad options.
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "channel_link.h"
+#include "daemon_options.h"
+#include "gl_frame_producer.h"
+#include "outputs.h"
+#include "replay_loop.h"
+#include "scene_setup.h"
+#include "thinlod/common/trace.h"
+#include "thinlod/protocol/daemon_runtime.h"
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+constexpr std::uint64_t kProgressEveryFrames = 10;
+
+// Logs, the CSV and the PNG dumps, frame by frame.
+class DaemonObserver final : public ReplayObserver {
+ public:
+  DaemonObserver(CsvOutput* csv, const GlFrameProducer& producer, const DaemonOptions& options)
+      : csv_(csv), producer_(producer), options_(options) {}
+
+  void onFrame(const FrameRecord& record, const FrameExtras& extras) override {
+    spdlog::debug(
+        "event=frame frame={} polygons={} link_bytes={} snr_db={:.2f} render_ms={:.2f} "
+        "reference_ms={:.2f} pose_to_frame_ms={:.2f} plan={}",
+        record.frame, record.polygons, record.linkBytes, record.snrDb, record.renderMs,
+        extras.referenceMs, record.poseToFrameMs, record.plan);
+    if (record.frame % kProgressEveryFrames == 0) {
+      spdlog::info("event=progress frame={} polygons={} snr_db={:.2f} render_ms={:.2f} plan={}",
+                   record.frame, record.polygons, record.snrDb, record.renderMs, record.plan);
+    }
+    if (csv_ != nullptr && outputError_.ok()) {
+      const Status written = csv_->append(record, extras);
+      if (!written.ok()) {
+        outputError_ = written;
+        spdlog::error("event=csv_failed error=\"{}\"", written.toString());
+      }
+    }
+    if (!options_.framesDir.empty() && record.frame % options_.dumpEvery == 0) dump(record.frame);
+  }
+
+  void onUpdateRejected(const protocol::SceneUpdate& update, const Status& why) override {
+    spdlog::warn(
+        "event=update_rejected plan={} frame={} operations={} action=dropped_whole "
+        "error=\"{}\"",
+        update.plan, update.frame, update.operations.size(), why.toString());
+  }
+  void onLockstepTimeout(std::uint64_t frame, double waitedMs) override {
+    spdlog::warn("event=lockstep_timeout frame={} waited_ms={:.1f} action=render_held_state", frame,
+                 waitedMs);
+  }
+  void onUploadDropped(std::uint64_t frame, const std::string& error) override {
+    spdlog::warn("event=upload_failed frame={} action=batch_dropped error=\"{}\"", frame, error);
+  }
+  void onSendFailed(const char* what, std::uint64_t frame, const Status& why) override {
+    spdlog::debug("event=send_failed message={} frame={} error=\"{}\"", what, frame,
+                  why.toString());
+  }
+
+  const Status& outputError() const { return outputError_; }
+
+ private:
+  void dump(std::uint64_t frame) {
+    Status written = writePng(dumpPath(options_.framesDir, "frame", frame), producer_.frame());
+    if (written.ok() && !options_.noReference) {
+      written =
+          writePng(dumpPath(options_.framesDir, "reference", frame), producer_.referenceFrame());
+    }
+    if (!written.ok()) spdlog::warn("event=dump_failed error=\"{}\"", written.toString());
+  }
+
+  CsvOutput* csv_;
+  const GlFrameProducer& producer_;
+  const DaemonOptions& options_;
+  Status outputError_;
+};
+
+int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
+  const Status valid = validateOptions(options);
+  if (!valid.ok()) {
+    spdlog::error("event=bad_options error=\"{}\"", valid.toString());
+    return 2;
+  }
+  Result<Trace> trace = loadTraceFile(options.tracePath);
+  if (!trace.ok()) {
+    spdlog::error("event=trace_failed error=\"{}\"", trace.status().toString());
+    return 1;
+  }
+
+  std::optional<LoadedScene> scene;
+  if (!options.scenePath.empty()) {
+    Result<LoadedScene> loaded = loadFrontendScene(options.scenePath, options.modelsDir);
+    if (!loaded.ok()) {
+      spdlog::error("event=scene_failed error=\"{}\"", loaded.status().toString());
+      return 1;
+    }
+    scene = std::move(loaded).value();
+    spdlog::info("event=scene_loaded path={} objects={} reference_triangles={} lights={}",
+                 options.scenePath, scene->objects.size(), scene->referenceTriangles,
+                 scene->lighting.lights.size());
+    if (scene->droppedLights > 0) {
+      spdlog::warn("event=lights_dropped count={}", scene->droppedLights);
+    }
+    if (scene->unlitObjects > 0) {
+      spdlog::warn(
+          "event=unlit_objects count={} note=\"objects without a Material are drawn "
+          "lit by the frontend, unlit in the reference\"",
+          scene->unlitObjects);
+    }
+  } else {
+    spdlog::warn("event=no_scene note=\"meshes from the backbone are drawn white\"");
+  }
+
+  GlProducerOptions glOptions;
+  glOptions.width = options.width;
+  glOptions.height = options.height;
+  glOptions.backend = parseBackend(options.backend).value();
+  glOptions.uploadBytesPerFrame = options.maxUploadBytesPerFrame == 0
+                                      ? std::numeric_limits<std::size_t>::max()
+                                      : static_cast<std::size_t>(options.maxUploadBytesPerFrame);
+  const render::Lighting lighting = scene ? scene->lighting : render::Lighting{};
+  std::vector<ReferenceItem> reference;
+  if (scene && !options.noReference) reference = scene->reference;
+  Result<std::unique_ptr<GlFrameProducer>> producer =
+      GlFrameProducer::create(glOptions, lighting, std::move(reference));
+  if (!producer.ok()) {
+    spdlog::error("event=gl_failed error=\"{}\"", producer.status().toString());
+    return 1;
+  }
+  spdlog::info("event=gl_ready backend=\"{}\" width={} height={}", (*producer)->describe(),
+               options.width, options.height);
+
+  std::unique_ptr<CsvOutput> csv;
+  if (!options.csvPath.empty()) {
+    Result<std::unique_ptr<CsvOutput>> opened = CsvOutput::open(options.csvPath);
+    if (!opened.ok()) {
+      spdlog::error("event=csv_failed error=\"{}\"", opened.status().toString());
+      return 1;
+    }
+    csv = std::move(opened).value();
+  }
+  if (!options.framesDir.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(options.framesDir, error);
+    if (error) {
+      spdlog::error("event=frames_dir_failed path={} error=\"{}\"", options.framesDir,
+                    error.message());
+      return 1;
+    }
+  }
+
+  Result<std::unique_ptr<ChannelLink>> link = ChannelLink::connect(
+      options.backboneAddress, defaultPeerName(), options.transport, runtime.wakeFd());
+  if (!link.ok()) {
+    spdlog::error("event=connect_failed address={} error=\"{}\"", options.backboneAddress,
+                  link.status().toString());
+    return 1;
+  }
+  const auto stop = [&runtime] { return runtime.shutdownRequested(); };
+  const bool connected = (*link)->waitConnected(std::chrono::milliseconds(options.connectTimeoutMs),
+                                                std::chrono::milliseconds(1000), stop);
+  if (!connected && !runtime.shutdownRequested()) {
+    spdlog::warn("event=backbone_unavailable address={} waited_ms={} action=replay_anyway",
+                 options.backboneAddress, options.connectTimeoutMs);
+  }
+  spdlog::info("event=ready address={} connected={} trace={} poses={} lockstep={} reference={}",
+               options.backboneAddress, connected, options.tracePath, trace->poses.size(),
+               options.lockstep, !options.noReference);
+
+  ReplayOptions replay;
+  replay.lockstep = options.lockstep;
+  replay.lockstepTimeout = std::chrono::milliseconds(options.lockstepTimeoutMs);
+  replay.rate = options.rate;
+  replay.maxFrames = static_cast<std::size_t>(options.frames);
+  replay.measure = !options.noReference;
+  replay.viewportWidth = static_cast<std::uint32_t>(options.width);
+  replay.viewportHeight = static_cast<std::uint32_t>(options.height);
+  if (scene) replay.conversion.meshColors = &scene->meshColors;
+
+  SteadyClock clock;
+  DaemonObserver observer(csv.get(), **producer, options);
+  ReplayResult result = runReplay(*trace, replay, clock, **link, **producer, observer, stop);
+
+  int exitCode = 0;
+  RunInfo info;
+  info.label = options.label;
+  info.tracePath = options.tracePath;
+  info.scenePath = options.scenePath;
+  info.backend = (*producer)->describe();
+  info.width = options.width;
+  info.height = options.height;
+  info.lockstep = options.lockstep;
+  info.rate = options.rate;
+  info.reference = !options.noReference;
+  info.connectedAtStart = connected;
+  info.referenceTriangles = scene && !options.noReference ? scene->referenceTriangles : 0;
+  if (!result.status.ok()) {
+    info.error = result.status.toString();
+    spdlog::error("event=replay_failed frame={} error=\"{}\"", result.records.size(), info.error);
+    exitCode = 1;
+  }
+  if (csv != nullptr) {
+    const Status closed = csv->close();
+    if (!closed.ok()) spdlog::error("event=csv_failed error=\"{}\"", closed.toString());
+    if (!closed.ok() || !observer.outputError().ok()) exitCode = 1;
+  }
+  if (!options.summaryJsonPath.empty()) {
+    const Status written = writeTextFile(options.summaryJsonPath, runSummaryJson(result, info));
+    if (!written.ok()) {
+      spdlog::error("event=summary_failed error=\"{}\"", written.toString());
+      exitCode = 1;
+    }
+  }
+  const ReplaySummary summary = summarizeFrames(result.records);
+  spdlog::info(
+      "event=finished frames={} interrupted={} updates_received={} updates_applied={} "
+      "updates_rejected={} lockstep_timeouts={} render_ms_median={:.2f} snr_db_median={:.2f} "
+      "polygons_max={}",
+      result.records.size(), result.interrupted, result.updatesReceived, result.updatesApplied,
+      result.updatesRejected, result.lockstepTimeouts, summary.renderMs.median, summary.snrMedianDb,
+      summary.polygonsMax);
+  return exitCode;
+}
+
+}  // namespace
+}  // namespace thinlod::frontend::daemon
+
+int main(int argc, char** argv) {
+  using namespace thinlod;
+  protocol::DaemonRuntime runtime("thinlod-frontend",
+                                  "Thin client: replays a flight path against the backbone, "
+                                  "renders what it holds, measures SNR per frame");
+  frontend::daemon::DaemonOptions options;
+  frontend::daemon::registerOptions(runtime, &options);
+  if (auto exitCode = runtime.parse(argc, argv)) return *exitCode;
+  return frontend::daemon::run(runtime, options);
+}

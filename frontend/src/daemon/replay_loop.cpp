@@ -1,0 +1,245 @@
+#include "replay_loop.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <utility>
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+constexpr double kNsPerMs = 1e6;
+constexpr double kNsPerS = 1e9;
+
+// An update handed to the renderer, not yet visible.
+struct SubmittedUpdate {
+  std::uint64_t plan = 0;
+  std::uint64_t frame = 0;  // the pose it answered
+  double targetAccuracy = 0.0;
+};
+
+std::int64_t scheduleOffsetNs(const Trace& trace, std::size_t frame, double rate) {
+  if (rate > 0.0) return std::llround(static_cast<double>(frame) * kNsPerS / rate);
+  return std::llround((trace.poses[frame].time - trace.poses.front().time) * kNsPerS);
+}
+
+protocol::ViewerPose wirePose(const Pose& pose, std::uint64_t sequence,
+                              const ReplayOptions& options) {
+  protocol::ViewerPose wire;
+  wire.sequence = sequence;
+  wire.timestampNs = std::llround(pose.time * kNsPerS);
+  wire.position = pose.position;
+  wire.orientation = glm::normalize(pose.orientation);
+  wire.fovY = pose.fovYRadians();
+  wire.viewportWidth = options.viewportWidth;
+  wire.viewportHeight = options.viewportHeight;
+  return wire;
+}
+
+class Replay {
+ public:
+  Replay(const Trace& trace, const ReplayOptions& options, Clock& clock, BackboneLink& link,
+         FrameProducer& producer, ReplayObserver& observer,
+         const std::function<bool()>& stopRequested)
+      : trace_(trace),
+        options_(options),
+        clock_(clock),
+        link_(link),
+        producer_(producer),
+        observer_(observer),
+        stop_(stopRequested),
+        poseSentNs_(trace.poses.size(), -1),
+        answered_(trace.poses.size(), false) {}
+
+  ReplayResult run() {
+    std::size_t frames = trace_.poses.size();
+    if (options_.maxFrames > 0) frames = std::min(frames, options_.maxFrames);
+    const std::int64_t startNs = clock_.nowNs();
+    std::uint64_t bytesBefore = link_.bytesReceived();
+    for (std::size_t i = 0; i < frames; ++i) {
+      if (stop_()) {
+        result_.interrupted = true;
+        break;
+      }
+      extras_ = FrameExtras{};
+      if (options_.rate >= 0.0) {
+        waitUntil(startNs + scheduleOffsetNs(trace_, i, options_.rate), [] { return false; });
+        if (stop_()) {
+          result_.interrupted = true;
+          break;
+        }
+      }
+      const Pose& pose = trace_.poses[i];
+      const std::int64_t sentNs = sendPose(pose, i);
+      absorb(link_.poll(std::chrono::milliseconds(0)));
+      if (options_.lockstep && extras_.poseSent) {
+        waitUntil(sentNs + options_.lockstepTimeout.count() * 1'000'000LL,
+                  [&] { return answered_[i] || !link_.connected(); });
+        if (!answered_[i] && link_.connected() && !stop_()) {
+          extras_.lockstepTimedOut = true;
+          ++result_.lockstepTimeouts;
+          observer_.onLockstepTimeout(i, (clock_.nowNs() - sentNs) / kNsPerMs);
+        }
+      }
+      extras_.waitMs = (clock_.nowNs() - sentNs) / kNsPerMs;
+
+      Result<ProducedFrame> produced = producer_.renderFrame(i, pose);
+      if (!produced.ok()) {
+        result_.status = produced.status();
+        break;
+      }
+      const std::int64_t frameDoneNs = clock_.nowNs();
+      FrameRecord record = recordOf(i, pose, *produced, frameDoneNs);
+
+      if (options_.measure) {
+        Result<FrameQuality> quality = producer_.measure(i, pose);
+        if (!quality.ok()) {
+          result_.status = quality.status();
+          break;
+        }
+        record.snrDb = quality->snrDb;
+        record.psnrDb = quality->psnrDb;
+        extras_.referenceMs = quality->referenceMs;
+      }
+      const std::uint64_t bytesNow = link_.bytesReceived();
+      record.linkBytes = bytesNow - bytesBefore;
+      bytesBefore = bytesNow;
+      sendStats(record, pose);
+      result_.records.push_back(record);
+      result_.extras.push_back(extras_);
+      observer_.onFrame(record, extras_);
+    }
+    return std::move(result_);
+  }
+
+ private:
+  // Polls the link in slices until `done()`, the deadline, or a stop request.
+  template <typename Done>
+  void waitUntil(std::int64_t deadlineNs, Done done) {
+    while (!stop_() && !done()) {
+      const std::int64_t now = clock_.nowNs();
+      if (now >= deadlineNs) return;
+      const std::int64_t remainingMs = (deadlineNs - now + 999'999) / 1'000'000;
+      absorb(link_.poll(std::chrono::milliseconds(
+          std::min<std::int64_t>(remainingMs, options_.pollSlice.count()))));
+    }
+  }
+
+  // Returns the clock time of the send (also when it failed).
+  std::int64_t sendPose(const Pose& pose, std::size_t frame) {
+    const std::int64_t now = clock_.nowNs();
+    if (!link_.connected()) {
+      ++result_.posesNotSent;
+      return now;
+    }
+    const Status sent = link_.send(wirePose(pose, frame, options_));
+    if (!sent.ok()) {
+      ++result_.posesNotSent;
+      observer_.onSendFailed("ViewerPose", frame, sent);
+      return now;
+    }
+    poseSentNs_[frame] = now;
+    extras_.poseSent = true;
+    return now;
+  }
+
+  void absorb(std::vector<protocol::SceneUpdate> updates) {
+    for (protocol::SceneUpdate& update : updates) {
+      ++result_.updatesReceived;
+      ++extras_.updatesReceived;
+      if (update.frame < answered_.size()) answered_[update.frame] = true;
+      Result<SceneBatch> batch = convertUpdate(update, options_.conversion);
+      const Status submitted =
+          batch.ok() ? producer_.submit(std::move(batch).value()) : batch.status();
+      if (!submitted.ok()) {
+        ++result_.updatesRejected;
+        ++extras_.updatesRejected;
+        observer_.onUpdateRejected(update, submitted);
+        continue;
+      }
+      submitted_.push_back({update.plan, update.frame, update.targetAccuracy});
+    }
+  }
+
+  FrameRecord recordOf(std::size_t frame, const Pose& pose, const ProducedFrame& produced,
+                       std::int64_t frameDoneNs) {
+    FrameRecord record;
+    record.frame = frame;
+    record.timeS = pose.time;
+    record.polygons = produced.triangles;
+    record.plan = produced.appliedPlan;
+    record.renderMs = produced.renderMs;
+    record.drawCalls = produced.drawCalls;
+    record.uploadedBytes = produced.uploadedBytes;
+    if (produced.droppedBatches > 0) observer_.onUploadDropped(frame, produced.lastUploadError);
+    if (produced.committedBatches > 0) {
+      result_.updatesApplied += produced.committedBatches;
+      // Batches become visible in arrival order; the newest visible one is
+      // the first queued with the applied plan.
+      auto newest = std::find_if(submitted_.begin(), submitted_.end(),
+                                 [&](const auto& u) { return u.plan == produced.appliedPlan; });
+      if (newest != submitted_.end()) {
+        targetAccuracy_ = newest->targetAccuracy;
+        if (newest->frame < poseSentNs_.size() && poseSentNs_[newest->frame] >= 0) {
+          record.poseToFrameMs = (frameDoneNs - poseSentNs_[newest->frame]) / kNsPerMs;
+        }
+        submitted_.erase(submitted_.begin(), newest + 1);
+      }
+    }
+    record.targetAccuracy = targetAccuracy_;
+    return record;
+  }
+
+  void sendStats(const FrameRecord& record, const Pose& pose) {
+    if (!link_.connected()) return;
+    protocol::FrameStats stats;
+    stats.frame = record.frame;
+    stats.plan = record.plan;
+    stats.timestampNs = std::llround(pose.time * kNsPerS);
+    stats.polygons = static_cast<std::uint32_t>(
+        std::min<std::size_t>(record.polygons, std::numeric_limits<std::uint32_t>::max()));
+    stats.linkBytes = record.linkBytes;
+    stats.hasSnr = std::isfinite(record.snrDb);
+    stats.snrDb = stats.hasSnr ? record.snrDb : 0.0;
+    stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
+    const Status sent = link_.send(stats);
+    if (!sent.ok()) observer_.onSendFailed("FrameStats", record.frame, sent);
+  }
+
+  const Trace& trace_;
+  const ReplayOptions& options_;
+  Clock& clock_;
+  BackboneLink& link_;
+  FrameProducer& producer_;
+  ReplayObserver& observer_;
+  const std::function<bool()>& stop_;
+  std::vector<std::int64_t> poseSentNs_;  // -1: not sent
+  std::vector<bool> answered_;            // an update for this pose arrived
+  std::deque<SubmittedUpdate> submitted_;
+  double targetAccuracy_ = FrameRecord::kMissing;
+  FrameExtras extras_;
+  ReplayResult result_;
+};
+
+}  // namespace
+
+std::int64_t SteadyClock::nowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+ReplayResult runReplay(const Trace& trace, const ReplayOptions& options, Clock& clock,
+                       BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
+                       const std::function<bool()>& stopRequested) {
+  if (trace.poses.empty()) {
+    ReplayResult result;
+    result.status = Status(ErrorCode::kInvalidArgument, "trace has no poses");
+    return result;
+  }
+  return Replay(trace, options, clock, link, producer, observer, stopRequested).run();
+}
+
+}  // namespace thinlod::frontend::daemon

@@ -1,0 +1,144 @@
+// The trace replay of thinlod-frontend, independent of sockets, GL and the
+// wall clock so it can be tested with fakes (docs/frontend.md, "Daemon").
+//
+// Contract:
+// - runReplay() drives one frame per trace pose i (up to maxFrames): wait for
+//   the frame's slot (pacing), send ViewerPose{sequence = i, timestampNs =
+//   pose time in ns}, take what the link has (0 ms) or, in lockstep, wait up
+//   to lockstepTimeout for the SceneUpdate with frame == i; convert and submit
+//   every update in arrival order (a bad update is rejected whole); render
+//   the frame; then measure it against the reference; emit a FrameRecord and
+//   send FrameStats.
+// - Waiting is always link.poll(timeout) in slices of at most pollSlice, so
+//   input keeps flowing and a stop request ends the wait within one slice.
+//   Nothing blocks on the network except the bounded lockstep wait, which
+//   ends early when the link is not connected.
+// - Pacing: rate > 0: frame i starts at start + i / rate; rate == 0: at start
+//   + (t_i - t_0) of the trace; rate < 0: unpaced (frames back to back). Late
+//   frames start at once (the schedule is not re-anchored).
+// - pose_to_frame_ms: on a frame where at least one update became visible,
+//   clock time when the frame was read back minus clock time when the pose
+//   that the newest visible update answered (SceneUpdate.frame) was sent;
+//   NaN on other frames or when that pose was not sent by this process.
+// - link_bytes: link.bytesReceived() since the previous frame.
+// - Errors: a failed render or measurement ends the replay; the records so
+//   far are kept and the Status is in ReplayResult::status.
+// - Single-threaded; the interfaces are called from the caller's thread.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/status.h"
+#include "thinlod/common/trace.h"
+#include "thinlod/frontend/frame_record.h"
+#include "thinlod/frontend/frontend_scene.h"
+#include "thinlod/protocol/messages.h"
+#include "wire_conversion.h"
+
+namespace thinlod::frontend::daemon {
+
+class Clock {
+ public:
+  virtual ~Clock() = default;
+  virtual std::int64_t nowNs() = 0;  // monotonic
+};
+
+class SteadyClock final : public Clock {
+ public:
+  std::int64_t nowNs() override;
+};
+
+// The backbone as the loop sees it.
+class BackboneLink {
+ public:
+  virtual ~BackboneLink() = default;
+  virtual bool connected() const = 0;
+  virtual Status send(const protocol::Message& message) = 0;
+  // Waits up to `timeout` for input (less when something arrives or a stop
+  // is requested) and returns the SceneUpdates received, in order.
+  virtual std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout) = 0;
+  virtual std::uint64_t bytesReceived() const = 0;  // encoded bytes, all messages, ever
+};
+
+struct ProducedFrame {
+  std::size_t triangles = 0;  // drawn
+  std::uint64_t appliedPlan = 0;
+  std::size_t committedBatches = 0;
+  std::size_t droppedBatches = 0;
+  std::string lastUploadError;
+  double renderMs = 0.0;
+  std::size_t drawCalls = 0;
+  std::size_t uploadedBytes = 0;
+};
+
+struct FrameQuality {
+  double snrDb = FrameRecord::kMissing;
+  double psnrDb = FrameRecord::kMissing;
+  double referenceMs = FrameRecord::kMissing;
+};
+
+// Renders the frontend frame and its reference.
+class FrameProducer {
+ public:
+  virtual ~FrameProducer() = default;
+  virtual Status submit(SceneBatch batch) = 0;
+  virtual Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose& pose) = 0;
+  // Compares the frame just rendered with the full-quality frame of `pose`.
+  virtual Result<FrameQuality> measure(std::uint64_t frame, const Pose& pose) = 0;
+};
+
+// Per-frame values beyond FrameRecord (extra CSV columns).
+struct FrameExtras {
+  double referenceMs = FrameRecord::kMissing;
+  double waitMs = 0.0;  // after sending the pose, waiting for the update (lockstep) or polling
+  bool poseSent = false;
+  bool lockstepTimedOut = false;
+  std::size_t updatesReceived = 0;  // this frame
+  std::size_t updatesRejected = 0;  // this frame
+};
+
+// Hooks for logs and outputs; every method has a no-op default.
+class ReplayObserver {
+ public:
+  virtual ~ReplayObserver() = default;
+  virtual void onFrame(const FrameRecord&, const FrameExtras&) {}
+  virtual void onUpdateRejected(const protocol::SceneUpdate&, const Status&) {}
+  virtual void onLockstepTimeout(std::uint64_t /*frame*/, double /*waitedMs*/) {}
+  virtual void onUploadDropped(std::uint64_t /*frame*/, const std::string& /*error*/) {}
+  virtual void onSendFailed(const char* /*what*/, std::uint64_t /*frame*/, const Status&) {}
+};
+
+struct ReplayOptions {
+  bool lockstep = false;
+  std::chrono::milliseconds lockstepTimeout{5000};
+  double rate = 0.0;          // see the pacing rule above
+  std::size_t maxFrames = 0;  // 0: every pose of the trace
+  bool measure = true;        // false: no reference, SNR/PSNR missing
+  std::uint32_t viewportWidth = 0;
+  std::uint32_t viewportHeight = 0;
+  std::chrono::milliseconds pollSlice{50};
+  ConversionOptions conversion;
+};
+
+struct ReplayResult {
+  std::vector<FrameRecord> records;
+  std::vector<FrameExtras> extras;
+  std::size_t updatesReceived = 0;
+  std::size_t updatesApplied = 0;  // became visible
+  std::size_t updatesRejected = 0;
+  std::size_t lockstepTimeouts = 0;
+  std::size_t posesNotSent = 0;  // link down at the time
+  bool interrupted = false;      // stopRequested() ended it early
+  Status status;                 // why it ended early with an error
+};
+
+ReplayResult runReplay(const Trace& trace, const ReplayOptions& options, Clock& clock,
+                       BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
+                       const std::function<bool()>& stopRequested);
+
+}  // namespace thinlod::frontend::daemon

@@ -1,0 +1,209 @@
+#include "wire_conversion.h"
+
+#include <algorithm>
+#include <glm/common.hpp>
+#include <memory>
+#include <string>
+#include <utility>
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+// Byte 6 of a codec frame is its codec (common/codec/encoding.h, frame layout).
+constexpr std::size_t kFrameCodecOffset = 6;
+
+Status invalid(const std::string& what, const std::string& problem) {
+  return Status(ErrorCode::kInvalidArgument, what + ": " + problem);
+}
+
+RepresentationKind toFrontendKind(protocol::RepresentationKind kind) {
+  switch (kind) {
+    case protocol::RepresentationKind::kSimpleImpostor:
+      return RepresentationKind::kSimpleImpostor;
+    case protocol::RepresentationKind::kMeshedImpostor:
+      return RepresentationKind::kMeshedImpostor;
+    case protocol::RepresentationKind::kMesh:
+      break;
+  }
+  return RepresentationKind::kMesh;
+}
+
+bool knownKind(protocol::RepresentationKind kind) {
+  return kind == protocol::RepresentationKind::kMesh ||
+         kind == protocol::RepresentationKind::kSimpleImpostor ||
+         kind == protocol::RepresentationKind::kMeshedImpostor;
+}
+
+// The codec byte a frame of this wire codec must carry, or 0 when the wire
+// codec is not a framed one.
+std::uint8_t frameCodecOf(protocol::TextureCodec codec) {
+  switch (codec) {
+    case protocol::TextureCodec::kZstdRgba8:
+      return static_cast<std::uint8_t>(codec::TextureCodec::kZstd);
+    case protocol::TextureCodec::kPng:
+      return static_cast<std::uint8_t>(codec::TextureCodec::kPng);
+    case protocol::TextureCodec::kJpeg:
+      return static_cast<std::uint8_t>(codec::TextureCodec::kJpeg);
+    case protocol::TextureCodec::kNone:
+    case protocol::TextureCodec::kRawRgba8:
+      break;
+  }
+  return 0;
+}
+
+std::string sizeText(std::uint64_t width, std::uint64_t height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// kNone -> null; otherwise the decoded image or an error.
+Result<std::shared_ptr<const render::RgbaImage>> convertTexture(const protocol::Texture& wire,
+                                                                const ConversionOptions& options,
+                                                                const std::string& what) {
+  if (wire.codec == protocol::TextureCodec::kNone) {
+    if (!wire.data.empty() || wire.width != 0 || wire.height != 0) {
+      return invalid(what, "codec None but " + sizeText(wire.width, wire.height) + " with " +
+                               std::to_string(wire.data.size()) + " bytes");
+    }
+    return std::shared_ptr<const render::RgbaImage>();
+  }
+  const std::uint32_t maxSide = options.limits.maxTextureDimension;
+  if (wire.width == 0 || wire.height == 0 || wire.width > maxSide || wire.height > maxSide) {
+    return invalid(what, "size " + sizeText(wire.width, wire.height) + " outside 1.." +
+                             std::to_string(maxSide) + " per side");
+  }
+  auto image = std::make_shared<render::RgbaImage>();
+  image->width = static_cast<int>(wire.width);
+  image->height = static_cast<int>(wire.height);
+  const std::size_t expectedBytes = static_cast<std::size_t>(wire.width) * wire.height * 4;
+  if (wire.codec == protocol::TextureCodec::kRawRgba8) {
+    if (wire.data.size() != expectedBytes) {
+      return invalid(what, "RawRgba8 data is " + std::to_string(wire.data.size()) +
+                               " bytes, expected " + std::to_string(expectedBytes));
+    }
+    image->pixels = wire.data;
+    return std::shared_ptr<const render::RgbaImage>(std::move(image));
+  }
+  const std::uint8_t frameCodec = frameCodecOf(wire.codec);
+  if (frameCodec == 0) {
+    return invalid(what, "unknown texture codec " + std::to_string(static_cast<int>(wire.codec)));
+  }
+  Result<codec::TextureRGBA8> decoded =
+      codec::decodeTexture(wire.data.data(), wire.data.size(), options.limits);
+  if (!decoded.ok()) {
+    return Status(decoded.status().code(), what + ": " + decoded.status().message());
+  }
+  // decodeTexture verified the header, so the frame is at least that long.
+  if (wire.data[kFrameCodecOffset] != frameCodec) {
+    return invalid(what, "frame codec " + std::to_string(wire.data[kFrameCodecOffset]) +
+                             " does not match the wire codec " +
+                             std::to_string(static_cast<int>(wire.codec)));
+  }
+  if (decoded->width != wire.width || decoded->height != wire.height) {
+    return invalid(what, "decoded size " + sizeText(decoded->width, decoded->height) +
+                             " does not match the announced " + sizeText(wire.width, wire.height));
+  }
+  if (decoded->pixels.size() != expectedBytes) {
+    return invalid(what, "decoded " + std::to_string(decoded->pixels.size()) + " bytes, expected " +
+                             std::to_string(expectedBytes));
+  }
+  image->pixels = std::move(decoded->pixels);
+  return std::shared_ptr<const render::RgbaImage>(std::move(image));
+}
+
+}  // namespace
+
+Result<Representation> convertRepresentation(const protocol::Representation& wire,
+                                             std::uint64_t objectId,
+                                             const ConversionOptions& options,
+                                             const std::string& what) {
+  if (!knownKind(wire.kind)) {
+    return invalid(what,
+                   "unknown representation kind " + std::to_string(static_cast<int>(wire.kind)));
+  }
+  Representation rep;
+  rep.kind = toFrontendKind(wire.kind);
+  rep.transform = wire.transform;
+  rep.generation = wire.generation;
+  const std::string kindName = representationKindName(rep.kind);
+
+  if (wire.mesh.empty()) {
+    if (rep.kind != RepresentationKind::kSimpleImpostor) {
+      return invalid(what, kindName + " has no mesh bytes");
+    }
+    if (wire.triangleCount != 0 && wire.triangleCount != 2) {
+      return invalid(what, "SimpleImpostor without a mesh (unit quad) announces " +
+                               std::to_string(wire.triangleCount) + " triangles");
+    }
+  } else {
+    Result<IndexedMesh> mesh =
+        codec::decodeMesh(wire.mesh.data(), wire.mesh.size(), options.limits);
+    if (!mesh.ok()) {
+      return Status(mesh.status().code(), what + ": mesh: " + mesh.status().message());
+    }
+    if (mesh->triangleCount() != wire.triangleCount) {
+      return invalid(what, "mesh has " + std::to_string(mesh->triangleCount()) +
+                               " triangles, the representation announces " +
+                               std::to_string(wire.triangleCount));
+    }
+    rep.mesh = std::make_shared<const IndexedMesh>(std::move(mesh).value());
+  }
+
+  Result<std::shared_ptr<const render::RgbaImage>> texture =
+      convertTexture(wire.texture, options, what + ": texture");
+  if (!texture.ok()) return texture.status();
+  rep.texture = std::move(texture).value();
+  if (rep.kind != RepresentationKind::kMesh && rep.texture == nullptr) {
+    return invalid(what, kindName + " has no texture (codec None)");
+  }
+  if (rep.texture != nullptr && rep.mesh != nullptr && rep.mesh->uvs.empty()) {
+    return invalid(what, "textured " + kindName + " mesh has no uvs");
+  }
+
+  if (rep.kind == RepresentationKind::kMesh && options.meshColors != nullptr) {
+    auto colour = options.meshColors->find(objectId);
+    if (colour != options.meshColors->end()) {
+      rep.color = glm::clamp(colour->second, glm::vec4(0.0f), glm::vec4(1.0f));
+    }
+  }
+  return rep;
+}
+
+Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
+                                 const ConversionOptions& options) {
+  SceneBatch batch;
+  batch.plan = update.plan;
+  batch.operations.reserve(update.operations.size());
+  const std::string updateName =
+      "SceneUpdate plan " + std::to_string(update.plan) + " frame " + std::to_string(update.frame);
+  for (std::size_t i = 0; i < update.operations.size(); ++i) {
+    const protocol::SceneOperation& wireOp = update.operations[i];
+    const std::string what = updateName + ", operation " + std::to_string(i) + " (object " +
+                             std::to_string(wireOp.objectId) + ")";
+    SceneOperation op;
+    op.id = wireOp.objectId;
+    if (wireOp.type == protocol::SceneOperation::Type::kRemove) {
+      op.type = SceneOperation::Type::kRemove;
+    } else if (wireOp.type == protocol::SceneOperation::Type::kAddOrReplace) {
+      op.type = SceneOperation::Type::kAddOrReplace;
+      Result<Representation> rep =
+          convertRepresentation(wireOp.representation, wireOp.objectId, options, what);
+      if (!rep.ok()) return rep.status();
+      op.representation = std::move(rep).value();
+    } else {
+      return invalid(what,
+                     "unknown operation type " + std::to_string(static_cast<int>(wireOp.type)));
+    }
+    batch.operations.push_back(std::move(op));
+  }
+  return batch;
+}
+
+std::size_t payloadBytes(const protocol::SceneUpdate& update) {
+  std::size_t bytes = 0;
+  for (const protocol::SceneOperation& op : update.operations) {
+    bytes += op.representation.mesh.size() + op.representation.texture.data.size();
+  }
+  return bytes;
+}
+
+}  // namespace thinlod::frontend::daemon

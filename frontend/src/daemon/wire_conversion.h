@@ -1,0 +1,57 @@
+// Wire -> frontend: turns a protocol::SceneUpdate (Draco meshes, codec-framed
+// textures, docs/protocol.md) into a frontend::SceneBatch the renderer can
+// submit. Pure: no I/O, no logging, no globals; thread-safe.
+//
+// Contract:
+// - The update is converted whole or not at all: the first bad operation
+//   makes the result an error naming the update (plan, frame), the operation
+//   index, the object id and the field; no partial batch is ever returned.
+// - Meshes: Draco frames (codec::decodeMesh, bounded by `limits`); kMesh and
+//   kMeshedImpostor need mesh bytes; a kSimpleImpostor with no mesh bytes gets
+//   a null mesh (the unit quad placed by `transform`). triangleCount on the
+//   wire must equal the decoded triangles (the wire contract says exact; an
+//   empty simple-impostor mesh may say 0 or 2).
+// - Textures: kRawRgba8 is taken as is (width*height*4 bytes); kPng, kJpeg,
+//   kZstdRgba8 are codec frames (codec::decodeTexture) whose own codec byte
+//   and decoded size must match the wire's codec, width and height. kNone is
+//   "no texture": an error for impostors (their lighting lives in it).
+// - Colour: impostors are white (lighting baked in); meshes take the colour
+//   the scene file gives their object (`meshColors`, by object id), white
+//   when the id is not listed. Transform, generation and kind are copied.
+// - What the frontend scene checks itself (ids unique, transforms invertible,
+//   uvs on textured meshes) is checked again there on submit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec4.hpp>
+#include <map>
+
+#include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/status.h"
+#include "thinlod/frontend/frontend_scene.h"
+#include "thinlod/protocol/messages.h"
+
+namespace thinlod::frontend::daemon {
+
+using MeshColors = std::map<std::uint64_t, glm::vec4>;  // object id -> RGBA in [0,1]
+
+struct ConversionOptions {
+  const MeshColors* meshColors = nullptr;  // may be null: every mesh is white
+  codec::DecodeLimits limits;
+};
+
+// One representation; `what` prefixes error messages.
+Result<Representation> convertRepresentation(const protocol::Representation& wire,
+                                             std::uint64_t objectId,
+                                             const ConversionOptions& options,
+                                             const std::string& what);
+
+// The whole update as one batch (plan copied), or the first error.
+Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
+                                 const ConversionOptions& options);
+
+// Bytes of mesh and texture payload in an update (what decoding has to chew).
+std::size_t payloadBytes(const protocol::SceneUpdate& update);
+
+}  // namespace thinlod::frontend::daemon
