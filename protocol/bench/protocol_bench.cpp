@@ -9,7 +9,8 @@
 //   throughput: server streams 256 KiB messages to the client
 //               (raw bytes vs SceneUpdates encoded, sent, decoded)
 //
-// Usage: thinlod_protocol_bench [--rtt N] [--stream N] [--json FILE]
+// Usage: thinlod_protocol_bench [--rtt N] [--stream N] [--rounds R] [--json FILE]
+// (defaults 1000, 1000, 5).
 // Prints a table; --json writes the same numbers.
 #include <spdlog/spdlog.h>
 
@@ -97,7 +98,7 @@ void rawServer(zmq::context_t& context, std::promise<std::string> address, std::
   }
 }
 
-LatencyStats rawLatency(std::size_t replyBytes, int iterations, int warmup) {
+std::vector<double> rawLatency(std::size_t replyBytes, int iterations, int warmup) {
   zmq::context_t context(1);
   std::atomic<bool> stop{false};
   std::promise<std::string> address;
@@ -120,7 +121,7 @@ LatencyStats rawLatency(std::size_t replyBytes, int iterations, int warmup) {
   }
   stop = true;
   server.join();
-  return summarize(us);
+  return us;
 }
 
 Throughput rawThroughput(int count) {
@@ -228,8 +229,8 @@ SceneUpdate smallUpdate() {
   return update;
 }
 
-LatencyStats oursLatency(const SceneUpdate& update, int iterations, int warmup,
-                         std::size_t* updateBytes) {
+std::vector<double> oursLatency(const SceneUpdate& update, int iterations, int warmup,
+                                std::size_t* updateBytes) {
   std::atomic<bool> stop{false};
   std::promise<std::string> address;
   auto bound = address.get_future();
@@ -253,7 +254,7 @@ LatencyStats oursLatency(const SceneUpdate& update, int iterations, int warmup,
   channel.reset();
   stop = true;
   server.join();
-  return summarize(us);
+  return us;
 }
 
 Throughput oursThroughput(int count) {
@@ -311,8 +312,9 @@ std::pair<double, double> codecMicros(int iterations) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int rttIterations = 2000;
-  int streamCount = 2000;
+  int rttIterations = 1000;
+  int streamCount = 1000;
+  int rounds = 5;
   std::string jsonPath;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -320,10 +322,13 @@ int main(int argc, char** argv) {
       rttIterations = std::max(10, std::atoi(argv[++i]));
     } else if (arg == "--stream" && i + 1 < argc) {
       streamCount = std::max(10, std::atoi(argv[++i]));
+    } else if (arg == "--rounds" && i + 1 < argc) {
+      rounds = std::max(1, std::atoi(argv[++i]));
     } else if (arg == "--json" && i + 1 < argc) {
       jsonPath = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--rtt N] [--stream N] [--json FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--rtt N] [--stream N] [--rounds R] [--json FILE]\n",
+                   argv[0]);
       return 2;
     }
   }
@@ -331,17 +336,40 @@ int main(int argc, char** argv) {
   const int warmup = std::max(10, rttIterations / 20);
   const int largeIterations = std::max(10, rttIterations / 4);
 
+  // Rounds interleave raw and ours so both see the same machine load;
+  // latency samples are pooled, throughputs summarized by their median.
   std::size_t smallUpdateBytes = 0, largeUpdateBytes = 0;
-  const LatencyStats raw64 = rawLatency(64, rttIterations, warmup);
-  const LatencyStats ours64 = oursLatency(smallUpdate(), rttIterations, warmup, &smallUpdateBytes);
-  const LatencyStats raw256 = rawLatency(kLargeBytes, largeIterations, warmup);
-  const LatencyStats ours256 = oursLatency(seeds::sceneUpdateOfSize(kLargeBytes, 0),
-                                           largeIterations, warmup, &largeUpdateBytes);
-  const Throughput rawStream = rawThroughput(streamCount);
-  const Throughput oursStream = oursThroughput(streamCount);
+  std::vector<double> raw64Us, ours64Us, raw256Us, ours256Us;
+  std::vector<double> rawRates, oursRates;
+  const SceneUpdate largeUpdate = seeds::sceneUpdateOfSize(kLargeBytes, 0);
+  auto append = [](std::vector<double>& to, const std::vector<double>& from) {
+    to.insert(to.end(), from.begin(), from.end());
+  };
+  for (int round = 0; round < rounds; ++round) {
+    append(raw64Us, rawLatency(64, rttIterations, warmup));
+    append(ours64Us, oursLatency(smallUpdate(), rttIterations, warmup, &smallUpdateBytes));
+    append(raw256Us, rawLatency(kLargeBytes, largeIterations, warmup));
+    append(ours256Us, oursLatency(largeUpdate, largeIterations, warmup, &largeUpdateBytes));
+    rawRates.push_back(rawThroughput(streamCount).messagesPerSecond);
+    oursRates.push_back(oursThroughput(streamCount).messagesPerSecond);
+  }
+  const LatencyStats raw64 = summarize(raw64Us);
+  const LatencyStats ours64 = summarize(ours64Us);
+  const LatencyStats raw256 = summarize(raw256Us);
+  const LatencyStats ours256 = summarize(ours256Us);
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  const double mb = static_cast<double>(kLargeBytes) / 1e6;
+  const Throughput rawStream{median(rawRates), median(rawRates) * mb};
+  const Throughput oursStream{median(oursRates), median(oursRates) * mb};
   const auto [encodeUs, decodeUs] = codecMicros(200);
 
-  std::printf("protocol bench: tcp://127.0.0.1, server thread (ROUTER) + client thread (DEALER)\n");
+  std::printf(
+      "protocol bench: tcp://127.0.0.1, server thread (ROUTER) + client thread (DEALER), %d "
+      "rounds\n",
+      rounds);
   std::printf("%-44s %10s %10s %8s\n", "round trip (us)", "median", "p99", "n");
   auto row = [](const char* name, const LatencyStats& s) {
     std::printf("%-44s %10.1f %10.1f %8zu\n", name, s.medianUs, s.p99Us, s.samples);
@@ -350,7 +378,8 @@ int main(int argc, char** argv) {
   row("ours ViewerPose -> SceneUpdate (small)", ours64);
   row("raw zmq 64 B -> 256 KiB", raw256);
   row("ours ViewerPose -> SceneUpdate (256 KiB mesh)", ours256);
-  std::printf("%-44s %10s %10s\n", "stream of 256 KiB messages", "msg/s", "MB/s");
+  std::printf("%-44s %10s %10s\n", "stream of 256 KiB messages (median of rounds)", "msg/s",
+              "MB/s");
   std::printf("%-44s %10.0f %10.0f\n", "raw zmq", rawStream.messagesPerSecond,
               rawStream.megabytesPerSecond);
   std::printf("%-44s %10.0f %10.0f\n", "ours (encode + send + decode)",
