@@ -95,6 +95,20 @@ TEST(PendingRequests, FailsAfterMaxAttempts) {
   EXPECT_FALSE(t.contains(1));
 }
 
+TEST(PendingRequests, AFailedSendCountsAsAnAttemptOfThatRequestOnly) {
+  auto t = table(2);
+  ASSERT_TRUE(t.add(1).ok());
+  ASSERT_TRUE(t.add(2).ok());
+  ASSERT_EQ(t.dispatch({{10, 2}}, kT0).size(), 2u);
+  auto released = t.attemptFailed(1);
+  ASSERT_EQ(released.retry.size(), 1u);
+  EXPECT_EQ(t.inFlightOn(10), 1u);  // request 2 still runs there
+  ASSERT_EQ(t.dispatch({{10, 2}}, kT0).size(), 1u);
+  released = t.attemptFailed(1);
+  EXPECT_EQ(released.failed, std::vector<std::uint64_t>{1});
+  EXPECT_TRUE(t.attemptFailed(99).retry.empty());
+}
+
 TEST(PendingRequests, FirstResultWinsDuplicatesAreRecognised) {
   auto t = table();
   ASSERT_TRUE(t.add(1).ok());

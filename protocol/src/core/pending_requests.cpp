@@ -91,6 +91,13 @@ PendingRequests::Released PendingRequests::expire(Clock::time_point now) {
   return released;
 }
 
+PendingRequests::Released PendingRequests::attemptFailed(std::uint64_t requestId) {
+  Released released;
+  auto it = entries_.find(requestId);
+  if (it != entries_.end() && it->second.inFlight) release(it, released);
+  return released;
+}
+
 bool PendingRequests::complete(std::uint64_t requestId) { return entries_.erase(requestId) != 0; }
 bool PendingRequests::cancel(std::uint64_t requestId) { return entries_.erase(requestId) != 0; }
 

@@ -136,11 +136,12 @@ void WorkerPool::Impl::dispatch(Clock::time_point now) {
                     d.attempt);
       continue;
     }
-    // The worker vanished between its last message and now: treat it as lost.
+    // Gone or full: this attempt failed; the request waits for the next
+    // poll (the Endpoint reports a vanished worker as kLeft on its own).
     spdlog::warn("event=request_send_failed request={} worker={} error=\"{}\"", d.requestId,
                  d.workerId, sent.toString());
-    auto released = pending.workerLost(d.workerId);
-    fail(released.failed, ErrorCode::kUnavailable, "could not be delivered to any worker");
+    auto released = pending.attemptFailed(d.requestId);
+    fail(released.failed, ErrorCode::kUnavailable, "could not be delivered to a worker");
   }
 }
 

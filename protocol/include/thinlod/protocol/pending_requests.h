@@ -61,6 +61,9 @@ class PendingRequests {
   Released workerLost(std::uint64_t workerId);
   // Attempts started before now - attemptTimeout.
   Released expire(Clock::time_point now);
+  // The running attempt of one request failed (e.g. it could not be sent):
+  // like workerLost, for that request only.
+  Released attemptFailed(std::uint64_t requestId);
   // True when the id was pending (the first result); false for a duplicate
   // or an unknown id.
   bool complete(std::uint64_t requestId);

@@ -171,7 +171,8 @@ class Poller {
 // the capacity in its Hello); they are re-sent with the same id when the
 // worker is lost, restarts or does not answer within attemptTimeout; the
 // first result wins; after maxAttempts the caller gets an error result
-// (kUnavailable when workers kept vanishing, kTimeout otherwise).
+// (kUnavailable when workers kept vanishing, kTimeout otherwise). To wait
+// on it with other sockets: poller.add(pool.endpoint()), then pool.poll(0ms).
 struct WorkerPoolEvent {
   enum class Kind { kWorkerJoined, kWorkerLeft, kSimplifyResult, kImpostorResult };
   Kind kind = Kind::kSimplifyResult;
