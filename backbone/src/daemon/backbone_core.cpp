@@ -1,0 +1,831 @@
+#include "backbone_core.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <limits>
+#include <utility>
+
+#include "thinlod/common/primitives.h"
+
+namespace thinlod::backbone_daemon {
+namespace {
+
+using backbone::RepresentationKind;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxCurveSegments = 16;
+// Bytes per triangle are only learned from meshes at least this large (the
+// frame overhead dominates smaller ones).
+constexpr double kMinTrianglesToLearnBytes = 64.0;
+
+Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
+
+bool isMeshKind(RepresentationKind kind) {
+  return kind == RepresentationKind::kOriginalMesh || kind == RepresentationKind::kSimplifiedMesh;
+}
+
+protocol::ConicRange everywhereOnWire() {
+  protocol::ConicRange range;
+  range.distanceMin = 0.0f;
+  range.distanceMax = std::numeric_limits<float>::infinity();
+  range.direction = glm::vec3(0.0f, 0.0f, 1.0f);
+  range.halfAngle = 3.14159265f;
+  return range;
+}
+
+double payloadBytes(const protocol::Representation& rep) {
+  return static_cast<double>(rep.mesh.size() + rep.texture.data.size()) + kOperationOverheadBytes;
+}
+
+// r(a) -> offset + scale * r(a) on the same accuracy domain.
+AccuracyCurve affineResources(const AccuracyCurve& curve, double offset, double scale) {
+  std::vector<CurveSegment> segments = curve.segments();
+  for (CurveSegment& s : segments) {
+    s.value = offset + scale * s.value;
+    s.slope *= scale;
+  }
+  Result<AccuracyCurve> mapped =
+      AccuracyCurve::fromSegments(std::move(segments), curve.maxAccuracy());
+  return mapped.ok() ? std::move(mapped).value() : curve;
+}
+
+std::string idText(std::uint64_t id) { return std::to_string(id); }
+
+}  // namespace
+
+Status validateCoreOptions(const CoreOptions& o) {
+  if (o.scheduler != "curves" && o.scheduler != "static" && o.scheduler != "greedy")
+    return invalid("scheduler '" + o.scheduler + "': expected curves, static or greedy");
+  THINLOD_RETURN_IF_ERROR(backbone::validateConfig(o.config));
+  THINLOD_RETURN_IF_ERROR(backbone::validateBudget(o.budget));
+  if (o.scheduler == "greedy" && !o.budget.maxTriangles)
+    return invalid("the greedy scheduler needs a polygon budget (--budget-polygons)");
+  if (o.textureSize < 8 || o.textureSize > 4096)
+    return invalid("texture size " + std::to_string(o.textureSize) + ": expected 8..4096");
+  if (o.textureCodec == protocol::TextureCodec::kNone)
+    return invalid("impostor texture codec must not be none");
+  for (double radii : {o.simpleImpostorRadii, o.meshedImpostorRadii}) {
+    if (!std::isfinite(radii) || radii < 0.0)
+      return invalid("impostor radii must be finite and >= 0 (0 disables the kind)");
+    if (radii > 0.0 && radii < 1.1)
+      return invalid("impostors need the viewer outside the object: radii >= 1.1");
+  }
+  if (!std::isfinite(o.meshedImpostorTriangles) || o.meshedImpostorTriangles < 1.0)
+    return invalid("meshed impostor triangles must be >= 1");
+  if (o.curvePoints < 2 || o.curvePoints > protocol::kMaxCurveSamples)
+    return invalid("curve points must be in 2.." + std::to_string(protocol::kMaxCurveSamples));
+  if (o.curveRequestTriangles < 1 || o.curveRequestTriangles > protocol::kMaxTriangleCount)
+    return invalid("curve request triangles out of range");
+  if (!std::isfinite(o.linkBurstBytes) || o.linkBurstBytes < 0.0 || o.linkBurstBytes > 4.0e9)
+    return invalid("link burst must be in [0, 4e9] bytes (0: automatic)");
+  if (!std::isfinite(o.defaultAspect) || o.defaultAspect <= 0.0)
+    return invalid("default aspect must be > 0");
+  return Status();
+}
+
+BackboneCore::BackboneCore(scene::Scene scene, std::string scenePath, CoreOptions options)
+    : sceneGraph_(std::move(scene)),
+      scenePath_(std::move(scenePath)),
+      options_(std::move(options)),
+      lastShaperNs_(std::numeric_limits<std::int64_t>::min()) {}
+
+BackboneCore::~BackboneCore() = default;
+
+Result<std::unique_ptr<BackboneCore>> BackboneCore::create(scene::Scene scene,
+                                                           std::string scenePath,
+                                                           CoreOptions options) {
+  THINLOD_RETURN_IF_ERROR(validateCoreOptions(options));
+  std::unique_ptr<BackboneCore> core(
+      new BackboneCore(std::move(scene), std::move(scenePath), std::move(options)));
+  THINLOD_RETURN_IF_ERROR(core->initialize());
+  return core;
+}
+
+const char* BackboneCore::schedulerName() const { return scheduler_->name(); }
+
+Status BackboneCore::initialize() {
+  Result<std::vector<scene::SceneObject>> objects = scene::collectSceneObjects(sceneGraph_);
+  if (!objects.ok()) return objects.status();
+  sceneObjects_ = std::move(objects).value();
+  Result<ConvertedScene> converted = convertScene(sceneGraph_, sceneObjects_);
+  if (!converted.ok()) return converted.status();
+  converted_ = std::move(converted).value();
+  scene_ = std::move(converted_.scheduling);
+  converted_.scheduling = backbone::SchedulingScene();
+
+  Result<std::unique_ptr<backbone::Scheduler>> scheduler = Status(ErrorCode::kInternal, "none");
+  if (options_.scheduler == "curves") {
+    scheduler = backbone::makeAccuracyCurveScheduler(options_.config);
+  } else if (options_.scheduler == "static") {
+    scheduler = backbone::makeVrmlStaticScheduler(options_.config, backbone::VrmlStaticConfig{});
+  } else {
+    scheduler = backbone::makeGreedyScheduler(options_.config, backbone::GreedyConfig{});
+  }
+  if (!scheduler.ok()) return scheduler.status();
+  scheduler_ = std::move(scheduler).value();
+
+  const std::size_t count = converted_.records.size();
+  meshBytesPerTriangle_.assign(count, kDefaultMeshBytesPerTriangle);
+  meshBytesLearned_.assign(count, false);
+  const double texels = double(options_.textureSize) * double(options_.textureSize);
+  // Relative accuracy of a texture (see docs/backbone.md): the object fills
+  // the texture up to perspective, detail below two texels is lost and the
+  // rendered level adds at most half a texel.
+  const double textureAccuracy = double(options_.textureSize) / 3.5;
+
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const ObjectRecord& record = converted_.records[k];
+    backbone::SceneObject& object = scene_.objects[k];
+    object.firstOption = static_cast<std::uint32_t>(scene_.options.size());
+
+    // Simplified mesh.
+    {
+      OptionState state;
+      state.object = k;
+      state.wireKind = protocol::RepresentationKind::kMesh;
+      backbone::RepresentationOption option;
+      option.kind = RepresentationKind::kSimplifiedMesh;
+      if (record.primitive) {
+        Result<AccuracyCurve> curve =
+            primitiveAccuracyCurve(record.object->shape->geometry.primitive);
+        if (!curve.ok())
+          return Status(curve.status().code(),
+                        "object " + idText(record.id) + ": " + curve.status().message());
+        state.baseTriangles =
+            curve->scaledAccuracy(record.meshToScheduler / (1.0 + kQuantizationShare));
+        state.measuredCurve = true;
+      } else {
+        // Until the simplifier's curve arrives: only the full mesh, exact.
+        state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy * record.meshToScheduler,
+                                                   record.fullTriangles);
+        Outstanding request;
+        request.ticket = nextTicket_++;
+        request.object = k;
+        request.option = static_cast<std::uint32_t>(scene_.options.size());
+        request.curve = true;
+        request.targetTriangles = static_cast<std::uint32_t>(
+            std::clamp<double>(record.fullTriangles, 1.0, options_.curveRequestTriangles));
+        protocol::SimplifyRequest message;
+        message.requestId = request.ticket;
+        message.objectId = record.id;
+        message.sourcePath = scenePath_;
+        message.target = protocol::SimplifyRequest::Target::kTriangles;
+        message.targetTriangles = request.targetTriangles;
+        message.curvePoints = options_.curvePoints;
+        byTicket_.emplace(request.ticket, request);
+        queued_.push_back({request.ticket, std::move(message)});
+      }
+      scene_.options.push_back(std::move(option));
+      optionStates_.push_back(std::move(state));
+      rebuildCurves(static_cast<std::uint32_t>(scene_.options.size() - 1));
+    }
+
+    // Impostors: usable from `radii` bounding radii on, every direction.
+    auto addImpostor = [&](RepresentationKind kind, protocol::RepresentationKind wireKind,
+                           double radii, double triangles) -> Status {
+      if (!(radii > 0.0)) return Status();
+      Result<ConicRange> validity = ConicRange::make(
+          record.bounds.center, radii * record.bounds.radius, kInf, {0.0, 0.0, 1.0}, kPi);
+      if (!validity.ok()) return validity.status();
+      OptionState state;
+      state.object = k;
+      state.wireKind = wireKind;
+      state.textureAccuracy = textureAccuracy * record.impostorToScheduler;
+      state.estimatedTriangles = triangles;
+      state.estimatedBytes = kDefaultTextureBytesPerTexel * texels + kMeshFrameOverheadBytes +
+                             3.0 * triangles + kOperationOverheadBytes;
+      backbone::RepresentationOption option;
+      option.kind = kind;
+      option.validity = *validity;
+      scene_.options.push_back(std::move(option));
+      optionStates_.push_back(std::move(state));
+      rebuildCurves(static_cast<std::uint32_t>(scene_.options.size() - 1));
+      return Status();
+    };
+    THINLOD_RETURN_IF_ERROR(addImpostor(
+        RepresentationKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
+        options_.meshedImpostorRadii, options_.meshedImpostorTriangles));
+    THINLOD_RETURN_IF_ERROR(addImpostor(RepresentationKind::kSimpleImpostor,
+                                        protocol::RepresentationKind::kSimpleImpostor,
+                                        options_.simpleImpostorRadii, 2.0));
+    object.optionCount = static_cast<std::uint32_t>(scene_.options.size()) - object.firstOption;
+  }
+  backbone::updateSubtreeVersions(scene_);
+  dirty_ = false;
+  return backbone::validateScene(scene_);
+}
+
+void BackboneCore::rebuildCurves(std::uint32_t index) {
+  OptionState& state = optionStates_[index];
+  backbone::RepresentationOption& option = scene_.options[index];
+  if (isMeshKind(option.kind)) {
+    option.relativeTriangles = state.calibration == 1.0
+                                   ? state.baseTriangles
+                                   : state.baseTriangles.scaledAccuracy(state.calibration);
+    option.relativeLinkBytes =
+        affineResources(option.relativeTriangles, kOperationOverheadBytes + kMeshFrameOverheadBytes,
+                        meshBytesPerTriangle_[state.object]);
+  } else {
+    const double accuracy = state.textureAccuracy * state.parallaxFactor;
+    option.relativeTriangles = AccuracyCurve::point(accuracy, state.estimatedTriangles);
+    option.relativeLinkBytes = AccuracyCurve::point(accuracy, state.estimatedBytes);
+  }
+  touchObject(state.object);
+}
+
+void BackboneCore::touchObject(std::uint32_t object) {
+  ++scene_.nodes[converted_.records[object].leafNode].contentVersion;
+  dirty_ = true;
+}
+
+double BackboneCore::timeoutSeconds() const {
+  const backbone::SchedulerConfig& c = options_.config;
+  return c.linkDelay + c.generationDelay + c.plannedLifetime;
+}
+
+// ---------------------------------------------------------------- requests
+
+std::vector<OutgoingRequest> BackboneCore::takeRequests() {
+  std::vector<OutgoingRequest> out;
+  out.swap(queued_);
+  return out;
+}
+
+std::vector<std::uint64_t> BackboneCore::takeCancellations() {
+  std::vector<std::uint64_t> out;
+  out.swap(cancellations_);
+  return out;
+}
+
+void BackboneCore::requestSubmitted(std::uint64_t ticket, std::uint64_t wireId) {
+  auto it = byTicket_.find(ticket);
+  if (it == byTicket_.end()) return;
+  if (it->second.wireId != 0) ticketOfWire_.erase(it->second.wireId);
+  it->second.wireId = wireId;
+  ticketOfWire_[wireId] = ticket;
+}
+
+void BackboneCore::requestNotSubmitted(std::uint64_t ticket) { forgetTicket(ticket); }
+
+void BackboneCore::forgetTicket(std::uint64_t ticket) {
+  auto it = byTicket_.find(ticket);
+  if (it == byTicket_.end()) return;
+  if (it->second.wireId != 0) ticketOfWire_.erase(it->second.wireId);
+  byTicket_.erase(it);
+  queued_.erase(std::remove_if(queued_.begin(), queued_.end(),
+                               [&](const OutgoingRequest& r) { return r.ticket == ticket; }),
+                queued_.end());
+}
+
+std::size_t BackboneCore::curvesPending() const {
+  std::size_t n = 0;
+  for (const auto& entry : byTicket_) n += entry.second.curve ? 1 : 0;
+  return n;
+}
+
+std::vector<std::uint64_t> BackboneCore::objectsWithoutMeasuredCurve() const {
+  std::vector<std::uint64_t> ids;
+  for (const OptionState& state : optionStates_) {
+    if (state.wireKind == protocol::RepresentationKind::kMesh && !state.measuredCurve)
+      ids.push_back(converted_.records[state.object].id);
+  }
+  return ids;
+}
+
+std::size_t BackboneCore::awaitedResults() const {
+  std::size_t n = 0;
+  for (const auto& entry : byTicket_)
+    n += (!entry.second.curve && entry.second.pose == poseCounter_) ? 1 : 0;
+  return n;
+}
+
+void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
+  if (r.object >= converted_.records.size() || r.option >= scene_.options.size()) return;
+  const ObjectRecord& record = converted_.records[r.object];
+  const backbone::RepresentationOption& option = scene_.options[r.option];
+  const OptionState& state = optionStates_[r.option];
+
+  Outstanding* existing = nullptr;
+  for (auto& entry : byTicket_) {
+    if (!entry.second.curve && entry.second.option == r.option) existing = &entry.second;
+  }
+
+  Outstanding request;
+  request.object = r.object;
+  request.option = r.option;
+  request.kind = state.wireKind;
+  request.schedulerId = r.requestId;
+  request.viewRegion = r.viewRegion;
+  request.pose = poseCounter_;
+  std::variant<protocol::SimplifyRequest, protocol::ImpostorRequest> message;
+
+  if (isMeshKind(option.kind)) {
+    const double wanted = std::ceil(r.expectedTriangles * (1.0 - 1e-12));
+    request.targetTriangles = static_cast<std::uint32_t>(
+        std::clamp(std::isfinite(wanted) ? wanted : 1.0, 1.0, double(protocol::kMaxTriangleCount)));
+    request.requestedAccuracy = r.relativeAccuracy;
+    if (existing != nullptr && !existing->impostor &&
+        existing->targetTriangles == request.targetTriangles) {
+      // The same mesh is on its way: its result now answers this request.
+      existing->schedulerId = request.schedulerId;
+      existing->requestedAccuracy = request.requestedAccuracy;
+      existing->viewRegion = request.viewRegion;
+      existing->pose = poseCounter_;
+      return;
+    }
+    protocol::SimplifyRequest simplify;
+    simplify.objectId = record.id;
+    simplify.sourcePath = scenePath_;
+    simplify.target = protocol::SimplifyRequest::Target::kTriangles;
+    simplify.targetTriangles = request.targetTriangles;
+    message = std::move(simplify);
+  } else {
+    request.impostor = true;
+    // The angular error the target allows at the region's distance: the
+    // impostor's validity cone is where its parallax error stays below it.
+    const double distance = backbone::conversionDistance(
+        r.viewRegion.center, r.viewRegion.radius, record.bounds, options_.config.minimalDistance);
+    double absolute = r.relativeAccuracy * distance / record.diameter;
+    if (plan_ && std::isfinite(plan_->targetAccuracy) && plan_->targetAccuracy > 0.0)
+      absolute = std::min(absolute, plan_->targetAccuracy);
+    if (!std::isfinite(absolute) || absolute <= 0.0) absolute = 1.0;
+    request.requestedAccuracy = absolute * record.diameter / distance;
+    if (existing != nullptr && existing->impostor && existing->kind == request.kind &&
+        glm::length(existing->viewRegion.center - r.viewRegion.center) <=
+            0.25 * r.viewRegion.radius &&
+        std::fabs(existing->requestedAccuracy - request.requestedAccuracy) <=
+            0.05 * request.requestedAccuracy) {
+      existing->schedulerId = request.schedulerId;
+      existing->pose = poseCounter_;
+      return;
+    }
+    protocol::ImpostorRequest impostor;
+    impostor.objectIds = {record.id};
+    impostor.eye = glm::vec3(r.viewRegion.center);
+    impostor.orientation = pose_.orientation;
+    impostor.fovY = pose_.fovY;
+    impostor.textureWidth = options_.textureSize;
+    impostor.textureHeight = options_.textureSize;
+    impostor.kind = state.wireKind;
+    impostor.accuracyBound = std::clamp(1.0 / absolute, 1e-7, 1.0);
+    impostor.textureCodec = options_.textureCodec;
+    message = std::move(impostor);
+  }
+  if (existing != nullptr) {
+    // Superseded: the older request's result would no longer be wanted.
+    if (existing->wireId != 0) cancellations_.push_back(existing->wireId);
+    forgetTicket(existing->ticket);
+  }
+  request.ticket = nextTicket_++;
+  std::visit([&](auto& m) { m.requestId = request.ticket; }, message);
+  byTicket_.emplace(request.ticket, request);
+  queued_.push_back({request.ticket, std::move(message)});
+}
+
+Result<BackboneCore::Outstanding> BackboneCore::claim(std::uint64_t wireId, const char* what) {
+  auto wire = ticketOfWire_.find(wireId);
+  if (wire == ticketOfWire_.end())
+    return Status(ErrorCode::kNotFound,
+                  std::string(what) + ": unknown request id " + idText(wireId));
+  auto it = byTicket_.find(wire->second);
+  if (it == byTicket_.end()) {
+    ticketOfWire_.erase(wire);
+    return Status(ErrorCode::kNotFound,
+                  std::string(what) + ": unknown request id " + idText(wireId));
+  }
+  Outstanding request = it->second;
+  forgetTicket(request.ticket);
+  return request;
+}
+
+void BackboneCore::learnMeshBytes(std::uint32_t object, double meshBytes, double triangles) {
+  if (triangles < kMinTrianglesToLearnBytes) return;
+  const double perTriangle = std::max(0.1, (meshBytes - kMeshFrameOverheadBytes) / triangles);
+  double& current = meshBytesPerTriangle_[object];
+  // The first measurement replaces the default; later ones only raise it
+  // (an estimate below the truth would let the link budget overflow).
+  if (meshBytesLearned_[object] && !(perTriangle > current * 1.02)) return;
+  current = perTriangle;
+  meshBytesLearned_[object] = true;
+  const backbone::SceneObject& o = scene_.objects[object];
+  for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k)
+    if (isMeshKind(scene_.options[k].kind)) rebuildCurves(k);
+}
+
+void BackboneCore::storeBackboneCopy(std::uint32_t option, backbone::RepresentationCopy copy,
+                                     protocol::Representation payload) {
+  scene_.options[option].atBackbone = copy;
+  optionStates_[option].backbonePayload = std::move(payload);
+  touchObject(optionStates_[option].object);
+}
+
+Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
+  Result<Outstanding> claimed = claim(result.requestId, "SimplifyResult");
+  if (!claimed.ok()) return claimed.status();
+  const Outstanding& request = *claimed;
+  const ObjectRecord& record = converted_.records[request.object];
+  const std::string where =
+      "SimplifyResult " + idText(result.requestId) + " (object " + idText(record.id) + ")";
+  if (request.impostor) return invalid(where + ": answers an ImpostorRequest");
+  if (result.objectId != record.id)
+    return invalid(where + ": carries object id " + idText(result.objectId));
+  if (!result.status.ok())
+    return Status(result.status.code(), where + ": simplifier error: " + result.status.message());
+  if (result.mesh.empty()) return invalid(where + ": no mesh");
+  if (result.triangleCount == 0 || result.triangleCount > protocol::kMaxTriangleCount)
+    return invalid(where + ": triangle count " + std::to_string(result.triangleCount));
+  if (!std::isfinite(result.accuracy) || result.accuracy <= 0.0)
+    return invalid(where + ": accuracy must be finite and > 0");
+
+  OptionState& state = optionStates_[request.option];
+  if (request.curve) {
+    if (result.curve.empty()) return invalid(where + ": no curve samples");
+    std::vector<AccuracySample> samples;
+    samples.reserve(result.curve.size());
+    for (std::size_t i = 0; i < result.curve.size(); ++i) {
+      const AccuracySample& s = result.curve[i];
+      if (!std::isfinite(s.accuracy) || s.accuracy <= 0.0 || !std::isfinite(s.resources) ||
+          s.resources < 0.0 || s.resources > double(protocol::kMaxTriangleCount))
+        return invalid(where + ": curve[" + std::to_string(i) + "] is not a finite sample");
+      samples.push_back({s.accuracy * record.meshToScheduler, s.resources});
+    }
+    Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
+    if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
+    learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
+    state.baseTriangles = std::move(fitted).value();
+    state.calibration = 1.0;
+    state.measuredCurve = true;
+    rebuildCurves(request.option);
+    return Status();
+  }
+
+  learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
+  const double relative = result.accuracy * record.meshToScheduler;
+  if (request.requestedAccuracy > 0.0 && relative < request.requestedAccuracy * 0.99) {
+    // Delivered less than the curve promised: shift the curve so the same
+    // triangles are credited with what they reached.
+    state.calibration = std::max(0.05, state.calibration * relative / request.requestedAccuracy);
+    rebuildCurves(request.option);
+  }
+  protocol::Representation rep;
+  rep.representationId = request.schedulerId;
+  rep.kind = protocol::RepresentationKind::kMesh;
+  rep.mesh = result.mesh;
+  rep.transform = record.object->objectToWorld;
+  rep.validity = everywhereOnWire();
+  rep.accuracy = result.accuracy;
+  rep.triangleCount = result.triangleCount;
+  backbone::RepresentationCopy copy;
+  copy.present = true;
+  copy.id = request.schedulerId;
+  copy.relativeAccuracy = relative;
+  copy.triangles = result.triangleCount;
+  copy.encodedBytes = payloadBytes(rep);
+  storeBackboneCopy(request.option, copy, std::move(rep));
+  return Status();
+}
+
+Status BackboneCore::onImpostorResult(const protocol::ImpostorResult& result) {
+  Result<Outstanding> claimed = claim(result.requestId, "ImpostorResult");
+  if (!claimed.ok()) return claimed.status();
+  const Outstanding& request = *claimed;
+  const ObjectRecord& record = converted_.records[request.object];
+  const std::string where =
+      "ImpostorResult " + idText(result.requestId) + " (object " + idText(record.id) + ")";
+  if (!request.impostor) return invalid(where + ": answers a SimplifyRequest");
+  if (result.objectIds.size() != 1 || result.objectIds[0] != record.id)
+    return invalid(where + ": object ids do not match the request");
+  if (!result.status.ok())
+    return Status(result.status.code(), where + ": simplifier error: " + result.status.message());
+  const protocol::Representation& rep = result.representation;
+  if (rep.kind != request.kind)
+    return invalid(where + std::string(": kind ") + protocol::representationKindName(rep.kind) +
+                   ", requested " + protocol::representationKindName(request.kind));
+  if (rep.texture.codec == protocol::TextureCodec::kNone || rep.texture.data.empty())
+    return invalid(where + ": no texture");
+  if (rep.triangleCount == 0 || rep.triangleCount > protocol::kMaxTriangleCount)
+    return invalid(where + ": triangle count " + std::to_string(rep.triangleCount));
+  if (!std::isfinite(rep.accuracy) || rep.accuracy <= 0.0)
+    return invalid(where + ": accuracy must be finite and > 0");
+  const protocol::ConicRange& v = rep.validity;
+  Result<ConicRange> validity = ConicRange::make(glm::dvec3(v.center), v.distanceMin, v.distanceMax,
+                                                 glm::dvec3(v.direction), v.halfAngle);
+  if (!validity.ok()) return invalid(where + ": validity: " + validity.status().message());
+  if (validity->isEmpty()) return invalid(where + ": empty validity range");
+
+  OptionState& state = optionStates_[request.option];
+  const double textureRelative = rep.accuracy * record.impostorToScheduler;
+  const double bytes = payloadBytes(rep);
+  const double oldAccuracy = state.textureAccuracy * state.parallaxFactor;
+  const double oldTriangles = state.estimatedTriangles;
+  const double oldBytes = state.estimatedBytes;
+  if (!state.learned) {
+    state.textureAccuracy = textureRelative;
+    state.estimatedTriangles = rep.triangleCount;
+    state.estimatedBytes = bytes;
+    state.learned = true;
+  } else {
+    state.textureAccuracy = std::min(state.textureAccuracy, textureRelative);
+    state.estimatedTriangles = std::max(state.estimatedTriangles, double(rep.triangleCount));
+    state.estimatedBytes = std::max(state.estimatedBytes, bytes);
+  }
+  // A cone that does not hold the region it was made for: ask for less
+  // accuracy next time (a looser bound gives a wider cone).
+  if (!validity->containsSphere(request.viewRegion.center, request.viewRegion.radius))
+    state.parallaxFactor = std::max(0.02, state.parallaxFactor * 0.7);
+  if (state.textureAccuracy * state.parallaxFactor != oldAccuracy ||
+      state.estimatedTriangles != oldTriangles || state.estimatedBytes != oldBytes)
+    rebuildCurves(request.option);
+
+  protocol::Representation stored = rep;
+  stored.representationId = request.schedulerId;
+  backbone::RepresentationCopy copy;
+  copy.present = true;
+  copy.id = request.schedulerId;
+  copy.relativeAccuracy = request.requestedAccuracy > 0.0
+                              ? std::min(textureRelative, request.requestedAccuracy)
+                              : textureRelative;
+  copy.triangles = rep.triangleCount;
+  copy.encodedBytes = bytes;
+  copy.validity = *validity;
+  storeBackboneCopy(request.option, copy, std::move(stored));
+  return Status();
+}
+
+// ------------------------------------------------------------------- poses
+
+Status BackboneCore::runPlan() {
+  if (dirty_) {
+    backbone::updateSubtreeVersions(scene_);
+    dirty_ = false;
+    THINLOD_RETURN_IF_ERROR(backbone::validateScene(scene_));
+  }
+  Result<backbone::Plan> planned = scheduler_->plan(scene_, viewer_, options_.budget, planner_);
+  if (!planned.ok()) return planned.status();
+  plan_ = std::move(planned).value();
+  ++plansThisPose_;
+  requestsThisPose_ += static_cast<std::uint32_t>(plan_->requests.size());
+  schedulingMicrosecondsThisPose_ += plan_->row.schedulingMicroseconds;
+  const double now = viewer_.timeSeconds;
+  for (const backbone::ObjectDecision& d : plan_->decisions) {
+    if (d.action != backbone::ObjectAction::kSend || d.option < 0) continue;
+    const backbone::RepresentationCopy& copy = scene_.options[d.option].atBackbone;
+    if (copy.present) promised_[copy.id] = now;
+  }
+  const std::vector<backbone::RepresentationRequest> requests = plan_->requests;
+  for (const backbone::RepresentationRequest& r : requests) {
+    promised_[r.requestId] = now;
+    issueRequest(r);
+  }
+  return Status();
+}
+
+Status BackboneCore::beginPose(const protocol::ViewerPose& pose) {
+  inPose_ = true;
+  pose_ = pose;
+  ++poseCounter_;
+  plan_.reset();
+  plansThisPose_ = 0;
+  requestsThisPose_ = 0;
+  schedulingMicrosecondsThisPose_ = 0.0;
+
+  const double time = std::max(lastTime_, double(pose.timestampNs) * 1e-9);
+  lastTime_ = time;
+  viewer_ = backbone::ViewerState();
+  viewer_.frame = pose.sequence;
+  viewer_.timeSeconds = time;
+  viewer_.position = glm::dvec3(pose.position);
+  viewer_.viewDirection = glm::dvec3(pose.orientation * glm::vec3(0.0f, 0.0f, -1.0f));
+  viewer_.verticalFov = pose.fovY;
+  const double aspect = (pose.viewportWidth > 0 && pose.viewportHeight > 0)
+                            ? double(pose.viewportWidth) / double(pose.viewportHeight)
+                            : options_.defaultAspect;
+  viewer_.horizontalFov =
+      std::min(kPi - 1e-6, 2.0 * std::atan(std::tan(0.5 * double(pose.fovY)) * aspect));
+
+  // Promises older than any in-flight request the scheduler still awaits.
+  for (auto it = promised_.begin(); it != promised_.end();) {
+    it = (time - it->second > 2.0 * timeoutSeconds()) ? promised_.erase(it) : std::next(it);
+  }
+  planStatus_ = runPlan();
+  return planStatus_;
+}
+
+Status BackboneCore::replan() {
+  if (!inPose_) return Status(ErrorCode::kInternal, "replan() outside a pose");
+  planStatus_ = runPlan();
+  return planStatus_;
+}
+
+double BackboneCore::frontendTrianglesOf(std::uint32_t object) const {
+  const backbone::SceneObject& o = scene_.objects[object];
+  double sum = 0.0;
+  for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k) {
+    if (scene_.options[k].atFrontend.present) sum += scene_.options[k].atFrontend.triangles;
+  }
+  return sum;
+}
+
+void BackboneCore::removeFromFrontend(std::uint32_t object) {
+  const backbone::SceneObject& o = scene_.objects[object];
+  for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k) {
+    backbone::RepresentationOption& option = scene_.options[k];
+    OptionState& state = optionStates_[k];
+    if (!option.atFrontend.present) continue;
+    frontendTriangles_ -= option.atFrontend.triangles;
+    // Still a valid representation: keep it for a later send.
+    if (!option.atBackbone.present && state.frontendPayload) {
+      option.atBackbone = option.atFrontend;
+      state.backbonePayload = std::move(state.frontendPayload);
+    }
+    option.atFrontend = backbone::RepresentationCopy();
+    state.frontendPayload.reset();
+    touchObject(object);
+  }
+}
+
+void BackboneCore::moveToFrontend(std::uint32_t index) {
+  OptionState& state = optionStates_[index];
+  backbone::RepresentationOption& option = scene_.options[index];
+  removeFromFrontend(state.object);
+  option.atFrontend = option.atBackbone;
+  state.frontendPayload = std::move(state.backbonePayload);
+  option.atBackbone = backbone::RepresentationCopy();
+  state.backbonePayload.reset();
+  frontendTriangles_ += option.atFrontend.triangles;
+  touchObject(state.object);
+}
+
+protocol::SceneUpdate BackboneCore::emptyUpdate(const protocol::ViewerPose& pose) {
+  protocol::SceneUpdate update;
+  update.plan = poseCounter_;
+  update.frame = pose.sequence;
+  update.targetAccuracy = 0.0;
+  return update;
+}
+
+PoseOutcome BackboneCore::finishPose() {
+  PoseOutcome out;
+  out.update.plan = poseCounter_;
+  out.update.frame = pose_.sequence;
+  out.plans = plansThisPose_;
+  out.frontendTriangles = frontendTriangles_;
+  inPose_ = false;
+  if (!planStatus_.ok() || !plan_) {
+    out.planError = planStatus_.ok() ? Status(ErrorCode::kInternal, "no plan") : planStatus_;
+    out.row.frame = pose_.sequence;
+    out.row.timeSeconds = viewer_.timeSeconds;
+    out.row.scheduler = scheduler_->name();
+    out.row.mode = "error";
+    return out;
+  }
+  const backbone::Plan& plan = *plan_;
+  out.planned = true;
+  out.row = plan.row;
+  out.row.requests = requestsThisPose_;
+  out.row.schedulingMicroseconds = schedulingMicrosecondsThisPose_;
+  out.update.targetAccuracy =
+      std::isfinite(plan.targetAccuracy) && plan.targetAccuracy > 0.0 ? plan.targetAccuracy : 0.0;
+
+  struct Add {
+    std::uint32_t object = 0;
+    std::uint32_t option = 0;
+    double delta = 0.0;  // triangles at the frontend after minus before
+    bool missing = false;
+  };
+  std::vector<Add> adds;
+  std::vector<std::uint32_t> removes;
+  std::vector<std::uint8_t> rendered(scene_.objects.size(), 0);
+  for (const backbone::ObjectDecision& d : plan.decisions) {
+    if (d.object >= scene_.objects.size()) continue;
+    switch (d.action) {
+      case backbone::ObjectAction::kSend:
+      case backbone::ObjectAction::kAwait: {
+        rendered[d.object] = 1;
+        if (d.option < 0) break;
+        const auto index = static_cast<std::uint32_t>(d.option);
+        const backbone::RepresentationCopy& back = scene_.options[index].atBackbone;
+        if (!back.present || !optionStates_[index].backbonePayload) break;
+        // Await: deliver the copy the scheduler is waiting for once it is here.
+        if (d.action == backbone::ObjectAction::kAwait && promised_.count(back.id) == 0) break;
+        const double before = frontendTrianglesOf(d.object);
+        adds.push_back({d.object, index, back.triangles - before, before == 0.0});
+        break;
+      }
+      case backbone::ObjectAction::kKeep:
+      case backbone::ObjectAction::kRequest:
+        rendered[d.object] = 1;
+        break;
+      case backbone::ObjectAction::kRemove:
+        break;
+    }
+  }
+  for (const backbone::ObjectDecision& d : plan.decisions) {
+    if (d.action == backbone::ObjectAction::kRemove && d.object < scene_.objects.size() &&
+        !rendered[d.object] && frontendTrianglesOf(d.object) > 0.0) {
+      rendered[d.object] = 2;
+      removes.push_back(d.object);
+    }
+  }
+  for (const backbone::Removal& r : plan.removals) {
+    if (r.object < scene_.objects.size() && !rendered[r.object] &&
+        frontendTrianglesOf(r.object) > 0.0) {
+      rendered[r.object] = 2;
+      removes.push_back(r.object);
+    }
+  }
+
+  for (std::uint32_t object : removes) {
+    removeFromFrontend(object);
+    protocol::SceneOperation op;
+    op.type = protocol::SceneOperation::Type::kRemove;
+    op.objectId = converted_.records[object].id;
+    out.update.operations.push_back(std::move(op));
+    ++out.removes;
+  }
+
+  // Downgrades first (they free polygons), then objects showing nothing,
+  // then the smallest upgrades.
+  std::stable_sort(adds.begin(), adds.end(), [](const Add& a, const Add& b) {
+    const bool downA = a.delta <= 0.0;
+    const bool downB = b.delta <= 0.0;
+    if (downA != downB) return downA;
+    if (a.missing != b.missing) return a.missing;
+    return a.delta < b.delta;
+  });
+
+  // The link shaper runs on pose time.
+  const std::int64_t nowNs = std::max(lastShaperNs_, pose_.timestampNs);
+  lastShaperNs_ = nowNs;
+  const protocol::LinkShaper::Clock::time_point now{std::chrono::nanoseconds(nowNs)};
+  if (options_.budget.maxLinkBytesPerSecond && !shaper_) {
+    const double rate = std::max(1.0, std::round(*options_.budget.maxLinkBytesPerSecond));
+    const double burst = options_.linkBurstBytes > 0.0
+                             ? options_.linkBurstBytes
+                             : std::max(rate * options_.config.plannedLifetime, 65536.0);
+    Result<protocol::TokenBucket> bucket = protocol::TokenBucket::create(
+        static_cast<std::uint64_t>(std::min(rate, 1e11)),
+        static_cast<std::uint64_t>(std::clamp(std::round(burst), 1.0, 4294967296.0)), now);
+    if (bucket.ok()) shaper_.emplace(std::move(bucket).value());
+  }
+  if (shaper_) shaper_->beginFrame(pose_.sequence);
+
+  const double cap = (options_.hardPolygonCap && options_.budget.maxTriangles)
+                         ? *options_.budget.maxTriangles
+                         : kInf;
+  for (const Add& add : adds) {
+    const backbone::RepresentationCopy& back = scene_.options[add.option].atBackbone;
+    const double delta = back.triangles - frontendTrianglesOf(add.object);
+    if (delta > 0.0 && frontendTriangles_ + delta > cap) {
+      ++out.deferredByPolygonCap;
+      continue;
+    }
+    const auto bytes = static_cast<std::uint64_t>(std::llround(back.encodedBytes));
+    if (shaper_) {
+      if (bytes > shaper_->bucket().burstBytes()) {
+        // Grow the bucket to hold this message, keeping the tokens it had.
+        const std::uint64_t available = shaper_->bucket().availableBytes(now);
+        Result<protocol::TokenBucket> grown =
+            protocol::TokenBucket::create(shaper_->bucket().rateBytesPerSecond(), bytes, now);
+        if (grown.ok()) {
+          protocol::TokenBucket bucket = std::move(grown).value();
+          if (bytes > available) (void)bucket.trySend(bytes - available, now);
+          shaper_.emplace(std::move(bucket));
+          shaper_->beginFrame(pose_.sequence);
+          ++out.tooLargeForLink;
+        }
+      }
+      if (!shaper_->trySend(bytes, now)) {
+        ++out.deferredByLink;
+        continue;
+      }
+    }
+    out.linkBytes += bytes;
+    protocol::SceneOperation op;
+    op.type = protocol::SceneOperation::Type::kAddOrReplace;
+    op.objectId = converted_.records[add.object].id;
+    op.representation = *optionStates_[add.option].backbonePayload;
+    out.update.operations.push_back(std::move(op));
+    moveToFrontend(add.option);
+    ++out.adds;
+  }
+  out.frontendTriangles = frontendTriangles_;
+  return out;
+}
+
+void BackboneCore::resetFrontend() {
+  for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) removeFromFrontend(k);
+  frontendTriangles_ = 0.0;
+  planner_.reset();
+  promised_.clear();
+  shaper_.reset();
+  lastTime_ = -1e300;
+  lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
+  inPose_ = false;
+  plan_.reset();
+}
+
+}  // namespace thinlod::backbone_daemon

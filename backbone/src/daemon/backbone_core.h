@@ -1,0 +1,227 @@
+// BackboneCore: everything the backbone daemon decides, without sockets,
+// files or logging (main.cpp is the thin shell around it).
+//
+// Contract:
+// - create() converts the scene (scene_conversion.h) and gives every object
+//   its representation options: a simplified mesh (relative triangle curve:
+//   primitives analytic, meshes measured by the simplifier, a conservative
+//   point curve "full mesh, exact" until then) and, when enabled, meshed and
+//   simple impostors (point curves from the texture size, learned from
+//   results). Link bytes are estimated from the results' encoded sizes
+//   (docs/backbone.md, "Link estimates").
+// - Requests: the core queues protocol requests with a local ticket as
+//   requestId; the shell submits them (WorkerPool assigns the wire id) and
+//   reports requestSubmitted(ticket, wireId). Results are matched by wire id;
+//   unknown ids, mismatched objects/kinds and malformed payloads are rejected
+//   with a Status (the request, if known, is forgotten). One request per
+//   (object, option) is outstanding at a time: a newer one supersedes it (the
+//   older wire id appears in takeCancellations()).
+// - Poses: beginPose() plans (queues requests); replan() plans the same pose
+//   again (after results arrived); finishPose() builds the pose's one
+//   SceneUpdate (frame = pose sequence). Removals first, then downgrades,
+//   then upgrades; an AddOrReplace that would leave the frontend above the
+//   polygon budget, or that the link shaper (pose timestamps as its clock)
+//   has no tokens for, waits for a later pose. The core's model of the
+//   frontend is what it sent: one displayed copy per object.
+// - Time is the pose timestamp (clamped to never run backwards).
+// - Not thread-safe; one frontend session at a time (resetFrontend() when it
+//   changes).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "scene_conversion.h"
+#include "thinlod/backbone/scheduler.h"
+#include "thinlod/protocol/link_shaper.h"
+#include "thinlod/protocol/messages.h"
+
+namespace thinlod::backbone_daemon {
+
+// Encoded bytes a SceneUpdate operation adds besides its mesh and texture
+// (ids, transform, validity, FlatBuffers tables).
+inline constexpr double kOperationOverheadBytes = 256.0;
+// Mesh bytes = frame overhead + bytes per triangle * triangles (defaults
+// until the first result of the object has been measured).
+inline constexpr double kMeshFrameOverheadBytes = 300.0;
+inline constexpr double kDefaultMeshBytesPerTriangle = 2.0;
+// Impostor texture bytes per texel before the first result (PNG of a
+// partly covered RGBA image; docs/backbone.md).
+inline constexpr double kDefaultTextureBytesPerTexel = 0.35;
+// Share of the error budget Draco quantization may add (the simplifier's
+// kQuantizationBudget): analytic primitive curves are credited 1/(1+this).
+inline constexpr double kQuantizationShare = 0.1;
+
+struct CoreOptions {
+  std::string scheduler = "curves";  // curves | static | greedy
+  backbone::SchedulerConfig config;
+  backbone::Budget budget;
+  std::uint32_t textureSize = 256;
+  protocol::TextureCodec textureCodec = protocol::TextureCodec::kPng;
+  double simpleImpostorRadii = 10.0;      // usable from this many bounding radii; 0: disabled
+  double meshedImpostorRadii = 4.0;       // 0: disabled
+  double meshedImpostorTriangles = 64.0;  // estimate until the first result
+  std::uint16_t curvePoints = 32;         // samples asked for per mesh curve
+  std::uint32_t curveRequestTriangles = 2000;
+  bool hardPolygonCap = true;         // never let the frontend hold more than budget.maxTriangles
+  double linkBurstBytes = 0.0;        // 0: max(budget-link * plannedLifetime, 64 KiB)
+  double defaultAspect = 16.0 / 9.0;  // width/height when the pose has no viewport
+};
+Status validateCoreOptions(const CoreOptions& options);
+
+struct OutgoingRequest {
+  std::uint64_t ticket = 0;
+  std::variant<protocol::SimplifyRequest, protocol::ImpostorRequest> message;
+};
+
+struct PoseOutcome {
+  protocol::SceneUpdate update;
+  backbone::DecisionRow row;  // the final plan's row; requests and time summed over the pose
+  bool planned = false;       // false: planning failed (planError), the update is empty
+  Status planError;
+  int plans = 0;
+  std::uint32_t adds = 0;
+  std::uint32_t removes = 0;
+  std::uint32_t deferredByPolygonCap = 0;
+  std::uint32_t deferredByLink = 0;
+  std::uint32_t tooLargeForLink = 0;  // larger than the shaper's burst: dropped
+  std::uint64_t linkBytes = 0;        // shaped bytes of this update
+  double frontendTriangles = 0.0;     // after the update is applied
+};
+
+class BackboneCore {
+ public:
+  // `scenePath` is sent in SimplifyRequests (absolute). The scene is kept.
+  static Result<std::unique_ptr<BackboneCore>> create(scene::Scene scene, std::string scenePath,
+                                                      CoreOptions options);
+  ~BackboneCore();
+  BackboneCore(const BackboneCore&) = delete;
+  BackboneCore& operator=(const BackboneCore&) = delete;
+
+  // ---- requests to the simplifier ----
+  std::vector<OutgoingRequest> takeRequests();
+  std::vector<std::uint64_t> takeCancellations();  // wire ids
+  void requestSubmitted(std::uint64_t ticket, std::uint64_t wireId);
+  void requestNotSubmitted(std::uint64_t ticket);
+  Status onSimplifyResult(const protocol::SimplifyResult& result);
+  Status onImpostorResult(const protocol::ImpostorResult& result);
+
+  // ---- startup curves ----
+  std::size_t curvesPending() const;
+  std::vector<std::uint64_t> objectsWithoutMeasuredCurve() const;  // mesh objects
+
+  // ---- poses ----
+  Status beginPose(const protocol::ViewerPose& pose);
+  Status replan();
+  // Requests of the current pose still without a result.
+  std::size_t awaitedResults() const;
+  PoseOutcome finishPose();
+  // Answers a pose without planning (e.g. superseded by a newer one).
+  protocol::SceneUpdate emptyUpdate(const protocol::ViewerPose& pose);
+
+  void resetFrontend();
+
+  // ---- introspection (tests, logs) ----
+  const backbone::SchedulingScene& schedulingScene() const { return scene_; }
+  const std::vector<ObjectRecord>& objects() const { return converted_.records; }
+  const std::vector<scene::SceneObject>& sceneObjects() const { return sceneObjects_; }
+  std::uint32_t lodNodes() const { return converted_.lodNodes; }
+  double frontendTriangles() const { return frontendTriangles_; }
+  std::size_t outstandingRequests() const { return byTicket_.size(); }
+  const CoreOptions& options() const { return options_; }
+  const char* schedulerName() const;
+
+ private:
+  struct OptionState {
+    std::uint32_t object = 0;
+    protocol::RepresentationKind wireKind = protocol::RepresentationKind::kMesh;
+    // Mesh kinds: scheduler-relative curve before calibration, and the
+    // factor that delivered accuracies taught us (<= 1).
+    AccuracyCurve baseTriangles;
+    double calibration = 1.0;
+    bool measuredCurve = false;
+    // Impostor kinds: point-curve estimates.
+    double textureAccuracy = 0.0;  // scheduler-relative, what the texture supports
+    double parallaxFactor = 1.0;   // lowered when validity cones miss the reach ball
+    double estimatedTriangles = 0.0;
+    double estimatedBytes = 0.0;
+    bool learned = false;
+    std::optional<protocol::Representation> backbonePayload;
+    std::optional<protocol::Representation> frontendPayload;
+  };
+  struct Outstanding {
+    std::uint64_t ticket = 0;
+    std::uint64_t wireId = 0;
+    std::uint32_t object = 0;
+    std::uint32_t option = 0;
+    bool curve = false;
+    bool impostor = false;
+    protocol::RepresentationKind kind = protocol::RepresentationKind::kMesh;
+    std::uint64_t schedulerId = 0;   // the copy id the scheduler knows it by
+    double requestedAccuracy = 0.0;  // scheduler-relative
+    std::uint32_t targetTriangles = 0;
+    backbone::Sphere viewRegion;
+    std::uint64_t pose = 0;  // poseCounter_ when (re)issued
+  };
+
+  BackboneCore(scene::Scene scene, std::string scenePath, CoreOptions options);
+  Status initialize();
+  void rebuildCurves(std::uint32_t option);
+  void touchObject(std::uint32_t object);
+  Status runPlan();
+  void issueRequest(const backbone::RepresentationRequest& request);
+  void forgetTicket(std::uint64_t ticket);
+  Result<Outstanding> claim(std::uint64_t wireId, const char* what);
+  void learnMeshBytes(std::uint32_t object, double meshBytes, double triangles);
+  void storeBackboneCopy(std::uint32_t option, backbone::RepresentationCopy copy,
+                         protocol::Representation payload);
+  void moveToFrontend(std::uint32_t option);
+  void removeFromFrontend(std::uint32_t object);
+  double frontendTrianglesOf(std::uint32_t object) const;
+  double timeoutSeconds() const;
+
+  scene::Scene sceneGraph_;
+  std::vector<scene::SceneObject> sceneObjects_;
+  std::string scenePath_;
+  CoreOptions options_;
+  ConvertedScene converted_;
+  backbone::SchedulingScene scene_;
+  std::vector<OptionState> optionStates_;
+  std::vector<double> meshBytesPerTriangle_;  // per object
+  std::vector<bool> meshBytesLearned_;
+  std::unique_ptr<backbone::Scheduler> scheduler_;
+  backbone::PlannerState planner_;
+  bool dirty_ = true;
+
+  // Requests.
+  std::uint64_t nextTicket_ = 1;
+  std::map<std::uint64_t, Outstanding> byTicket_;
+  std::map<std::uint64_t, std::uint64_t> ticketOfWire_;
+  std::vector<OutgoingRequest> queued_;
+  std::vector<std::uint64_t> cancellations_;
+
+  // Current pose.
+  bool inPose_ = false;
+  protocol::ViewerPose pose_;
+  backbone::ViewerState viewer_;
+  std::uint64_t poseCounter_ = 0;
+  std::optional<backbone::Plan> plan_;
+  Status planStatus_;
+  int plansThisPose_ = 0;
+  std::uint32_t requestsThisPose_ = 0;
+  double schedulingMicrosecondsThisPose_ = 0.0;
+
+  // Frontend session.
+  double lastTime_ = -1e300;
+  std::int64_t lastShaperNs_ = 0;
+  std::optional<protocol::LinkShaper> shaper_;
+  std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
+  double frontendTriangles_ = 0.0;
+};
+
+}  // namespace thinlod::backbone_daemon

@@ -1,0 +1,483 @@
+// thinlod-backbone: the socket shell around BackboneCore (backbone_core.h).
+// Frontends connect to an Endpoint, simplifier workers to a WorkerPool; one
+// Poller waits on both and on the runtime's shutdown fd. See docs/backbone.md.
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "backbone_core.h"
+#include "thinlod/common/scene_parser.h"
+#include "thinlod/protocol/daemon_runtime.h"
+#include "thinlod/protocol/transport.h"
+
+namespace {
+
+using namespace std::chrono_literals;
+using thinlod::Status;
+using thinlod::backbone_daemon::BackboneCore;
+using thinlod::backbone_daemon::CoreOptions;
+using thinlod::backbone_daemon::PoseOutcome;
+namespace protocol = thinlod::protocol;
+using Clock = std::chrono::steady_clock;
+
+struct Settings {
+  std::string scene;
+  std::string modelsDir;
+  std::string scheduler = "curves";
+  double budgetPolygons = 0.0;
+  double budgetLink = 0.0;
+  double accuracy = 0.0;
+  double maxSpeed = 0.1;
+  double maxAngularSpeed = 1.0;
+  double lifetime = 1.0;
+  double linkDelay = 0.05;
+  double generationDelay = 0.1;
+  double minimalDistance = 0.1;
+  int syncWaitMs = 0;
+  double curveTimeoutS = 60.0;
+  int curvePoints = 32;
+  int textureSize = 256;
+  std::string textureCodec = "png";
+  double simpleImpostorRadii = 10.0;
+  double meshedImpostorRadii = 4.0;
+  double meshedImpostorTriangles = 64.0;
+  bool polygonCap = true;
+  double linkBurst = 0.0;
+  std::string decisionsCsv;
+  std::string readyFile;
+  std::string frontendAddress = protocol::kDefaultFrontendAddress;
+  std::string simplifierAddress = protocol::kDefaultSimplifierAddress;
+  int attemptTimeoutMs = 30000;
+  int maxAttempts = 3;
+  protocol::TransportOptions transport;
+};
+
+void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
+  runtime.addOption("scene", &s.scene, "scene file (required)");
+  runtime.addOption("models-dir", &s.modelsDir, "where the scene's mesh files are looked up first");
+  runtime.addOption("scheduler", &s.scheduler, "curves | static | greedy");
+  runtime.addOption("budget-polygons", &s.budgetPolygons,
+                    "triangles the frontend may hold (0: no polygon budget)");
+  runtime.addOption("budget-link", &s.budgetLink, "link budget in bytes/s (0: unlimited)");
+  runtime.addOption("accuracy", &s.accuracy, "fixed target accuracy in rad^-1 (0: maximise)");
+  runtime.addOption("max-speed", &s.maxSpeed, "viewer speed bound (m/s) for prediction");
+  runtime.addOption("max-angular-speed", &s.maxAngularSpeed, "viewer turn rate bound (rad/s)");
+  runtime.addOption("lifetime", &s.lifetime, "planned lifetime of a representation (s)");
+  runtime.addOption("link-delay", &s.linkDelay, "backbone -> frontend delay (s)");
+  runtime.addOption("generation-delay", &s.generationDelay, "simplifier generation delay (s)");
+  runtime.addOption("minimal-distance", &s.minimalDistance,
+                    "lower clamp of the viewer-object distance (m)");
+  runtime.addOption("sync-wait-ms", &s.syncWaitMs,
+                    "wait this long for a plan's simplifier results, then re-plan once (0: live)");
+  runtime.addOption("curve-timeout-s", &s.curveTimeoutS,
+                    "at startup, wait this long for the meshes' accuracy curves before ready");
+  runtime.addOption("curve-points", &s.curvePoints, "curve samples asked for per mesh");
+  runtime.addOption("texture-size", &s.textureSize, "impostor texture size (pixels per side)");
+  runtime.addOption("texture-codec", &s.textureCodec, "impostor textures: png | jpeg | zstd | raw");
+  runtime.addOption("simple-impostor-radii", &s.simpleImpostorRadii,
+                    "simple impostors from this many bounding radii away (0: none)");
+  runtime.addOption("meshed-impostor-radii", &s.meshedImpostorRadii,
+                    "meshed impostors from this many bounding radii away (0: none)");
+  runtime.addOption("meshed-impostor-triangles", &s.meshedImpostorTriangles,
+                    "triangles of a meshed impostor until the first one is measured");
+  runtime.addOption("frontend-polygon-cap", &s.polygonCap,
+                    "never let the frontend hold more than --budget-polygons (=false to allow)");
+  runtime.addOption("link-burst", &s.linkBurst,
+                    "link shaper burst in bytes (0: max(budget-link * lifetime, 64 KiB))");
+  runtime.addOption("decisions-csv", &s.decisionsCsv, "write one decision row per pose here");
+  runtime.addOption("ready-file", &s.readyFile,
+                    "write the bound addresses as JSON here once both sockets are bound");
+  runtime.addOption("frontend.address", &s.frontendAddress, "where frontends connect");
+  runtime.addOption("simplifier.address", &s.simplifierAddress, "where simplifier workers connect");
+  runtime.addOption("simplifier.attempt_timeout_ms", &s.attemptTimeoutMs,
+                    "re-send a request when a worker has not answered within this");
+  runtime.addOption("simplifier.max_attempts", &s.maxAttempts,
+                    "give a request up after this many attempts");
+  runtime.addTransportOptions(&s.transport);
+}
+
+thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
+  CoreOptions o;
+  o.scheduler = s.scheduler;
+  o.config.maxSpeed = s.maxSpeed;
+  o.config.maxAngularSpeed = s.maxAngularSpeed;
+  o.config.plannedLifetime = s.lifetime;
+  o.config.linkDelay = s.linkDelay;
+  o.config.generationDelay = s.generationDelay;
+  o.config.minimalDistance = s.minimalDistance;
+  if (s.budgetPolygons > 0.0) o.budget.maxTriangles = s.budgetPolygons;
+  if (s.budgetLink > 0.0) o.budget.maxLinkBytesPerSecond = s.budgetLink;
+  if (s.accuracy > 0.0) o.budget.fixedAccuracy = s.accuracy;
+  if (!o.budget.maxTriangles && !o.budget.maxLinkBytesPerSecond && !o.budget.fixedAccuracy)
+    return Status(thinlod::ErrorCode::kInvalidArgument,
+                  "set --budget-polygons, --budget-link and/or --accuracy");
+  if (s.textureSize < 8 || s.textureSize > 4096 || s.curvePoints < 2 || s.curvePoints > 4096)
+    return Status(thinlod::ErrorCode::kInvalidArgument,
+                  "--texture-size must be 8..4096 and --curve-points 2..4096");
+  o.textureSize = static_cast<std::uint32_t>(s.textureSize);
+  o.curvePoints = static_cast<std::uint16_t>(s.curvePoints);
+  if (s.textureCodec == "png") {
+    o.textureCodec = protocol::TextureCodec::kPng;
+  } else if (s.textureCodec == "jpeg") {
+    o.textureCodec = protocol::TextureCodec::kJpeg;
+  } else if (s.textureCodec == "zstd") {
+    o.textureCodec = protocol::TextureCodec::kZstdRgba8;
+  } else if (s.textureCodec == "raw") {
+    o.textureCodec = protocol::TextureCodec::kRawRgba8;
+  } else {
+    return Status(thinlod::ErrorCode::kInvalidArgument,
+                  "--texture-codec '" + s.textureCodec + "': expected png, jpeg, zstd or raw");
+  }
+  o.simpleImpostorRadii = s.simpleImpostorRadii;
+  o.meshedImpostorRadii = s.meshedImpostorRadii;
+  o.meshedImpostorTriangles = s.meshedImpostorTriangles;
+  o.hardPolygonCap = s.polygonCap;
+  o.linkBurstBytes = s.linkBurst;
+  if (s.syncWaitMs < 0 || !(s.curveTimeoutS >= 0.0) || s.attemptTimeoutMs <= 0 || s.maxAttempts < 1)
+    return Status(thinlod::ErrorCode::kInvalidArgument,
+                  "--sync-wait-ms and --curve-timeout-s must be >= 0, the simplifier attempt "
+                  "timeout and attempts > 0");
+  THINLOD_RETURN_IF_ERROR(thinlod::backbone_daemon::validateCoreOptions(o));
+  return o;
+}
+
+Status writeReadyFile(const std::string& path, const std::string& frontend,
+                      const std::string& simplifier) {
+  const nlohmann::json ready = {
+      {"frontend", frontend}, {"simplifier", simplifier}, {"pid", static_cast<int>(::getpid())}};
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::trunc);
+    out << ready.dump() << "\n";
+    if (!out) return Status(thinlod::ErrorCode::kIoError, "cannot write " + temporary);
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec)
+    return Status(thinlod::ErrorCode::kIoError, "cannot rename to " + path + ": " + ec.message());
+  return Status();
+}
+
+class Daemon {
+ public:
+  Daemon(protocol::DaemonRuntime& runtime, const Settings& settings, BackboneCore& core,
+         protocol::Endpoint& frontends, protocol::WorkerPool& workers, std::ofstream* csv)
+      : runtime_(runtime),
+        settings_(settings),
+        core_(core),
+        frontends_(frontends),
+        workers_(workers),
+        csv_(csv) {
+    poller_.add(frontends_);
+    poller_.add(workers_.endpoint());
+    poller_.addFd(runtime_.wakeFd());
+  }
+
+  int run() {
+    submitRequests();
+    waitForCurves();
+    if (runtime_.shutdownRequested()) return 0;
+    spdlog::info("event=ready frontend={} simplifier={} objects={} scheduler={} workers={}",
+                 frontends_.address(), workers_.endpoint().address(), core_.objects().size(),
+                 core_.schedulerName(), workers_.liveWorkers());
+    spdlog::default_logger()->flush();
+    while (!runtime_.shutdownRequested()) {
+      pump(100ms);
+      servePoses();
+    }
+    spdlog::info("event=stopping poses={} pending_requests={}", posesServed_,
+                 workers_.pendingRequests());
+    return 0;
+  }
+
+ private:
+  void waitForCurves() {
+    const auto deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(settings_.curveTimeoutS));
+    auto nextReport = Clock::now();
+    const std::size_t wanted = core_.curvesPending();
+    while (!runtime_.shutdownRequested() && core_.curvesPending() > 0 && Clock::now() < deadline) {
+      if (Clock::now() >= nextReport) {
+        spdlog::info("event=curves_waiting received={} wanted={} workers={}",
+                     wanted - core_.curvesPending(), wanted, workers_.liveWorkers());
+        nextReport = Clock::now() + 2s;
+      }
+      pump(100ms);
+      servePoses();
+    }
+    const auto missing = core_.objectsWithoutMeasuredCurve();
+    if (!missing.empty()) {
+      std::string ids;
+      for (std::uint64_t id : missing) ids += (ids.empty() ? "" : ",") + std::to_string(id);
+      spdlog::warn(
+          "event=curves_missing objects={} note=\"full mesh (exact) until the curve arrives\"",
+          ids);
+    } else {
+      spdlog::info("event=curves_ready objects={}", wanted);
+    }
+  }
+
+  // Waits up to `timeout` for input, then handles every socket's events.
+  void pump(std::chrono::milliseconds timeout) {
+    poller_.wait(timeout);
+    for (protocol::EndpointEvent& event : frontends_.poll(0ms)) onFrontendEvent(event);
+    for (protocol::WorkerPoolEvent& event : workers_.poll(0ms)) onWorkerEvent(event);
+    submitRequests();
+  }
+
+  void submitRequests() {
+    for (std::uint64_t wireId : core_.takeCancellations()) workers_.cancel(wireId);
+    for (auto& request : core_.takeRequests()) {
+      thinlod::Result<std::uint64_t> id =
+          std::visit([&](auto& message) { return workers_.submit(message); }, request.message);
+      if (id.ok()) {
+        core_.requestSubmitted(request.ticket, *id);
+      } else {
+        core_.requestNotSubmitted(request.ticket);
+        spdlog::warn("event=request_not_submitted error=\"{}\"", id.status().toString());
+      }
+    }
+  }
+
+  void onFrontendEvent(protocol::EndpointEvent& event) {
+    switch (event.kind) {
+      case protocol::EndpointEvent::Kind::kJoined:
+        spdlog::info("event=frontend_joined peer={} name={}", event.peer.value,
+                     std::get<protocol::Hello>(event.message).name);
+        break;
+      case protocol::EndpointEvent::Kind::kLeft:
+        spdlog::info("event=frontend_left peer={} reason=\"{}\"", event.peer.value,
+                     event.reason.toString());
+        if (active_ && *active_ == event.peer) active_.reset();
+        break;
+      case protocol::EndpointEvent::Kind::kMessage:
+        if (auto* pose = std::get_if<protocol::ViewerPose>(&event.message)) {
+          poses_.emplace_back(event.peer, *pose);
+        } else if (auto* stats = std::get_if<protocol::FrameStats>(&event.message)) {
+          spdlog::debug("event=frame_stats frame={} polygons={} link_bytes={}", stats->frame,
+                        stats->polygons, stats->linkBytes);
+        } else {
+          spdlog::warn("event=unexpected_dropped endpoint=frontends peer={} message={}",
+                       event.peer.value, protocol::messageName(event.message));
+        }
+        break;
+    }
+  }
+
+  void onWorkerEvent(protocol::WorkerPoolEvent& event) {
+    switch (event.kind) {
+      case protocol::WorkerPoolEvent::Kind::kWorkerJoined:
+        spdlog::info("event=worker_joined worker={} workers={}", event.worker.value,
+                     workers_.liveWorkers());
+        break;
+      case protocol::WorkerPoolEvent::Kind::kWorkerLeft:
+        spdlog::info("event=worker_left worker={} workers={} pending={}", event.worker.value,
+                     workers_.liveWorkers(), workers_.pendingRequests());
+        break;
+      case protocol::WorkerPoolEvent::Kind::kSimplifyResult:
+        noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId);
+        break;
+      case protocol::WorkerPoolEvent::Kind::kImpostorResult:
+        noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId);
+        break;
+    }
+  }
+
+  void noteResult(const Status& status, const char* kind, std::uint64_t requestId) {
+    if (status.ok()) {
+      ++resultsAccepted_;
+      spdlog::debug("event=result kind={} request={}", kind, requestId);
+    } else {
+      spdlog::warn("event=result_rejected kind={} request={} error=\"{}\"", kind, requestId,
+                   status.toString());
+    }
+  }
+
+  void servePoses() {
+    while (!poses_.empty() && !runtime_.shutdownRequested()) {
+      auto [peer, pose] = poses_.front();
+      poses_.pop_front();
+      bool superseded = false;
+      for (const auto& queued : poses_) superseded |= queued.first == peer;
+      if (superseded) {
+        // A newer pose of the same frontend waits: answer this one empty.
+        send(peer, core_.emptyUpdate(pose));
+        spdlog::info("event=pose_superseded frame={}", pose.sequence);
+        continue;
+      }
+      servePose(peer, pose);
+    }
+  }
+
+  void servePose(protocol::PeerId peer, const protocol::ViewerPose& pose) {
+    if (!active_ || *active_ != peer) {
+      if (hadFrontend_)
+        spdlog::info("event=frontend_session peer={} note=\"state reset\"", peer.value);
+      core_.resetFrontend();
+      active_ = peer;
+      hadFrontend_ = true;
+    }
+    const auto started = Clock::now();
+    Status planned = core_.beginPose(pose);
+    submitRequests();
+    if (planned.ok() && settings_.syncWaitMs > 0 && core_.awaitedResults() > 0) {
+      const auto deadline = started + std::chrono::milliseconds(settings_.syncWaitMs);
+      const std::uint64_t before = resultsAccepted_;
+      while (!runtime_.shutdownRequested() && core_.awaitedResults() > 0 &&
+             Clock::now() < deadline) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        pump(std::clamp(left, 1ms, 50ms));
+      }
+      if (resultsAccepted_ > before) {
+        // A failed re-plan keeps the first plan's error for finishPose.
+        (void)core_.replan();
+        submitRequests();
+      }
+    }
+    PoseOutcome outcome = core_.finishPose();
+    send(peer, outcome.update);
+    ++posesServed_;
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - started).count();
+    if (!outcome.planned) {
+      spdlog::error("event=plan_failed frame={} error=\"{}\"", pose.sequence,
+                    outcome.planError.toString());
+    } else {
+      const auto& row = outcome.row;
+      spdlog::info(
+          "event=plan frame={} target={:.4g} triangles={:.0f} requests={} sends={} keeps={} "
+          "adds={} removes={} frontend_triangles={:.0f} link_bytes={} plans={} ms={:.2f}",
+          pose.sequence, row.targetAccuracy, row.predictedTriangles, row.requests, row.sends,
+          row.keeps, outcome.adds, outcome.removes, outcome.frontendTriangles, outcome.linkBytes,
+          outcome.plans, ms);
+    }
+    if (outcome.deferredByPolygonCap > 0 || outcome.deferredByLink > 0 ||
+        outcome.tooLargeForLink > 0) {
+      spdlog::info("event=deferred frame={} polygon_cap={} link={} burst_grown={}", pose.sequence,
+                   outcome.deferredByPolygonCap, outcome.deferredByLink, outcome.tooLargeForLink);
+    }
+    if (csv_ != nullptr) {
+      *csv_ << thinlod::backbone::decisionRowCsv(outcome.row) << "\n";
+      csv_->flush();
+    }
+  }
+
+  void send(protocol::PeerId peer, const protocol::SceneUpdate& update) {
+    const Status sent = frontends_.send(peer, update);
+    if (!sent.ok()) {
+      spdlog::warn("event=update_not_sent frame={} peer={} error=\"{}\"", update.frame, peer.value,
+                   sent.toString());
+    }
+  }
+
+  protocol::DaemonRuntime& runtime_;
+  const Settings& settings_;
+  BackboneCore& core_;
+  protocol::Endpoint& frontends_;
+  protocol::WorkerPool& workers_;
+  std::ofstream* csv_;
+  protocol::Poller poller_;
+  std::deque<std::pair<protocol::PeerId, protocol::ViewerPose>> poses_;
+  std::optional<protocol::PeerId> active_;
+  bool hadFrontend_ = false;
+  std::uint64_t resultsAccepted_ = 0;
+  std::uint64_t posesServed_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  protocol::DaemonRuntime runtime("thinlod-backbone",
+                                  "thinlod backbone: schedules level of detail for frontends "
+                                  "with accuracy curves and asks simplifiers for representations");
+  Settings settings;
+  addOptions(runtime, settings);
+  if (auto exit = runtime.parse(argc, argv)) return *exit;
+
+  thinlod::Result<CoreOptions> options = coreOptions(settings);
+  if (!options.ok()) {
+    spdlog::error("event=bad_options error=\"{}\"", options.status().toString());
+    return 2;
+  }
+  if (settings.scene.empty()) {
+    spdlog::error("event=bad_options error=\"--scene is required\"");
+    return 2;
+  }
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(settings.scene, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  const std::string scenePath = (ec || canonical.empty() ? absolute : canonical).string();
+  thinlod::scene::SceneLoadOptions load;
+  if (!settings.modelsDir.empty()) load.meshSearchPaths = {settings.modelsDir};
+  thinlod::Result<thinlod::scene::Scene> scene = thinlod::scene::loadSceneFile(scenePath, load);
+  if (!scene.ok()) {
+    spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, scene.status().toString());
+    return 1;
+  }
+  auto core = BackboneCore::create(std::move(scene).value(), scenePath, *options);
+  if (!core.ok()) {
+    spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, core.status().toString());
+    return 1;
+  }
+  BackboneCore& backbone = **core;
+  spdlog::info("event=scene path={} objects={} lods={} options={} curves_wanted={}", scenePath,
+               backbone.objects().size(), backbone.lodNodes(),
+               backbone.schedulingScene().options.size(), backbone.curvesPending());
+
+  std::optional<std::ofstream> csv;
+  if (!settings.decisionsCsv.empty()) {
+    csv.emplace(settings.decisionsCsv, std::ios::trunc);
+    *csv << thinlod::backbone::decisionRowCsvHeader() << "\n";
+    csv->flush();
+    if (!*csv) {
+      spdlog::error("event=bad_options error=\"cannot write {}\"", settings.decisionsCsv);
+      return 1;
+    }
+  }
+
+  protocol::Endpoint::Options endpointOptions;
+  endpointOptions.address = settings.frontendAddress;
+  endpointOptions.name = "backbone";
+  endpointOptions.transport = settings.transport;
+  auto frontends = protocol::Endpoint::bind(endpointOptions);
+  if (!frontends.ok()) {
+    spdlog::error("event=bind_failed address={} error=\"{}\"", settings.frontendAddress,
+                  frontends.status().toString());
+    return 1;
+  }
+  protocol::WorkerPool::Options poolOptions;
+  poolOptions.address = settings.simplifierAddress;
+  poolOptions.name = "backbone";
+  poolOptions.transport = settings.transport;
+  poolOptions.requests.attemptTimeout = std::chrono::milliseconds(settings.attemptTimeoutMs);
+  poolOptions.requests.maxAttempts = settings.maxAttempts;
+  auto workers = protocol::WorkerPool::bind(poolOptions);
+  if (!workers.ok()) {
+    spdlog::error("event=bind_failed address={} error=\"{}\"", settings.simplifierAddress,
+                  workers.status().toString());
+    return 1;
+  }
+  spdlog::info("event=listening frontend={} simplifier={}", (*frontends)->address(),
+               (*workers)->endpoint().address());
+  if (!settings.readyFile.empty()) {
+    const Status written = writeReadyFile(settings.readyFile, (*frontends)->address(),
+                                          (*workers)->endpoint().address());
+    if (!written.ok()) {
+      spdlog::error("event=ready_file_failed error=\"{}\"", written.toString());
+      return 1;
+    }
+  }
+  Daemon daemon(runtime, settings, backbone, **frontends, **workers, csv ? &*csv : nullptr);
+  return daemon.run();
+}
