@@ -16,6 +16,10 @@
 //   possible when the loser has the smaller slope, so a pair flips at most
 //   once). Crossings are computed relative to the current accuracy, which
 //   keeps near-parallel lines stable.
+// - The conservative fit minimises the worst RATIO fit / measured staircase,
+//   not an area: measured curves span decades (r ~ K a), and an area on a
+//   linear accuracy axis ignores the cheap end, where a 10x overestimate of
+//   a coarse level's cost makes the scheduler skip it.
 #include "thinlod/common/accuracy_curve.h"
 
 #include <algorithm>
@@ -295,26 +299,232 @@ using EventQueue =
     std::priority_queue<ChildEvent, std::vector<ChildEvent>, std::greater<ChildEvent>>;
 
 // ---------------------------------------------------------------------------
-// Conservative fit helpers.
-struct StepPoint {
-  double x;  // the staircase takes value r from x on
-  double r;
+// Conservative fit: the fitted curve is a list of pieces, each one line over
+// consecutive steps of the measured staircase, starting (with a vertical
+// jump if that helps) at its first step's start. The objective is the worst
+// ratio fit / staircase; see fitConservative for the algorithm.
+
+// One step of the staircase; thinning may merge several frontier points
+// into one step, which is why `need` and `base` differ.
+struct FitStep {
+  double start;  // first accuracy of the step
+  double end;    // last accuracy (a frontier sample's accuracy)
+  double need;   // the fit must be >= need on [start, end] (conservative)
+  double base;   // the staircase's smallest value on the step: ratios use it
 };
 
-struct Line {
-  double x0;  // anchor
-  double y0;
+// A line anchored at its piece's first step start: r = value + slope (a - anchor).
+struct FitLine {
+  double value;
   double slope;
-  double at(double x) const { return y0 + slope * (x - x0); }
 };
 
-// Drops frontier points (each removal raises the staircase, so it stays a
-// conservative bound of the original) until `target` remain, always removing
-// the point whose removal adds the least area. The last point is kept: it
-// fixes the maximum accuracy.
-std::vector<AccuracySample> thinFrontier(const std::vector<AccuracySample>& frontier,
-                                         double lowestAccuracy, std::size_t target) {
+struct FitPiece {
+  std::size_t firstStep;
+  FitLine line;
+};
+
+// The (value, slope) pairs of the lines a piece may still use: a convex
+// polygon clipped by two half-planes per step it covers (O'Rourke's online
+// line fitting). Stays a handful of vertices for measured data.
+class LineRegion {
+ public:
+  void reset(double lowValue, double highValue, double maxSlope) {
+    vertices_.clear();
+    vertices_.push_back({lowValue, 0.0});
+    vertices_.push_back({highValue, 0.0});
+    if (maxSlope > 0.0) {
+      vertices_.push_back({highValue, maxSlope});
+      vertices_.push_back({lowValue, maxSlope});
+    }
+  }
+  // Keeps the lines with value + slope * offset >= bound (atLeast) or <= bound.
+  void clip(double offset, double bound, bool atLeast) {
+    auto distance = [&](const FitLine& p) {
+      const double d = p.value + p.slope * offset - bound;
+      return atLeast ? d : -d;
+    };
+    scratch_.clear();
+    const std::size_t n = vertices_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const FitLine& p = vertices_[i];
+      const FitLine& q = vertices_[i + 1 < n ? i + 1 : 0];
+      const double dp = distance(p);
+      const double dq = distance(q);
+      if (dp >= 0.0) push(p);
+      if ((dp > 0.0 && dq < 0.0) || (dp < 0.0 && dq > 0.0)) {
+        // Interpolate from the endpoint nearer the boundary: the rounding
+        // error is then relative to the short part of the edge.
+        const bool fromP = std::fabs(dp) <= std::fabs(dq);
+        const FitLine& u = fromP ? p : q;
+        const FitLine& w = fromP ? q : p;
+        const double du = fromP ? dp : dq;
+        const double dw = fromP ? dq : dp;
+        const double t = du / (du - dw);
+        push({u.value + t * (w.value - u.value), u.slope + t * (w.slope - u.slope)});
+      }
+    }
+    if (scratch_.size() > 1 && scratch_.back().value == scratch_.front().value &&
+        scratch_.back().slope == scratch_.front().slope) {
+      scratch_.pop_back();
+    }
+    vertices_.swap(scratch_);
+  }
+  bool empty() const { return vertices_.empty(); }
+  void save() { saved_ = vertices_; }
+  void restore() { vertices_.swap(saved_); }
+  // The vertex minimising (primary . line), ties broken by (secondary . line).
+  FitLine minimise(const FitLine& primary, const FitLine& secondary) const {
+    FitLine best = vertices_.front();
+    double bestPrimary = kInfinity;
+    double bestSecondary = kInfinity;
+    for (const FitLine& v : vertices_) {
+      const double p = primary.value * v.value + primary.slope * v.slope;
+      const double s = secondary.value * v.value + secondary.slope * v.slope;
+      if (p < bestPrimary || (p == bestPrimary && s < bestSecondary)) {
+        best = v;
+        bestPrimary = p;
+        bestSecondary = s;
+      }
+    }
+    return best;
+  }
+
+ private:
+  void push(const FitLine& p) {
+    if (!scratch_.empty() && scratch_.back().value == p.value && scratch_.back().slope == p.slope) {
+      return;
+    }
+    scratch_.push_back(p);
+  }
+  std::vector<FitLine> vertices_;
+  std::vector<FitLine> scratch_;
+  std::vector<FitLine> saved_;
+};
+
+// Covers the steps left to right with pieces whose ratio to the staircase
+// is <= `ratio` at every step's end (where a non-decreasing fit is highest
+// relative to a step), each piece as long as possible and then ending as
+// low as possible (the next piece must start at or above that end).
+// Returns false when that takes more than maxPieces pieces. Writes the
+// pieces when `pieces` is given (the last piece then minimises its mean
+// ratio, the others break ties in their end value by it).
+bool coverGreedily(const std::vector<FitStep>& steps, double ratio, int maxPieces,
+                   LineRegion& region, std::vector<FitPiece>* pieces) {
+  const std::size_t m = steps.size();
+  if (pieces != nullptr) pieces->clear();
+  double floorValue = 0.0;  // where the previous piece ended
+  int count = 0;
+  for (std::size_t k = 0; k < m;) {
+    if (++count > maxPieces) return false;
+    const double anchor = steps[k].start;
+    const double lowValue = std::max(floorValue, steps[k].need);
+    const double highValue = ratio * steps[k].base;
+    if (!(lowValue <= highValue) || !std::isfinite(highValue)) return false;
+    // Any line that also covers step k+1 stays below its ceiling there. The
+    // cap keeps slope * offset finite when accuracies are ulps apart.
+    double maxSlope = 0.0;
+    if (k + 1 < m) {
+      maxSlope = (ratio * steps[k + 1].base - lowValue) / (steps[k + 1].end - anchor);
+      const double span = std::max(steps[m - 1].end - anchor, std::numeric_limits<double>::min());
+      const double slopeCap = std::numeric_limits<double>::max() / 4.0 / span;
+      if (!(maxSlope <= slopeCap)) maxSlope = std::isfinite(slopeCap) ? slopeCap : 0.0;
+      maxSlope = std::max(maxSlope, 0.0);
+    }
+    region.reset(lowValue, highValue, maxSlope);
+    region.clip(steps[k].end - anchor, highValue, false);
+    if (region.empty()) return false;
+    std::size_t last = k;
+    for (std::size_t j = k + 1; j < m; ++j) {
+      region.save();
+      region.clip(steps[j].start - anchor, steps[j].need, true);
+      if (!region.empty()) region.clip(steps[j].end - anchor, ratio * steps[j].base, false);
+      if (region.empty()) {
+        region.restore();
+        break;
+      }
+      last = j;
+    }
+    // Mean ratio over the piece's steps, as a linear function of the line.
+    FitLine meanRatio{0.0, 0.0};
+    if (pieces != nullptr) {
+      for (std::size_t j = k; j <= last; ++j) {
+        if (steps[j].base <= 0.0) continue;
+        meanRatio.value += 1.0 / steps[j].base;
+        meanRatio.slope += (steps[j].end - anchor) / steps[j].base;
+      }
+    }
+    FitLine line;
+    if (last + 1 < m) {
+      line = region.minimise(FitLine{1.0, steps[last + 1].start - anchor}, meanRatio);
+      floorValue = evaluate(CurveSegment{anchor, line.value, line.slope}, steps[last + 1].start);
+    } else {
+      line = region.minimise(meanRatio, FitLine{1.0, steps[last].end - anchor});
+    }
+    if (pieces != nullptr) pieces->push_back(FitPiece{k, line});
+    k = last + 1;
+  }
+  return true;
+}
+
+// The pieces of least worst ratio (to a relative precision of
+// kRatioPrecision) with at most maxPieces pieces: bisection over the ratio
+// on a log scale; coverGreedily decides each candidate.
+std::vector<FitPiece> fitMinimaxRatio(std::vector<FitStep> steps, int maxPieces) {
+  constexpr double kRatioPrecision = 1e-11;
+  constexpr int kMaxBisections = 200;
+  const std::size_t m = steps.size();
+  // Resources 0 can only be matched exactly, which takes a piece of its
+  // own; with a single piece, measure that step against the next one.
+  if (steps[0].base <= 0.0 && m > 1 && maxPieces == 1) steps[0].base = steps[1].base;
+  const double lowestBase = steps[0].base > 0.0 ? steps[0].base : steps[1].base;
+  // One flat piece at the top (or two, the first over a zero step) has
+  // this ratio: an upper bound.
+  double high = std::max(1.0, steps[m - 1].need / lowestBase) * (1.0 + 1e-9);
+  LineRegion region;
+  std::vector<FitPiece> pieces;
+  if (!(std::isfinite(high) && coverGreedily(steps, high, maxPieces, region, nullptr))) {
+    // Not reached in exact arithmetic; stay conservative regardless.
+    if (steps[0].base <= 0.0) pieces.push_back(FitPiece{0, FitLine{steps[0].need, 0.0}});
+    pieces.push_back(FitPiece{pieces.size(), FitLine{steps[m - 1].need, 0.0}});
+    return pieces;
+  }
+  double low = 1.0;
+  if (coverGreedily(steps, low, maxPieces, region, nullptr)) high = low;
+  for (int i = 0; i < kMaxBisections && high > low * (1.0 + kRatioPrecision); ++i) {
+    const double mid = std::sqrt(low) * std::sqrt(high);
+    if (!(mid > low && mid < high)) break;
+    if (coverGreedily(steps, mid, maxPieces, region, nullptr)) {
+      high = mid;
+    } else {
+      low = mid;
+    }
+  }
+  coverGreedily(steps, high, maxPieces, region, &pieces);
+  return pieces;
+}
+
+// The frontier as steps; above `limit` points, merges neighbouring points
+// (the merged step needs the larger resources: still conservative) in order
+// of the least ratio added, until `limit` steps remain. A point with zero
+// resources is never merged (no ratio to it is finite). The last point
+// stays: it fixes the maximum accuracy.
+std::vector<FitStep> staircaseSteps(const std::vector<AccuracySample>& frontier,
+                                    double lowestAccuracy, std::size_t limit) {
   const std::size_t m = frontier.size();
+  auto startOf = [&](std::size_t i) {
+    return i == 0 ? lowestAccuracy : nextUp(frontier[i - 1].accuracy);
+  };
+  std::vector<FitStep> steps;
+  steps.reserve(std::min(m, limit));
+  if (m <= limit) {
+    for (std::size_t i = 0; i < m; ++i) {
+      steps.push_back(
+          FitStep{startOf(i), frontier[i].accuracy, frontier[i].resources, frontier[i].resources});
+    }
+    return steps;
+  }
+  // Point i represents the step of frontier points prev[i]+1 .. i.
   std::vector<int> prev(m), next(m);
   std::vector<bool> removed(m, false);
   std::vector<std::uint32_t> version(m, 0);
@@ -322,36 +532,41 @@ std::vector<AccuracySample> thinFrontier(const std::vector<AccuracySample>& fron
     prev[i] = static_cast<int>(i) - 1;
     next[i] = i + 1 < m ? static_cast<int>(i + 1) : -1;
   }
-  auto removalCost = [&](int i) {
-    const double left = prev[i] < 0 ? lowestAccuracy : frontier[prev[i]].accuracy;
-    return (frontier[next[i]].resources - frontier[i].resources) * (frontier[i].accuracy - left);
+  // Merging i into next[i]: the merged step needs next's resources from
+  // i's first point on.
+  auto mergeCost = [&](int i) {
+    const double lowest = frontier[prev[i] + 1].resources;
+    return lowest > 0.0 ? frontier[next[i]].resources / lowest : kInfinity;
   };
   using Entry = std::pair<double, std::pair<int, std::uint32_t>>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
-  for (std::size_t i = 0; i + 1 < m; ++i)
-    heap.push({removalCost(static_cast<int>(i)), {static_cast<int>(i), 0}});
+  for (std::size_t i = 0; i + 1 < m; ++i) {
+    heap.push({mergeCost(static_cast<int>(i)), {static_cast<int>(i), 0}});
+  }
   std::size_t remaining = m;
-  while (remaining > target && !heap.empty()) {
+  while (remaining > limit && !heap.empty()) {
     const auto [cost, who] = heap.top();
     heap.pop();
     const int i = who.first;
     if (removed[i] || who.second != version[i]) continue;
+    if (cost == kInfinity) break;
     removed[i] = true;
     --remaining;
     const int p = prev[i];
     const int n = next[i];
     if (p >= 0) next[p] = n;
     prev[n] = p;
-    // The neighbours' removal costs changed: p's next and n's left edge.
-    if (p >= 0) heap.push({removalCost(p), {p, ++version[p]}});
-    if (next[n] >= 0) heap.push({removalCost(n), {n, ++version[n]}});
+    // n's step now starts at p+1; p's next is n.
+    if (p >= 0) heap.push({mergeCost(p), {p, ++version[p]}});
+    if (next[n] >= 0) heap.push({mergeCost(n), {n, ++version[n]}});
   }
-  std::vector<AccuracySample> kept;
-  kept.reserve(remaining);
   for (std::size_t i = 0; i < m; ++i) {
-    if (!removed[i]) kept.push_back(frontier[i]);
+    if (removed[i]) continue;
+    const std::size_t first = static_cast<std::size_t>(prev[i] + 1);
+    steps.push_back(FitStep{startOf(first), frontier[i].accuracy, frontier[i].resources,
+                            frontier[first].resources});
   }
-  return kept;
+  return steps;
 }
 
 // Index of the last segment with start <= a (0 when a is left of all).
@@ -360,11 +575,6 @@ std::size_t segmentIndexAt(const std::vector<CurveSegment>& segments, double a) 
       std::upper_bound(segments.begin(), segments.end(), a,
                        [](double value, const CurveSegment& s) { return value < s.start; });
   return it == segments.begin() ? 0 : static_cast<std::size_t>(it - segments.begin()) - 1;
-}
-
-// Cross product sign for the upper hull (points sorted by x).
-double turn(const StepPoint& o, const StepPoint& a, const StepPoint& b) {
-  return (a.x - o.x) * (b.r - o.r) - (a.r - o.r) * (b.x - o.x);
 }
 
 }  // namespace
@@ -651,6 +861,18 @@ AccuracyCurve AccuracyCurve::lowerEnvelope(const std::vector<const AccuracyCurve
   return out;
 }
 
+// Algorithm: the Pareto frontier of the samples defines the staircase S as
+// steps [start_k, a_k] of value r_k. A piece of the fit is one line over
+// consecutive steps k..q, starting at start_k (a vertical jump at a knot is
+// allowed: it makes the fit exact where the staircase jumps). Conservative
+// means line(start_j) >= r_j for each covered step; the ratio on a step is
+// worst at its end, so "ratio <= t" means line(a_j) <= t r_j. For a fixed t
+// the pieces come from a greedy left-to-right cover (each piece as long as
+// possible, then ending as low as possible, which is the best start for the
+// next piece); a bisection on log t finds the least t that needs at most
+// maxSegments pieces. Each greedy pass is O(steps) polygon clips, the
+// bisection about 45 passes; frontiers above kStepLimit points are first
+// thinned by merging the steps whose merge raises S by the least ratio.
 Result<AccuracyCurve> AccuracyCurve::fitConservative(std::vector<AccuracySample> samples,
                                                      int maxSegments) {
   if (samples.empty()) {
@@ -695,122 +917,44 @@ Result<AccuracyCurve> AccuracyCurve::fitConservative(std::vector<AccuracySample>
   }
   std::reverse(frontier.begin(), frontier.end());
 
-  // Keep the dynamic program small; thinning is conservative by itself.
-  constexpr std::size_t kDynamicProgramLimit = 192;
-  const std::size_t target = std::max(kDynamicProgramLimit, static_cast<std::size_t>(maxSegments));
-  if (frontier.size() > target) frontier = thinFrontier(frontier, lowestAccuracy, target);
+  // Step k of the staircase holds r_k on [start_k, a_k]; start_k is the
+  // first double above the previous point's accuracy so that a measured
+  // accuracy costs exactly what was measured for it. Large frontiers are
+  // thinned (conservatively) to keep the bisection fast.
+  constexpr std::size_t kStepLimit = 1024;
+  const std::size_t limit = std::max(kStepLimit, static_cast<std::size_t>(maxSegments));
+  const std::vector<FitStep> steps = staircaseSteps(frontier, lowestAccuracy, limit);
+  const std::size_t m = steps.size();
 
-  // Step k of the staircase holds r_k on [x_k, x_{k+1}); x_k is the first
-  // double above the previous point's accuracy so that a measured accuracy
-  // costs exactly what was measured for it.
-  const std::size_t m = frontier.size();
-  std::vector<StepPoint> steps(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    steps[k].x = k == 0 ? lowestAccuracy : nextUp(frontier[k - 1].accuracy);
-    steps[k].r = frontier[k].resources;
-  }
-  auto stepEnd = [&](std::size_t q) { return q + 1 < m ? steps[q + 1].x : highestAccuracy; };
-
-  AccuracyCurve out;
-  out.maxAccuracy_ = highestAccuracy;
-  std::vector<std::pair<std::size_t, Line>> pieces;  // (first step, line)
+  std::vector<FitPiece> pieces;
   if (m <= static_cast<std::size_t>(maxSegments)) {
-    for (std::size_t k = 0; k < m; ++k) pieces.push_back({k, Line{steps[k].x, steps[k].r, 0.0}});
+    for (std::size_t k = 0; k < m; ++k) pieces.push_back(FitPiece{k, FitLine{steps[k].need, 0.0}});
   } else {
-    // cost[p][q]: the smallest area under one line covering steps p..q.
-    // The line lies on or above every step start (f non-decreasing makes
-    // that sufficient), has slope >= 0, and ends at or below the next step
-    // so that the following piece can start there without a decrease.
-    std::vector<double> cost(m * m, kInfinity);
-    std::vector<Line> best(m * m);
-    std::vector<std::size_t> hull;
-    for (std::size_t p = 0; p < m; ++p) {
-      hull.clear();
-      for (std::size_t q = p; q < m; ++q) {
-        while (hull.size() >= 2 &&
-               turn(steps[hull[hull.size() - 2]], steps[hull.back()], steps[q]) >= 0.0) {
-          hull.pop_back();
-        }
-        hull.push_back(q);
-        const double begin = steps[p].x;
-        const double end = stepEnd(q);
-        const double mid = begin + 0.5 * (end - begin);
-        Line line{steps[q].x, steps[q].r, 0.0};  // flat at the highest step
-        if (mid < steps[q].x) {
-          // Tangent of the upper hull at mid: the lowest line there.
-          std::size_t lo = 0;
-          std::size_t hi = hull.size() - 1;
-          while (hi - lo > 1) {
-            const std::size_t h = (lo + hi) / 2;
-            if (steps[hull[h]].x <= mid) {
-              lo = h;
-            } else {
-              hi = h;
-            }
-          }
-          const StepPoint& u = steps[hull[lo]];
-          const StepPoint& w = steps[hull[hi]];
-          line = Line{u.x, u.r, (w.r - u.r) / (w.x - u.x)};
-          if (q + 1 < m && line.at(end) > steps[q + 1].r) {
-            // Pivot about the next step's corner: the steepest line through
-            // it that stays above every step start.
-            double slope = kInfinity;
-            for (std::size_t k = p; k <= q; ++k) {
-              slope = std::min(slope, (steps[q + 1].r - steps[k].r) / (end - steps[k].x));
-            }
-            line = Line{end, steps[q + 1].r, std::max(0.0, slope)};
-          }
-        }
-        cost[p * m + q] = (end - begin) * line.at(mid);
-        best[p * m + q] = line;
-      }
-    }
-    // total[j][q]: best cover of steps 0..q-1 with j pieces.
-    const std::size_t pieceLimit = static_cast<std::size_t>(maxSegments);
-    std::vector<double> total((pieceLimit + 1) * (m + 1), kInfinity);
-    std::vector<std::size_t> from((pieceLimit + 1) * (m + 1), 0);
-    auto at = [m](std::size_t j, std::size_t q) { return j * (m + 1) + q; };
-    total[at(0, 0)] = 0.0;
-    for (std::size_t j = 1; j <= pieceLimit; ++j) {
-      for (std::size_t q = 1; q <= m; ++q) {
-        for (std::size_t p = j - 1; p < q; ++p) {
-          const double previous = total[at(j - 1, p)];
-          if (previous == kInfinity) continue;
-          const double candidate = previous + cost[p * m + (q - 1)];
-          if (candidate < total[at(j, q)]) {
-            total[at(j, q)] = candidate;
-            from[at(j, q)] = p;
-          }
-        }
-      }
-    }
-    std::size_t bestCount = 1;
-    for (std::size_t j = 1; j <= pieceLimit; ++j) {
-      if (total[at(j, m)] < total[at(bestCount, m)]) bestCount = j;
-    }
-    std::size_t q = m;
-    for (std::size_t j = bestCount; j >= 1; --j) {
-      const std::size_t p = from[at(j, q)];
-      pieces.push_back({p, best[p * m + (q - 1)]});
-      q = p;
-    }
-    std::reverse(pieces.begin(), pieces.end());
+    pieces = fitMinimaxRatio(steps, maxSegments);
   }
 
   // Turn the lines into segments and make them conservative in floating
-  // point too: every step start must evaluate at or above its step.
+  // point too: every step start must evaluate at or above what the step
+  // needs (the segment is non-decreasing, so the whole step then is), and
+  // no segment may start below the previous one's end.
+  AccuracyCurve out;
+  out.maxAccuracy_ = highestAccuracy;
   for (std::size_t i = 0; i < pieces.size(); ++i) {
-    const std::size_t first = pieces[i].first;
-    const std::size_t last = i + 1 < pieces.size() ? pieces[i + 1].first - 1 : m - 1;
-    const Line& line = pieces[i].second;
-    CurveSegment segment{steps[first].x, line.at(steps[first].x), line.slope};
-    for (std::size_t k = first; k <= last; ++k) {
-      const double shortfall = steps[k].r - evaluate(segment, steps[k].x);
-      if (shortfall > 0.0) segment.value += shortfall;
-      while (evaluate(segment, steps[k].x) < steps[k].r) segment.value = nextUp(segment.value);
-    }
+    const std::size_t first = pieces[i].firstStep;
+    const std::size_t last = i + 1 < pieces.size() ? pieces[i + 1].firstStep - 1 : m - 1;
+    CurveSegment segment{steps[first].start, std::max(0.0, pieces[i].line.value),
+                         std::max(0.0, pieces[i].line.slope)};
     if (!out.segments_.empty()) {
       segment.value = std::max(segment.value, evaluate(out.segments_.back(), segment.start));
+    }
+    for (std::size_t k = first; k <= last; ++k) {
+      // Each round at least doubles the raise, so this ends after a few.
+      double raise = 0.0;
+      while (evaluate(segment, steps[k].start) < steps[k].need) {
+        const double shortfall = steps[k].need - evaluate(segment, steps[k].start);
+        raise = std::max(2.0 * raise, shortfall);
+        segment.value = nextUp(segment.value + raise);
+      }
     }
     out.segments_.push_back(segment);
   }
