@@ -1,0 +1,645 @@
+// BackboneCore (backbone/src/daemon/backbone_core.h) without sockets: scene
+// conversion, requests and sends, the frontend polygon cap, the link shaper,
+// request convergence for a standing viewer, and rejection of bad results.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <deque>
+#include <random>
+#include <set>
+
+#include "backbone_core.h"
+#include "fake_simplifier.h"
+#include "scene_conversion.h"
+#include "thinlod/common/scene_parser.h"
+#include "thinlod/protocol/codec.h"
+
+namespace thinlod::backbone_daemon {
+namespace {
+
+using namespace testing;
+using backbone::ObjectAction;
+using backbone::RepresentationKind;
+using backbone::SceneNodeKind;
+
+const glm::vec3 kEntrance(2.0f, 1.1f, 3.5f);
+const glm::vec3 kCow(2.0f, 0.3f, 0.55f);
+
+std::unique_ptr<BackboneCore> makeCore(const CoreOptions& options) {
+  auto core = paperRoomCore(options);
+  EXPECT_TRUE(core.ok()) << core.status().toString();
+  return core.ok() ? std::move(core).value() : nullptr;
+}
+
+// Answers the startup curve request(s).
+void deliverCurves(BackboneCore& core) {
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+}
+
+std::size_t countOps(const protocol::SceneUpdate& update, protocol::SceneOperation::Type type) {
+  std::size_t n = 0;
+  for (const auto& op : update.operations) n += op.type == type ? 1 : 0;
+  return n;
+}
+
+// ---------------------------------------------------------- scene conversion
+
+TEST(BackboneCoreScene, PaperRoomHasFourObjectsUnderTheRootGroup) {
+  auto core = makeCore(polygonBudget(200));
+  ASSERT_NE(core, nullptr);
+  const backbone::SchedulingScene& scene = core->schedulingScene();
+  ASSERT_EQ(core->objects().size(), 4u);
+  ASSERT_EQ(scene.objects.size(), 4u);
+  EXPECT_EQ(scene.nodes[0].kind, SceneNodeKind::kGroup);
+  EXPECT_EQ(scene.nodes[0].childCount, 4u);
+  EXPECT_EQ(core->lodNodes(), 0u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const ObjectRecord& record = core->objects()[k];
+    EXPECT_EQ(record.id, k + 1);
+    EXPECT_EQ(scene.objects[k].externalId, k + 1);
+    EXPECT_EQ(scene.nodes[record.leafNode].kind, SceneNodeKind::kLeaf);
+    EXPECT_EQ(scene.nodes[record.leafNode].object, k);
+    EXPECT_GT(record.bounds.radius, 0.0);
+    // simplified mesh + meshed impostor + simple impostor
+    ASSERT_EQ(scene.objects[k].optionCount, 3u);
+    const auto& first = scene.options[scene.objects[k].firstOption];
+    EXPECT_EQ(first.kind, RepresentationKind::kSimplifiedMesh);
+  }
+  EXPECT_TRUE(backbone::validateScene(scene).ok());
+  // Ids 1-3 are the primitives (spheres, cylinder), 4 the cow.
+  EXPECT_TRUE(core->objects()[0].primitive);
+  EXPECT_FALSE(core->objects()[3].primitive);
+  // The spheres' leaf spheres are tight: radius 0.3 m.
+  EXPECT_NEAR(core->objects()[0].bounds.radius, 0.3, 0.01);
+}
+
+TEST(BackboneCoreScene, PrimitivesHaveAnalyticCurvesAndTheCowWaitsForItsCurve) {
+  auto core = makeCore(polygonBudget(200));
+  ASSERT_NE(core, nullptr);
+  const backbone::SchedulingScene& scene = core->schedulingScene();
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& mesh = scene.options[scene.objects[k].firstOption];
+    EXPECT_GT(mesh.relativeTriangles.segments().size(), 4u) << "object " << k + 1;
+    EXPECT_LT(mesh.relativeTriangles.minAccuracy(), mesh.relativeTriangles.maxAccuracy());
+  }
+  EXPECT_EQ(core->curvesPending(), 1u);
+  EXPECT_EQ(core->objectsWithoutMeasuredCurve(), std::vector<std::uint64_t>{4});
+  const auto& cow = scene.options[scene.objects[3].firstOption];
+  // Until the curve arrives: one point, the full mesh (exact).
+  EXPECT_EQ(cow.relativeTriangles.minAccuracy(), cow.relativeTriangles.maxAccuracy());
+  EXPECT_EQ(cow.relativeTriangles.resourcesFor(1.0), 5804.0);
+
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  ASSERT_EQ(requests.size(), 1u);
+  const auto& curveRequest = std::get<protocol::SimplifyRequest>(requests[0].message);
+  EXPECT_EQ(curveRequest.objectId, 4u);
+  EXPECT_GT(curveRequest.curvePoints, 0u);
+  EXPECT_EQ(curveRequest.sourcePath, paperRoomPath());
+  FakeSimplifier fake(*core);
+  answer(*core, fake, requests);
+
+  EXPECT_EQ(core->curvesPending(), 0u);
+  EXPECT_TRUE(core->objectsWithoutMeasuredCurve().empty());
+  const auto& measured = core->schedulingScene().options[scene.objects[3].firstOption];
+  EXPECT_GT(measured.relativeTriangles.segments().size(), 2u);
+  EXPECT_LT(measured.relativeTriangles.minAccuracy(), measured.relativeTriangles.maxAccuracy());
+  // The link curve covers the same accuracies and grows with the triangles.
+  EXPECT_EQ(measured.relativeLinkBytes.minAccuracy(), measured.relativeTriangles.minAccuracy());
+  EXPECT_GT(measured.relativeLinkBytes.resourcesFor(measured.relativeLinkBytes.maxAccuracy()),
+            measured.relativeLinkBytes.resourcesFor(measured.relativeLinkBytes.minAccuracy()));
+  EXPECT_TRUE(backbone::validateScene(core->schedulingScene()).ok());
+}
+
+TEST(BackboneCoreScene, LodLevelsBecomeLodNodesWithWorldRanges) {
+  const std::string text = R"(#VRML V2.0 utf8
+Transform {
+  translation 10 0 0
+  children LOD {
+    center 0 0 0
+    range [ 5 ]
+    level [
+      Shape { geometry Sphere { radius 1 } }
+      Shape { geometry Box { size 1 1 1 } }
+    ]
+  }
+}
+Shape { geometry Sphere { radius 0.5 } }
+)";
+  Result<scene::Scene> parsed = scene::parseScene(text, "lod.wrl");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().toString();
+  auto objects = scene::collectSceneObjects(*parsed);
+  ASSERT_TRUE(objects.ok());
+  Result<ConvertedScene> converted = convertScene(*parsed, *objects);
+  ASSERT_TRUE(converted.ok()) << converted.status().toString();
+  const backbone::SchedulingScene& s = converted->scheduling;
+  EXPECT_EQ(converted->lodNodes, 1u);
+  ASSERT_EQ(s.nodes[0].childCount, 2u);
+  const std::uint32_t lod = s.children[s.nodes[0].firstChild];
+  ASSERT_EQ(s.nodes[lod].kind, SceneNodeKind::kLod);
+  ASSERT_EQ(s.nodes[lod].childCount, 2u);
+  const ConicRange& near = s.childRanges[s.nodes[lod].firstChild];
+  const ConicRange& far = s.childRanges[s.nodes[lod].firstChild + 1];
+  // Level ranges follow the LOD's transform: centred at x = 10.
+  EXPECT_NEAR(near.center().x, 10.0, 1e-6);
+  EXPECT_NEAR(near.maxDistance(), 5.0, 1e-6);
+  EXPECT_NEAR(far.minDistance(), 5.0, 1e-6);
+  EXPECT_TRUE(near.containsPoint({12.0, 0.0, 0.0}));
+  EXPECT_FALSE(near.containsPoint({16.0, 0.0, 0.0}));
+  // Each level is a group holding one leaf.
+  const std::uint32_t level0 = s.children[s.nodes[lod].firstChild];
+  EXPECT_EQ(s.nodes[level0].kind, SceneNodeKind::kGroup);
+  ASSERT_EQ(s.nodes[level0].childCount, 1u);
+  EXPECT_EQ(s.nodes[s.children[s.nodes[level0].firstChild]].kind, SceneNodeKind::kLeaf);
+  // Tree checks pass once options exist (the core adds them).
+  backbone::SchedulingScene withOptions = s;
+  for (auto& object : withOptions.objects) {
+    object.firstOption = static_cast<std::uint32_t>(withOptions.options.size());
+    object.optionCount = 1;
+    backbone::RepresentationOption option;
+    option.relativeTriangles = AccuracyCurve::point(10.0, 100.0);
+    option.relativeLinkBytes = AccuracyCurve::point(10.0, 1000.0);
+    withOptions.options.push_back(option);
+  }
+  EXPECT_TRUE(backbone::validateScene(withOptions).ok());
+}
+
+// ------------------------------------------------------------ pose -> update
+
+TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  EXPECT_FALSE(requests.empty());
+  EXPECT_EQ(core->awaitedResults(), requests.size());
+  PoseOutcome first = core->finishPose();
+  ASSERT_TRUE(first.planned) << first.planError.toString();
+  EXPECT_EQ(first.update.frame, 0u);
+  EXPECT_TRUE(first.update.operations.empty());  // nothing generated yet
+  EXPECT_GT(first.row.requests, 0u);
+  EXPECT_GT(first.update.targetAccuracy, 0.0);
+
+  answer(*core, fake, requests);
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+  submitAll(*core);
+  PoseOutcome second = core->finishPose();
+  EXPECT_EQ(second.update.frame, 1u);
+  const std::size_t adds = countOps(second.update, protocol::SceneOperation::Type::kAddOrReplace);
+  EXPECT_EQ(adds, requests.size());
+  std::set<std::uint64_t> ids;
+  for (const auto& op : second.update.operations) {
+    ids.insert(op.objectId);
+    EXPECT_GE(op.objectId, 1u);
+    EXPECT_LE(op.objectId, 4u);
+    EXPECT_GT(op.representation.triangleCount, 0u);
+    EXPECT_FALSE(op.representation.mesh.empty());
+  }
+  // Encodable: the frontend's decoder would accept it.
+  EXPECT_TRUE(protocol::validate(protocol::Message(second.update)).ok());
+  EXPECT_EQ(ids.size(), adds);  // object ids unique within the batch
+  EXPECT_LE(second.frontendTriangles, 400.0);
+  EXPECT_EQ(core->frontendTriangles(), second.frontendTriangles);
+}
+
+TEST(BackboneCorePose, SyncWaitReplanSendsInTheSameUpdate) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(7, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  ASSERT_FALSE(requests.empty());
+  answer(*core, fake, requests);
+  EXPECT_EQ(core->awaitedResults(), 0u);
+  ASSERT_TRUE(core->replan().ok());
+  submitAll(*core);
+  PoseOutcome outcome = core->finishPose();
+  EXPECT_EQ(outcome.plans, 2);
+  EXPECT_EQ(outcome.update.frame, 7u);
+  EXPECT_EQ(countOps(outcome.update, protocol::SceneOperation::Type::kAddOrReplace),
+            requests.size());
+  // Mesh representations carry the object's transform (content frame geometry).
+  for (const auto& op : outcome.update.operations) {
+    if (op.representation.kind != protocol::RepresentationKind::kMesh) continue;
+    const auto& object = core->sceneObjects()[op.objectId - 1];
+    EXPECT_EQ(op.representation.transform, object.objectToWorld);
+    EXPECT_TRUE(std::isinf(op.representation.validity.distanceMax));
+  }
+}
+
+TEST(BackboneCorePose, PlanningFailureStillAnswersWithAnEmptyUpdate) {
+  auto core = makeCore(polygonBudget(200));
+  ASSERT_NE(core, nullptr);
+  protocol::ViewerPose pose = poseAt(3, 0.0, kEntrance, kCow);
+  pose.position = glm::vec3(std::nanf(""), 0.0f, 0.0f);  // the codec would reject it; the core too
+  EXPECT_FALSE(core->beginPose(pose).ok());
+  PoseOutcome outcome = core->finishPose();
+  EXPECT_FALSE(outcome.planned);
+  EXPECT_EQ(outcome.update.frame, 3u);
+  EXPECT_TRUE(outcome.update.operations.empty());
+  // The next valid pose is served normally.
+  EXPECT_TRUE(core->beginPose(poseAt(4, 0.1, kEntrance, kCow)).ok());
+  EXPECT_TRUE(core->finishPose().planned);
+}
+
+// --------------------------------------------------------------- polygon cap
+
+// A random flight through the room; results arrive 0..3 poses late; the
+// simplifier delivers `inflation` x the triangles asked for.
+void flyAndCheckCap(double inflation, std::uint64_t seed) {
+  const double budget = 200.0;
+  auto core = makeCore(polygonBudget(budget));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  fake.inflation = inflation;
+  FrontendModel frontend;
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::deque<std::pair<int, OutgoingRequest>> inFlight;  // (due pose, request)
+  glm::dvec3 position(2.0, 1.1, 3.4);
+  glm::dvec3 velocity(0.0);
+  const double dt = 0.25;
+  std::size_t adds = 0;
+  std::size_t deferred = 0;
+  for (int step = 0; step < 240; ++step) {
+    // Bounded random walk: |v| <= 0.09 m/s, inside the room.
+    velocity += glm::dvec3(unit(random) - 0.5, 0.0, unit(random) - 0.5) * 0.03;
+    if (glm::length(velocity) > 0.09) velocity *= 0.09 / glm::length(velocity);
+    position += velocity * dt;
+    position = glm::clamp(position, glm::dvec3(0.3, 1.1, 0.3), glm::dvec3(3.7, 1.1, 3.4));
+    const glm::vec3 target(kCow.x + 1.5f * std::sin(step * 0.05f), 0.4f, kCow.z + 1.0f);
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * dt, glm::vec3(position), target)).ok());
+    for (OutgoingRequest& r : submitAll(*core))
+      inFlight.emplace_back(step + static_cast<int>(unit(random) * 4.0), std::move(r));
+    for (std::uint64_t wire : core->takeCancellations()) {
+      inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
+                                    [&](const auto& f) { return wireIdOf(f.second) == wire; }),
+                     inFlight.end());
+    }
+    std::vector<OutgoingRequest> due;
+    for (auto it = inFlight.begin(); it != inFlight.end();) {
+      if (it->first <= step) {
+        due.push_back(std::move(it->second));
+        it = inFlight.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    answer(*core, fake, due);
+    PoseOutcome outcome = core->finishPose();
+    ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+    frontend.apply(outcome.update);
+    adds += outcome.adds;
+    deferred += outcome.deferredByPolygonCap;
+    ASSERT_LE(frontend.total(), budget) << "step " << step;
+    ASSERT_EQ(frontend.total(), core->frontendTriangles()) << "step " << step;
+  }
+  EXPECT_GT(adds, 4u);  // the flight did get representations
+  if (inflation > 1.0) {
+    EXPECT_GT(deferred, 0u);  // the cap had work to do
+  }
+}
+
+TEST(BackboneCoreCap, PolygonBudgetHoldsAtTheFrontendOverARandomFlight) { flyAndCheckCap(1.0, 11); }
+
+TEST(BackboneCoreCap, PolygonBudgetHoldsWhenTheSimplifierDeliversTooMuch) {
+  flyAndCheckCap(1.6, 12);
+}
+
+// ----------------------------------------------------------------- link shaper
+
+// Flies towards the cow; returns (time, shaped bytes) per pose and the
+// number of deferred operations.
+struct LinkRun {
+  std::vector<std::pair<double, double>> sent;
+  std::size_t deferred = 0;
+  std::size_t adds = 0;
+};
+
+LinkRun flyWithLinkBudget(double rate, double burst, double meshBytesPerTriangle) {
+  LinkRun run;
+  CoreOptions options;
+  options.config.maxSpeed = 0.1;
+  options.budget.maxLinkBytesPerSecond = rate;
+  options.linkBurstBytes = burst;
+  auto core = makeCore(options);
+  EXPECT_NE(core, nullptr);
+  if (!core) return run;
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  // From now on meshes are larger than the curve result taught the core.
+  fake.meshBytesPerTriangle = meshBytesPerTriangle;
+  fake.texturebytes = 9000;
+  for (int step = 0; step < 80; ++step) {
+    const double t = step * 0.2;
+    const glm::vec3 position(2.0f, 1.1f, 3.4f - 0.018f * step);
+    EXPECT_TRUE(core->beginPose(poseAt(step, t, position, kCow)).ok());
+    answer(*core, fake, submitAll(*core));  // immediate results
+    PoseOutcome outcome = core->finishPose();
+    run.sent.emplace_back(t, double(outcome.linkBytes));
+    run.deferred += outcome.deferredByLink;
+    run.adds += outcome.adds;
+  }
+  return run;
+}
+
+void expectWithinBucket(const LinkRun& run, double rate, double burst) {
+  double total = 0.0;
+  for (std::size_t i = 0; i < run.sent.size(); ++i) {
+    double window = 0.0;
+    for (std::size_t j = i; j < run.sent.size(); ++j) {
+      window += run.sent[j].second;
+      const double span = run.sent[j].first - run.sent[i].first;
+      ASSERT_LE(window, rate * span + burst + 1e-6) << "window " << i << ".." << j;
+    }
+    total += run.sent[i].second;
+  }
+  EXPECT_GT(total, 0.0);
+}
+
+TEST(BackboneCoreLink, ShapedBytesStayWithinRateTimesWindowPlusBurst) {
+  const LinkRun run = flyWithLinkBudget(12000.0, 16000.0, 1.5);
+  expectWithinBucket(run, 12000.0, 16000.0);
+}
+
+TEST(BackboneCoreLink, ShaperDefersWhatTheEstimatesMissedAndSendsItLater) {
+  // 40 B/triangle where the core learned 1.5: sends overrun the scheduler's
+  // link plan and the shaper holds them back.
+  const LinkRun run = flyWithLinkBudget(6000.0, 12000.0, 40.0);
+  expectWithinBucket(run, 6000.0, 12000.0);
+  EXPECT_GT(run.deferred, 0u);
+  EXPECT_GT(run.adds, 3u);
+}
+
+// ------------------------------------------------------------ convergence
+
+void standStill(const CoreOptions& options) {
+  auto core = makeCore(options);
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  const glm::vec3 position(2.0f, 1.1f, 2.6f);
+  std::vector<std::uint32_t> requests;
+  for (int step = 0; step < 16; ++step) {
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, position, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    PoseOutcome outcome = core->finishPose();
+    ASSERT_TRUE(outcome.planned);
+    requests.push_back(outcome.row.requests);
+  }
+  std::uint32_t early = 0;
+  for (int step = 0; step < 4; ++step) early += requests[step];
+  EXPECT_GT(early, 0u);
+  for (int step = 8; step < 16; ++step) EXPECT_EQ(requests[step], 0u) << "step " << step;
+  EXPECT_GT(core->frontendTriangles(), 0.0);
+}
+
+TEST(BackboneCoreConvergence, StandingViewerStopsRequestingUnderAPolygonBudget) {
+  standStill(polygonBudget(300));
+}
+
+TEST(BackboneCoreConvergence, StandingViewerStopsRequestingAtAFixedAccuracy) {
+  CoreOptions options;
+  options.config.maxSpeed = 0.1;
+  options.budget.fixedAccuracy = 150.0;
+  standStill(options);
+}
+
+// ------------------------------------------------------------- rejections
+
+class BackboneCoreResults : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    core_ = makeCore(polygonBudget(400));
+    ASSERT_NE(core_, nullptr);
+    deliverCurves(*core_);
+    ASSERT_TRUE(core_->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+    requests_ = submitAll(*core_);
+    (void)core_->finishPose();
+    for (const OutgoingRequest& r : requests_) {
+      if (std::holds_alternative<protocol::SimplifyRequest>(r.message) && !mesh_) mesh_ = &r;
+    }
+    ASSERT_NE(mesh_, nullptr);
+  }
+  protocol::SimplifyResult goodMeshResult() const {
+    protocol::SimplifyRequest wire = std::get<protocol::SimplifyRequest>(mesh_->message);
+    wire.requestId = wireIdOf(*mesh_);
+    return FakeSimplifier(*core_).simplify(wire);
+  }
+  void expectRejected(const protocol::SimplifyResult& result, ErrorCode code) {
+    const Status status = core_->onSimplifyResult(result);
+    EXPECT_EQ(status.code(), code) << status.toString();
+    // The request is forgotten: the good answer now is unknown too.
+    EXPECT_EQ(core_->onSimplifyResult(goodMeshResult()).code(), ErrorCode::kNotFound);
+    // And the core keeps planning.
+    EXPECT_TRUE(core_->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+    EXPECT_TRUE(core_->finishPose().planned);
+  }
+
+  std::unique_ptr<BackboneCore> core_;
+  std::vector<OutgoingRequest> requests_;
+  const OutgoingRequest* mesh_ = nullptr;
+};
+
+TEST_F(BackboneCoreResults, UnknownRequestIdIsNotFound) {
+  protocol::SimplifyResult result = goodMeshResult();
+  result.requestId = 987654321;
+  EXPECT_EQ(core_->onSimplifyResult(result).code(), ErrorCode::kNotFound);
+  protocol::ImpostorResult impostor;
+  impostor.requestId = 5;
+  impostor.objectIds = {1};
+  EXPECT_EQ(core_->onImpostorResult(impostor).code(), ErrorCode::kNotFound);
+  EXPECT_TRUE(core_->onSimplifyResult(goodMeshResult()).ok());  // the real one still counts
+}
+
+TEST_F(BackboneCoreResults, WrongObjectIdIsRejected) {
+  protocol::SimplifyResult result = goodMeshResult();
+  result.objectId = result.objectId % 4 + 1;
+  expectRejected(result, ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreResults, EmptyMeshIsRejected) {
+  protocol::SimplifyResult result = goodMeshResult();
+  result.mesh.clear();
+  expectRejected(result, ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreResults, ZeroTrianglesAreRejected) {
+  protocol::SimplifyResult result = goodMeshResult();
+  result.triangleCount = 0;
+  expectRejected(result, ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreResults, NonFiniteAccuracyIsRejected) {
+  protocol::SimplifyResult result = goodMeshResult();
+  result.accuracy = std::numeric_limits<double>::quiet_NaN();
+  expectRejected(result, ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreResults, SimplifierErrorIsPassedOnAndForgotten) {
+  protocol::SimplifyResult result;
+  result.requestId = goodMeshResult().requestId;
+  result.objectId = goodMeshResult().objectId;
+  result.status = Status(ErrorCode::kNotFound, "no such object");
+  expectRejected(result, ErrorCode::kNotFound);
+}
+
+TEST_F(BackboneCoreResults, ImpostorResultForAMeshRequestIsRejected) {
+  protocol::ImpostorResult result;
+  result.requestId = goodMeshResult().requestId;
+  result.objectIds = {goodMeshResult().objectId};
+  EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(core_->onSimplifyResult(goodMeshResult()).code(), ErrorCode::kNotFound);
+}
+
+TEST(BackboneCoreCurve, MalformedCurveSamplesKeepTheFallbackCurve) {
+  auto core = makeCore(polygonBudget(200));
+  ASSERT_NE(core, nullptr);
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  ASSERT_EQ(requests.size(), 1u);
+  protocol::SimplifyRequest wire = std::get<protocol::SimplifyRequest>(requests[0].message);
+  wire.requestId = wireIdOf(requests[0]);
+  protocol::SimplifyResult result = FakeSimplifier(*core).simplify(wire);
+  result.curve[1].accuracy = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(core->onSimplifyResult(result).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(core->curvesPending(), 0u);
+  EXPECT_EQ(core->objectsWithoutMeasuredCurve(), std::vector<std::uint64_t>{4});
+  EXPECT_TRUE(backbone::validateScene(core->schedulingScene()).ok());
+}
+
+// A standing viewer far enough from a sphere for impostors: impostor
+// results with a bad kind or a malformed validity range are rejected.
+class BackboneCoreImpostors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    CoreOptions options;
+    options.config.maxSpeed = 0.1;
+    options.budget.maxTriangles = 20.0;  // too few for meshes: impostors win
+    options.simpleImpostorRadii = 3.0;
+    options.meshedImpostorRadii = 0.0;
+    core_ = makeCore(options);
+    ASSERT_NE(core_, nullptr);
+    deliverCurves(*core_);
+    ASSERT_TRUE(core_->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+    for (OutgoingRequest& r : submitAll(*core_)) {
+      if (std::holds_alternative<protocol::ImpostorRequest>(r.message)) impostors_.push_back(r);
+    }
+    (void)core_->finishPose();
+    ASSERT_FALSE(impostors_.empty());
+  }
+  protocol::ImpostorResult good() const {
+    protocol::ImpostorRequest wire = std::get<protocol::ImpostorRequest>(impostors_[0].message);
+    wire.requestId = wireIdOf(impostors_[0]);
+    return FakeSimplifier(*core_).impostor(wire);
+  }
+  std::unique_ptr<BackboneCore> core_;
+  std::vector<OutgoingRequest> impostors_;
+};
+
+TEST_F(BackboneCoreImpostors, RequestCarriesRegionCentreBoundAndTextureSize) {
+  const auto& request = std::get<protocol::ImpostorRequest>(impostors_[0].message);
+  EXPECT_EQ(request.objectIds.size(), 1u);
+  EXPECT_EQ(request.kind, protocol::RepresentationKind::kSimpleImpostor);
+  EXPECT_EQ(request.textureWidth, 256u);
+  EXPECT_GT(request.accuracyBound, 0.0);
+  EXPECT_LT(request.accuracyBound, 0.5);
+  EXPECT_LT(glm::length(request.eye - kEntrance), 1e-3f);
+  EXPECT_TRUE(core_->onImpostorResult(good()).ok());
+}
+
+TEST_F(BackboneCoreImpostors, WrongKindIsRejected) {
+  protocol::ImpostorResult result = good();
+  result.representation.kind = protocol::RepresentationKind::kMeshedImpostor;
+  EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(core_->onImpostorResult(good()).code(), ErrorCode::kNotFound);
+}
+
+TEST_F(BackboneCoreImpostors, InvertedValidityIsRejected) {
+  protocol::ImpostorResult result = good();
+  result.representation.validity.distanceMin = 5.0f;
+  result.representation.validity.distanceMax = 1.0f;
+  EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreImpostors, MissingTextureIsRejected) {
+  protocol::ImpostorResult result = good();
+  result.representation.texture = protocol::Texture();
+  EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+}
+
+TEST_F(BackboneCoreImpostors, ForeignObjectIdsAreRejected) {
+  protocol::ImpostorResult result = good();
+  result.objectIds = {1, 2};
+  EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+}
+
+// ------------------------------------------------------------ sessions
+
+TEST(BackboneCoreSession, NewFrontendSessionIsServedFromStoredCopies) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  for (int step = 0; step < 3; ++step) {
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    (void)core->finishPose();
+  }
+  ASSERT_GT(core->frontendTriangles(), 0.0);
+  core->resetFrontend();
+  EXPECT_EQ(core->frontendTriangles(), 0.0);
+  // The new session starts its clock at 0 again; before any new result
+  // arrives it gets the representations generated for the old one.
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  submitAll(*core);  // not answered
+  PoseOutcome outcome = core->finishPose();
+  EXPECT_GT(outcome.adds, 0u);
+  EXPECT_EQ(outcome.removes, 0u);  // the new frontend holds nothing to remove
+  EXPECT_GT(outcome.frontendTriangles, 0.0);
+  EXPECT_LE(outcome.frontendTriangles, 400.0);
+}
+
+TEST(BackboneCoreOptions, InvalidOptionsAreRefused) {
+  CoreOptions options = polygonBudget(200);
+  options.scheduler = "random";
+  EXPECT_FALSE(validateCoreOptions(options).ok());
+  options = polygonBudget(200);
+  options.textureSize = 4;
+  EXPECT_FALSE(validateCoreOptions(options).ok());
+  options = CoreOptions();
+  EXPECT_FALSE(validateCoreOptions(options).ok());  // no budget at all
+  options.scheduler = "greedy";
+  options.budget.fixedAccuracy = 100.0;
+  EXPECT_FALSE(validateCoreOptions(options).ok());  // greedy needs polygons
+  options.budget.maxTriangles = 100.0;
+  EXPECT_TRUE(validateCoreOptions(options).ok());
+}
+
+TEST(BackboneCoreOptions, BaselineSchedulersServePoses) {
+  for (const char* name : {"static", "greedy"}) {
+    CoreOptions options = polygonBudget(300);
+    options.scheduler = name;
+    auto core = makeCore(options);
+    ASSERT_NE(core, nullptr);
+    deliverCurves(*core);
+    FakeSimplifier fake(*core);
+    FrontendModel frontend;
+    for (int step = 0; step < 4; ++step) {
+      ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok()) << name;
+      answer(*core, fake, submitAll(*core));
+      PoseOutcome outcome = core->finishPose();
+      ASSERT_TRUE(outcome.planned) << name;
+      frontend.apply(outcome.update);
+      EXPECT_LE(frontend.total(), 300.0) << name;
+    }
+    EXPECT_GT(frontend.triangles.size(), 0u) << name;
+  }
+}
+
+}  // namespace
+}  // namespace thinlod::backbone_daemon
