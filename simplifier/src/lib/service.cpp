@@ -331,6 +331,20 @@ Result<std::size_t> SimplifierService::loadScene(const std::string& path) {
   }
 }
 
+Status SimplifierService::initializeRendering() {
+  try {
+    return impl_->ensureRendering();
+  } catch (const std::exception& e) {
+    return Status(ErrorCode::kInternal, std::string("rendering: ") + e.what());
+  }
+}
+
+std::string SimplifierService::rendererDescription() const {
+  if (!impl_->context || !impl_->impostors) return std::string();
+  return std::string(render::backendName(impl_->context->backend())) + ": " +
+         impl_->context->rendererName();
+}
+
 protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyRequest& request) {
   ++impl_->stats.simplifyRequests;
   Result<protocol::SimplifyResult> result = Status(ErrorCode::kInternal, "not handled");

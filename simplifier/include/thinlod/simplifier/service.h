@@ -81,6 +81,8 @@ class SimplifierService {
   // Creates the GL context now (on the calling thread) instead of on the
   // first impostor request; kUnavailable names why each back-end failed.
   Status initializeRendering();
+  // "egl: llvmpipe (LLVM 15.0.6, 256 bits)" once rendering works, else "".
+  std::string rendererDescription() const;
 
   const ServiceStats& stats() const;
   const ServiceOptions& options() const;
