@@ -1,0 +1,418 @@
+// The replay loop with a fake clock, a scripted backbone link and a producer
+// around a real FrontendScene: pacing, lockstep, latency, rejects, stop.
+#include "replay_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
+
+#include "daemon_test_util.h"
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+using testing::addOp;
+using testing::meshRepresentation;
+using testing::sphereMesh;
+
+constexpr std::int64_t kMs = 1'000'000;
+
+class FakeClock final : public Clock {
+ public:
+  std::int64_t nowNs() override { return now; }
+  std::int64_t now = 1000 * kMs;
+};
+
+// A backbone that answers poses as `responder` says, after a delay.
+class FakeLink final : public BackboneLink {
+ public:
+  using Responder = std::function<std::optional<std::pair<std::int64_t, protocol::SceneUpdate>>(
+      const protocol::ViewerPose&)>;
+  explicit FakeLink(FakeClock& clock) : clock_(clock) {}
+
+  bool connected() const override { return up && clock_.now < dropAtNs; }
+  Status send(const protocol::Message& message) override {
+    if (!connected()) return Status(ErrorCode::kUnavailable, "down");
+    if (const auto* pose = std::get_if<protocol::ViewerPose>(&message)) {
+      poses.push_back(*pose);
+      poseSentNs.push_back(clock_.now);
+      if (responder) {
+        if (auto reply = responder(*pose)) {
+          inFlight.emplace_back(clock_.now + reply->first, std::move(reply->second));
+        }
+      }
+    } else if (const auto* stats = std::get_if<protocol::FrameStats>(&message)) {
+      frameStats.push_back(*stats);
+    }
+    return Status();
+  }
+  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout) override {
+    const std::int64_t deadline = clock_.now + timeout.count() * kMs;
+    std::int64_t wake = deadline;
+    for (const auto& [at, update] : inFlight) wake = std::min(wake, std::max(at, clock_.now));
+    if (dropAtNs > clock_.now) wake = std::min(wake, dropAtNs);
+    clock_.now = wake;
+    std::vector<protocol::SceneUpdate> arrived;
+    for (auto it = inFlight.begin(); it != inFlight.end();) {
+      if (it->first <= clock_.now) {
+        bytes += 1000 + payloadBytes(it->second);
+        arrived.push_back(std::move(it->second));
+        it = inFlight.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    return arrived;
+  }
+  std::uint64_t bytesReceived() const override { return bytes; }
+
+  bool up = true;
+  std::int64_t dropAtNs = std::numeric_limits<std::int64_t>::max();
+  Responder responder;
+  std::vector<protocol::ViewerPose> poses;
+  std::vector<std::int64_t> poseSentNs;
+  std::vector<protocol::FrameStats> frameStats;
+  std::vector<std::pair<std::int64_t, protocol::SceneUpdate>> inFlight;
+  std::uint64_t bytes = 0;
+
+ private:
+  FakeClock& clock_;
+};
+
+// Uploads everything at once; render and measure take fixed clock time.
+class SceneProducer final : public FrameProducer {
+ public:
+  explicit SceneProducer(FakeClock& clock) : clock_(clock) {}
+  Status submit(SceneBatch batch) override { return scene.enqueue(std::move(batch)); }
+  Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose&) override {
+    if (failAtFrame && *failAtFrame == frame) return Status(ErrorCode::kInternal, "GL lost");
+    renderStartNs.push_back(clock_.now);
+    for (const PendingUpload& upload : scene.planUploads(~std::size_t{0})) {
+      EXPECT_TRUE(scene.markUploaded(upload.key).ok());
+    }
+    const CommitResult committed = scene.commitReady();
+    clock_.now += renderNs;
+    ProducedFrame produced;
+    produced.triangles = scene.polygons();
+    produced.appliedPlan = scene.lastAppliedPlan();
+    produced.committedBatches = committed.plans.size();
+    produced.renderMs = static_cast<double>(renderNs) / kMs;
+    return produced;
+  }
+  Result<FrameQuality> measure(std::uint64_t, const Pose&) override {
+    clock_.now += measureNs;
+    FrameQuality quality;
+    quality.snrDb = snrDb;
+    quality.psnrDb = 30.0;
+    quality.referenceMs = static_cast<double>(measureNs) / kMs;
+    return quality;
+  }
+
+  FrontendScene scene;
+  std::int64_t renderNs = 5 * kMs;
+  std::int64_t measureNs = 20 * kMs;
+  double snrDb = 12.0;
+  std::optional<std::uint64_t> failAtFrame;
+  std::vector<std::int64_t> renderStartNs;
+
+ private:
+  FakeClock& clock_;
+};
+
+class RecordingObserver final : public ReplayObserver {
+ public:
+  void onUpdateRejected(const protocol::SceneUpdate& update, const Status& why) override {
+    rejectedPlans.push_back(update.plan);
+    reasons.push_back(why.message());
+  }
+  void onLockstepTimeout(std::uint64_t frame, double) override { timeouts.push_back(frame); }
+  void onFrame(const FrameRecord& record, const FrameExtras&) override {
+    frames.push_back(record.frame);
+  }
+  std::vector<std::uint64_t> rejectedPlans;
+  std::vector<std::string> reasons;
+  std::vector<std::uint64_t> timeouts;
+  std::vector<std::uint64_t> frames;
+};
+
+Trace traceAt(const std::vector<double>& times) {
+  Trace trace;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    Pose pose;
+    pose.time = times[i];
+    pose.position = glm::vec3(static_cast<float>(i), 1.0f, 5.0f);
+    pose.fovYDegrees = 45.0f;
+    trace.poses.push_back(pose);
+  }
+  return trace;
+}
+
+// Update answering pose `frame`: object `id` becomes a sphere with 8*4-ish triangles.
+protocol::SceneUpdate sphereUpdate(std::uint64_t plan, std::uint64_t frame, std::uint64_t id,
+                                   double target) {
+  protocol::SceneUpdate update;
+  update.plan = plan;
+  update.frame = frame;
+  update.targetAccuracy = target;
+  update.operations.push_back(addOp(id, meshRepresentation(sphereMesh(1.0f, 8, 4))));
+  return update;
+}
+
+const std::size_t kSphereTriangles = sphereMesh(1.0f, 8, 4).triangleCount();
+
+class ReplayLoopTest : public ::testing::Test {
+ protected:
+  ReplayResult run(const Trace& trace) {
+    return runReplay(trace, options, clock, link, producer, observer, [this] { return stop(); });
+  }
+  FakeClock clock;
+  FakeLink link{clock};
+  SceneProducer producer{clock};
+  RecordingObserver observer;
+  ReplayOptions options;
+  std::function<bool()> stop = [] { return false; };
+};
+
+TEST_F(ReplayLoopTest, LockstepAppliesEachAnswerInTheFrameOfItsPose) {
+  options.lockstep = true;
+  options.rate = -1.0;
+  options.viewportWidth = 640;
+  options.viewportHeight = 480;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    return std::make_optional(
+        std::make_pair(3 * kMs, sphereUpdate(pose.sequence + 1, pose.sequence,
+                                             pose.sequence % 2 + 1, 10.0 * (pose.sequence + 1))));
+  };
+  const Trace trace = traceAt({0.0, 0.1, 0.2, 0.35});
+  ReplayResult result = run(trace);
+  ASSERT_TRUE(result.status.ok()) << result.status.toString();
+  ASSERT_EQ(result.records.size(), 4u);
+  EXPECT_EQ(result.updatesReceived, 4u);
+  EXPECT_EQ(result.updatesApplied, 4u);
+  EXPECT_EQ(result.lockstepTimeouts, 0u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    SCOPED_TRACE(i);
+    const FrameRecord& r = result.records[i];
+    EXPECT_EQ(r.frame, i);
+    EXPECT_DOUBLE_EQ(r.timeS, trace.poses[i].time);
+    EXPECT_EQ(r.plan, i + 1);
+    EXPECT_DOUBLE_EQ(r.targetAccuracy, 10.0 * (i + 1));
+    EXPECT_EQ(r.polygons, (i == 0 ? 1 : 2) * kSphereTriangles);
+    // Answer after 3 ms, then 5 ms of rendering.
+    EXPECT_DOUBLE_EQ(r.poseToFrameMs, 8.0);
+    EXPECT_DOUBLE_EQ(result.extras[i].waitMs, 3.0);
+    EXPECT_DOUBLE_EQ(r.renderMs, 5.0);
+    EXPECT_DOUBLE_EQ(r.snrDb, 12.0);
+    EXPECT_DOUBLE_EQ(result.extras[i].referenceMs, 20.0);
+    EXPECT_GT(r.linkBytes, 1000u);
+    // The pose on the wire.
+    const protocol::ViewerPose& pose = link.poses[i];
+    EXPECT_EQ(pose.sequence, i);
+    EXPECT_EQ(pose.timestampNs, std::llround(trace.poses[i].time * 1e9));
+    EXPECT_EQ(pose.position, trace.poses[i].position);
+    EXPECT_FLOAT_EQ(pose.fovY, glm::radians(45.0f));
+    EXPECT_EQ(pose.viewportWidth, 640u);
+    EXPECT_EQ(pose.viewportHeight, 480u);
+    // FrameStats back.
+    const protocol::FrameStats& stats = link.frameStats[i];
+    EXPECT_EQ(stats.frame, i);
+    EXPECT_EQ(stats.plan, i + 1);
+    EXPECT_EQ(stats.polygons, r.polygons);
+    EXPECT_EQ(stats.linkBytes, r.linkBytes);
+    EXPECT_TRUE(stats.hasSnr);
+    EXPECT_DOUBLE_EQ(stats.snrDb, 12.0);
+  }
+}
+
+TEST_F(ReplayLoopTest, LockstepTimeoutRendersWhatItHolds) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(40);
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
+    if (pose.sequence == 0) reply = std::make_pair(2 * kMs, sphereUpdate(1, 0, 1, 5.0));
+    return reply;
+  };
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_EQ(result.records.size(), 3u);
+  EXPECT_EQ(result.lockstepTimeouts, 2u);
+  EXPECT_EQ(observer.timeouts, (std::vector<std::uint64_t>{1, 2}));
+  for (std::size_t i = 1; i < 3; ++i) {
+    EXPECT_TRUE(result.extras[i].lockstepTimedOut);
+    EXPECT_DOUBLE_EQ(result.extras[i].waitMs, 40.0);
+    EXPECT_EQ(result.records[i].polygons, kSphereTriangles);
+    EXPECT_EQ(result.records[i].plan, 1u);
+    EXPECT_DOUBLE_EQ(result.records[i].targetAccuracy, 5.0);
+    EXPECT_TRUE(std::isnan(result.records[i].poseToFrameMs));
+  }
+}
+
+TEST_F(ReplayLoopTest, LiveModeAppliesALateAnswerWhenItArrivesWithItsTrueLatency) {
+  options.rate = 10.0;  // one frame every 100 ms
+  link.responder = [](const protocol::ViewerPose& pose) {
+    std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
+    if (pose.sequence == 0) reply = std::make_pair(130 * kMs, sphereUpdate(1, 0, 1, 5.0));
+    return reply;
+  };
+  const std::int64_t start = clock.now;
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
+  ASSERT_EQ(result.records.size(), 4u);
+  ASSERT_EQ(producer.renderStartNs.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(producer.renderStartNs[i] - start, static_cast<std::int64_t>(i) * 100 * kMs);
+  }
+  // Arrived at 130 ms, during the wait for frame 2's slot: drawn in frame 2.
+  EXPECT_EQ(result.records[1].polygons, 0u);
+  EXPECT_EQ(result.records[2].polygons, kSphereTriangles);
+  EXPECT_EQ(result.records[2].plan, 1u);
+  EXPECT_DOUBLE_EQ(result.records[2].poseToFrameMs, 205.0);  // slot 200 + 5 ms render
+  EXPECT_TRUE(std::isnan(result.records[3].poseToFrameMs));  // nothing new in frame 3
+  EXPECT_EQ(result.records[2].linkBytes, link.bytes);
+  EXPECT_EQ(result.records[3].linkBytes, 0u);
+}
+
+TEST_F(ReplayLoopTest, DefaultPacingFollowsTheTraceTimes) {
+  const std::int64_t start = clock.now;
+  ReplayResult result = run(traceAt({2.0, 2.25, 2.3, 3.0}));
+  ASSERT_EQ(producer.renderStartNs.size(), 4u);
+  // Each frame takes 25 ms (render + reference), less than every gap.
+  const std::vector<std::int64_t> expected = {0, 250, 300, 1000};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(producer.renderStartNs[i] - start, expected[i] * kMs) << i;
+  }
+  EXPECT_EQ(result.records.size(), 4u);
+}
+
+TEST_F(ReplayLoopTest, LateFramesStartAtOnceWithoutSkippingPoses) {
+  options.rate = 100.0;  // 10 ms slots, but a frame takes 25 ms
+  const std::int64_t start = clock.now;
+  ReplayResult result = run(traceAt({0.0, 1.0, 2.0}));
+  ASSERT_EQ(result.records.size(), 3u);
+  EXPECT_EQ(producer.renderStartNs[1] - start, 25 * kMs);
+  EXPECT_EQ(producer.renderStartNs[2] - start, 50 * kMs);
+}
+
+TEST_F(ReplayLoopTest, BackboneDownKeepsRenderingWithoutWaiting) {
+  link.up = false;
+  options.lockstep = true;
+  options.rate = -1.0;
+  const std::int64_t start = clock.now;
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_TRUE(result.status.ok());
+  EXPECT_EQ(result.records.size(), 3u);
+  EXPECT_EQ(result.posesNotSent, 3u);
+  EXPECT_EQ(result.lockstepTimeouts, 0u);
+  EXPECT_TRUE(link.frameStats.empty());
+  EXPECT_EQ(clock.now - start, 3 * 25 * kMs);  // render + measure only
+}
+
+TEST_F(ReplayLoopTest, LockstepWaitEndsWhenTheLinkDrops) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(5000);
+  options.rate = -1.0;
+  link.dropAtNs = clock.now + 10 * kMs;
+  ReplayResult result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  EXPECT_DOUBLE_EQ(result.extras[0].waitMs, 10.0);
+  EXPECT_EQ(result.lockstepTimeouts, 0u);
+  EXPECT_FALSE(result.extras[1].poseSent);
+}
+
+TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
+  options.lockstep = true;
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    protocol::SceneUpdate update = sphereUpdate(pose.sequence + 1, pose.sequence, 1, 1.0);
+    if (pose.sequence == 1) {
+      // A valid replacement of 1 and a second object with broken Draco bytes.
+      protocol::SceneOperation broken = addOp(2, meshRepresentation(sphereMesh(1.0f, 6, 3)));
+      broken.representation.mesh.resize(broken.representation.mesh.size() / 2);
+      update.operations[0] = addOp(1, meshRepresentation(sphereMesh(1.0f, 16, 8)));
+      update.operations.push_back(broken);
+    }
+    return std::make_optional(std::make_pair(kMs, update));
+  };
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_EQ(result.records.size(), 3u);
+  EXPECT_EQ(result.updatesReceived, 3u);
+  EXPECT_EQ(result.updatesRejected, 1u);
+  EXPECT_EQ(observer.rejectedPlans, (std::vector<std::uint64_t>{2}));
+  EXPECT_NE(observer.reasons[0].find("operation 1 (object 2): mesh:"), std::string::npos)
+      << observer.reasons[0];
+  EXPECT_EQ(result.extras[1].updatesRejected, 1u);
+  // Frame 1 still shows frame 0's state; no half-applied replacement of object 1.
+  EXPECT_EQ(result.records[1].polygons, kSphereTriangles);
+  EXPECT_EQ(result.records[1].plan, 1u);
+  EXPECT_FALSE(result.extras[1].lockstepTimedOut);  // the answer came, it was just bad
+  EXPECT_EQ(result.records[2].plan, 3u);
+  EXPECT_EQ(producer.scene.objects().size(), 1u);
+}
+
+TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {
+  options.rate = -1.0;
+  stop = [this] { return observer.frames.size() >= 2; };
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
+  EXPECT_TRUE(result.interrupted);
+  EXPECT_TRUE(result.status.ok());
+  EXPECT_EQ(result.records.size(), 2u);
+}
+
+TEST_F(ReplayLoopTest, StopRequestEndsAPacingWaitWithoutRenderingTheFrame) {
+  const std::int64_t start = clock.now;
+  stop = [this, start] { return clock.now - start >= 500 * kMs; };
+  ReplayResult result = run(traceAt({0.0, 10.0}));
+  EXPECT_TRUE(result.interrupted);
+  EXPECT_EQ(result.records.size(), 1u);
+  EXPECT_LT(clock.now - start, 600 * kMs);  // within one poll slice of the request
+}
+
+TEST_F(ReplayLoopTest, MaxFramesLimitsTheReplay) {
+  options.rate = -1.0;
+  options.maxFrames = 2;
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
+  EXPECT_FALSE(result.interrupted);
+  EXPECT_EQ(result.records.size(), 2u);
+  EXPECT_EQ(link.poses.size(), 2u);
+}
+
+TEST_F(ReplayLoopTest, InfiniteSnrIsSentAsNoSnr) {
+  options.rate = -1.0;
+  producer.snrDb = std::numeric_limits<double>::infinity();
+  ReplayResult result = run(traceAt({0.0}));
+  ASSERT_EQ(link.frameStats.size(), 1u);
+  EXPECT_FALSE(link.frameStats[0].hasSnr);
+  EXPECT_EQ(link.frameStats[0].snrDb, 0.0);
+  EXPECT_TRUE(std::isinf(result.records[0].snrDb));
+}
+
+TEST_F(ReplayLoopTest, WithoutMeasurementSnrIsMissing) {
+  options.rate = -1.0;
+  options.measure = false;
+  const std::int64_t start = clock.now;
+  ReplayResult result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  EXPECT_TRUE(std::isnan(result.records[0].snrDb));
+  EXPECT_TRUE(std::isnan(result.extras[0].referenceMs));
+  EXPECT_FALSE(link.frameStats[0].hasSnr);
+  EXPECT_EQ(clock.now - start, 2 * 5 * kMs);  // no reference work
+}
+
+TEST_F(ReplayLoopTest, RenderFailureEndsTheReplayWithItsStatus) {
+  options.rate = -1.0;
+  producer.failAtFrame = 1;
+  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  EXPECT_EQ(result.status.code(), ErrorCode::kInternal);
+  EXPECT_EQ(result.records.size(), 1u);
+}
+
+TEST_F(ReplayLoopTest, EmptyTraceIsAnError) {
+  ReplayResult result = run(Trace{});
+  EXPECT_EQ(result.status.code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(result.records.empty());
+}
+
+}  // namespace
+}  // namespace thinlod::frontend::daemon
