@@ -1,0 +1,385 @@
+// thinlod-backbone as a real process (integration tier): an in-test
+// simplifier worker answers its requests, an in-test frontend sends poses and
+// receives SceneUpdates, raw DEALER sockets send garbage, truncated and
+// wrong-version bytes to both sockets, and SIGTERM stops it cleanly.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+#include <zmq.hpp>
+
+#include "thinlod/protocol/codec.h"
+#include "thinlod/protocol/transport.h"
+#include "thinlod_wire_generated.h"
+
+namespace thinlod::protocol {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Generous: a slow, shared machine must not fail the test.
+constexpr auto kDeadline = 20s;
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool pumpUntil(const std::function<void()>& step, const std::function<bool()>& done,
+               std::chrono::milliseconds deadline = kDeadline) {
+  const auto end = Clock::now() + deadline;
+  while (Clock::now() < end) {
+    step();
+    if (done()) return true;
+  }
+  return done();
+}
+
+class BackboneProcess {
+ public:
+  explicit BackboneProcess(std::vector<std::string> extra) {
+    dir_ =
+        fs::temp_directory_path() / ("thinlod-backbone-test-" + std::to_string(::getpid()) + "-" +
+                                     std::to_string(Clock::now().time_since_epoch().count()));
+    fs::create_directories(dir_);
+    std::vector<std::string> args = {
+        THINLOD_BACKBONE_EXE,
+        "--scene",
+        std::string(THINLOD_SOURCE_DIR) + "/deploy/data/paper-room.wrl",
+        "--models-dir",
+        std::string(THINLOD_SHARED_DIR) + "/models",
+        "--frontend.address",
+        "tcp://127.0.0.1:0",
+        "--simplifier.address",
+        "tcp://127.0.0.1:0",
+        "--ready-file",
+        (dir_ / "ready.json").string(),
+        "--decisions-csv",
+        (dir_ / "decisions.csv").string(),
+        "--transport.heartbeat_ms",
+        "100",
+        "--transport.liveness_misses",
+        "20"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const std::string log = (dir_ / "backbone.log").string();
+    pid_ = fork();
+    if (pid_ == 0) {
+      FILE* out = std::freopen(log.c_str(), "w", stderr);
+      (void)out;
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  ~BackboneProcess() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  // Reads the ready file (written once both sockets are bound).
+  bool waitForAddresses() {
+    const auto end = Clock::now() + kDeadline;
+    while (Clock::now() < end && alive()) {
+      std::ifstream in(dir_ / "ready.json");
+      if (in) {
+        const nlohmann::json ready = nlohmann::json::parse(in, nullptr, false);
+        if (!ready.is_discarded() && ready.contains("frontend")) {
+          frontend_ = ready["frontend"].get<std::string>();
+          simplifier_ = ready["simplifier"].get<std::string>();
+          return true;
+        }
+      }
+      std::this_thread::sleep_for(20ms);
+    }
+    return false;
+  }
+  bool logContains(const std::string& text) const {
+    return readFile(dir_ / "backbone.log").find(text) != std::string::npos;
+  }
+  std::string log() const { return readFile(dir_ / "backbone.log"); }
+  std::string decisions() const { return readFile(dir_ / "decisions.csv"); }
+  bool alive() const { return !exited_ && kill(pid_, 0) == 0 && !reaped(); }
+  // Exit status after `signal`, or -1 if it did not exit within the deadline.
+  int stopWith(int signal) {
+    kill(pid_, signal);
+    const auto end = Clock::now() + kDeadline;
+    while (Clock::now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return -1;
+  }
+  const std::string& frontendAddress() const { return frontend_; }
+  const std::string& simplifierAddress() const { return simplifier_; }
+
+ private:
+  bool reaped() const {
+    int status = 0;
+    return waitpid(pid_, &status, WNOHANG) == pid_;
+  }
+  fs::path dir_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  std::string frontend_;
+  std::string simplifier_;
+};
+
+TransportOptions testTransport() {
+  TransportOptions t;
+  t.heartbeatInterval = 100ms;
+  t.livenessMisses = 20;
+  return t;
+}
+
+// A worker that answers every request at once with small valid results.
+class FakeWorker {
+ public:
+  explicit FakeWorker(const std::string& address) {
+    Channel::Options options;
+    options.address = address;
+    options.hello.role = Role::kSimplifier;
+    options.hello.name = "fake-simplifier";
+    options.hello.capacity = 4;
+    options.transport = testTransport();
+    auto channel = Channel::connect(options);
+    EXPECT_TRUE(channel.ok()) << channel.status().toString();
+    if (channel.ok()) channel_ = std::move(channel).value();
+  }
+  void poll(std::chrono::milliseconds timeout) {
+    if (!channel_) return;
+    for (ChannelEvent& e : channel_->poll(timeout)) {
+      if (e.kind != ChannelEvent::Kind::kMessage) continue;
+      if (auto* s = std::get_if<SimplifyRequest>(&e.message)) {
+        ++simplifyRequests;
+        curveRequests += s->curvePoints > 0 ? 1 : 0;
+        sendFailures += channel_->send(simplify(*s)).ok() ? 0 : 1;
+      } else if (auto* i = std::get_if<ImpostorRequest>(&e.message)) {
+        ++impostorRequests;
+        sendFailures += channel_->send(impostor(*i)).ok() ? 0 : 1;
+      }
+    }
+  }
+  bool connected() const { return channel_ && channel_->connected(); }
+  int simplifyRequests = 0;
+  int curveRequests = 0;
+  int impostorRequests = 0;
+  int sendFailures = 0;  // only after the daemon has gone
+
+ private:
+  static SimplifyResult simplify(const SimplifyRequest& request) {
+    SimplifyResult result;
+    result.requestId = request.requestId;
+    result.objectId = request.objectId;
+    result.triangleCount = std::max<std::uint32_t>(12, std::min(request.targetTriangles, 5804u));
+    result.accuracy = 3.0 * std::sqrt(double(result.triangleCount));
+    result.mesh.assign(300 + 2 * result.triangleCount, 0x42);
+    if (request.curvePoints > 0) {
+      for (double t = 50.0; t < 5804.0; t *= 2.0) result.curve.push_back({3.0 * std::sqrt(t), t});
+      result.curve.push_back({3.0 * std::sqrt(5804.0), 5804.0});
+    }
+    return result;
+  }
+  static ImpostorResult impostor(const ImpostorRequest& request) {
+    ImpostorResult result;
+    result.requestId = request.requestId;
+    result.objectIds = request.objectIds;
+    Representation& rep = result.representation;
+    rep.kind = request.kind;
+    rep.triangleCount = 2;
+    rep.mesh.assign(100, 0x11);
+    rep.texture.codec = TextureCodec::kPng;
+    rep.texture.width = request.textureWidth;
+    rep.texture.height = request.textureHeight;
+    rep.texture.data.assign(3000, 0x22);
+    rep.accuracy = 80.0;
+    rep.validity.center = glm::vec3(2.0f, 0.5f, 1.5f);
+    rep.validity.distanceMin = 0.0f;
+    rep.validity.distanceMax = std::numeric_limits<float>::infinity();
+    rep.validity.halfAngle = 3.14159265f;
+    return result;
+  }
+  std::unique_ptr<Channel> channel_;
+};
+
+ViewerPose entrancePose(std::uint64_t sequence, double seconds) {
+  ViewerPose pose;
+  pose.sequence = sequence;
+  pose.timestampNs = static_cast<std::int64_t>(seconds * 1e9);
+  pose.position = glm::vec3(2.0f, 1.1f, 3.5f);
+  // Looking along -z (the identity camera orientation), towards the room.
+  pose.orientation = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  pose.fovY = 0.785398f;
+  pose.viewportWidth = 640;
+  pose.viewportHeight = 480;
+  return pose;
+}
+
+Bytes wrongVersionHeartbeat() {
+  flatbuffers::FlatBufferBuilder b;
+  auto body = thinlod::wire::CreateHeartbeat(b, 1, 2).Union();
+  b.Finish(thinlod::wire::CreateEnvelope(b, 99, thinlod::wire::Body::Heartbeat, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
+// Garbage, a truncated valid message and a future version, on a raw DEALER.
+void sendBadBytes(zmq::context_t& context, const std::string& address) {
+  zmq::socket_t raw(context, zmq::socket_type::dealer);
+  raw.set(zmq::sockopt::linger, 200);
+  raw.connect(address);
+  raw.send(zmq::str_buffer("definitely not a flatbuffer"), zmq::send_flags::none);
+  Result<Bytes> pose = encode(Message(entrancePose(1, 0.0)));
+  ASSERT_TRUE(pose.ok());
+  raw.send(zmq::buffer(pose->data(), pose->size() / 2), zmq::send_flags::none);
+  const Bytes future = wrongVersionHeartbeat();
+  raw.send(zmq::buffer(future.data(), future.size()), zmq::send_flags::none);
+  raw.send(zmq::str_buffer("frame-1"), zmq::send_flags::sndmore);
+  raw.send(zmq::str_buffer("frame-2"), zmq::send_flags::none);
+}
+
+TEST(BackboneDaemonProcess, ServesPosesSurvivesBadBytesAndStopsOnSigterm) {
+  BackboneProcess daemon({"--budget-polygons", "400", "--sync-wait-ms", "3000", "--curve-timeout-s",
+                          "20", "--log-level", "info"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+
+  // The worker joins while the daemon waits for the cow's curve.
+  FakeWorker worker(daemon.simplifierAddress());
+  ASSERT_TRUE(
+      pumpUntil([&] { worker.poll(10ms); }, [&] { return daemon.logContains("event=ready"); }))
+      << daemon.log();
+  EXPECT_TRUE(daemon.logContains("event=curves_ready"));
+  EXPECT_EQ(worker.curveRequests, 1);
+
+  Channel::Options frontendOptions;
+  frontendOptions.address = daemon.frontendAddress();
+  frontendOptions.hello.role = Role::kFrontend;
+  frontendOptions.hello.name = "frontend-test";
+  frontendOptions.transport = testTransport();
+  auto frontend = Channel::connect(frontendOptions);
+  ASSERT_TRUE(frontend.ok());
+  std::vector<SceneUpdate> updates;
+  auto step = [&] {
+    worker.poll(5ms);
+    for (ChannelEvent& e : (*frontend)->poll(5ms)) {
+      if (e.kind == ChannelEvent::Kind::kMessage) {
+        if (auto* u = std::get_if<SceneUpdate>(&e.message)) updates.push_back(*u);
+      }
+    }
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return (*frontend)->connected(); }));
+
+  auto updateFor = [&](std::uint64_t frame) -> const SceneUpdate* {
+    for (const SceneUpdate& u : updates)
+      if (u.frame == frame) return &u;
+    return nullptr;
+  };
+  ASSERT_TRUE((*frontend)->send(entrancePose(5, 0.0)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return updateFor(5) != nullptr; })) << daemon.log();
+  // With --sync-wait-ms the worker's answers are in the first update.
+  const SceneUpdate* first = updateFor(5);
+  EXPECT_FALSE(first->operations.empty());
+  EXPECT_GT(first->targetAccuracy, 0.0);
+  double triangles = 0.0;
+  for (const SceneOperation& op : first->operations) {
+    EXPECT_EQ(op.type, SceneOperation::Type::kAddOrReplace);
+    EXPECT_GE(op.objectId, 1u);
+    EXPECT_LE(op.objectId, 4u);
+    triangles += op.representation.triangleCount;
+  }
+  EXPECT_LE(triangles, 400.0);
+  EXPECT_GT(worker.simplifyRequests + worker.impostorRequests, 1);
+
+  // Bad bytes on both sockets: logged and dropped.
+  zmq::context_t context(1);
+  sendBadBytes(context, daemon.frontendAddress());
+  sendBadBytes(context, daemon.simplifierAddress());
+  auto malformedLogged = [&] {
+    const std::string log = daemon.log();
+    std::size_t count = 0;
+    for (std::size_t at = log.find("event=malformed_dropped"); at != std::string::npos;
+         at = log.find("event=malformed_dropped", at + 1))
+      ++count;
+    return count;
+  };
+  // Garbage, truncated and two-frame messages on each socket (the future
+  // version may be answered with a HelloReply instead).
+  ASSERT_TRUE(pumpUntil(step, [&] { return malformedLogged() >= 6; })) << daemon.log();
+
+  // Still serving both sides.
+  ASSERT_TRUE((*frontend)->send(entrancePose(6, 0.5)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return updateFor(6) != nullptr; })) << daemon.log();
+  EXPECT_TRUE(daemon.alive());
+  EXPECT_TRUE(worker.connected());
+  EXPECT_TRUE((*frontend)->connected());
+  EXPECT_EQ(worker.sendFailures, 0);
+  if (std::getenv("THINLOD_PRINT_LOG")) std::printf("%s\n", daemon.log().c_str());
+
+  EXPECT_EQ(daemon.stopWith(SIGTERM), 0) << daemon.log();
+  EXPECT_TRUE(daemon.logContains("event=stopping"));
+  EXPECT_TRUE(daemon.logContains("event=plan frame=5"));
+  // One decision row per pose after the header.
+  const std::string csv = daemon.decisions();
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+  // The frontend hears the daemon's goodbye.
+  ASSERT_TRUE(pumpUntil(step, [&] { return !(*frontend)->connected(); }));
+}
+
+TEST(BackboneDaemonProcess, BecomesReadyWithoutASimplifierAndKeepsAnswering) {
+  BackboneProcess daemon({"--accuracy", "100", "--curve-timeout-s", "0.3"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+  const auto end = Clock::now() + kDeadline;
+  while (Clock::now() < end && !daemon.logContains("event=ready"))
+    std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(daemon.logContains("event=ready")) << daemon.log();
+  EXPECT_TRUE(daemon.logContains("event=curves_missing objects=4"));
+
+  Channel::Options options;
+  options.address = daemon.frontendAddress();
+  options.hello.role = Role::kFrontend;
+  options.hello.name = "frontend-alone";
+  options.transport = testTransport();
+  auto frontend = Channel::connect(options);
+  ASSERT_TRUE(frontend.ok());
+  std::vector<std::uint64_t> frames;
+  auto step = [&] {
+    for (ChannelEvent& e : (*frontend)->poll(10ms)) {
+      if (e.kind == ChannelEvent::Kind::kMessage)
+        if (auto* u = std::get_if<SceneUpdate>(&e.message)) frames.push_back(u->frame);
+    }
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return (*frontend)->connected(); }));
+  for (std::uint64_t i = 0; i < 3; ++i)
+    ASSERT_TRUE((*frontend)->send(entrancePose(i, i * 0.5)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return frames.size() >= 3; })) << daemon.log();
+  // Every pose is answered (an older one may be answered empty when a newer waits).
+  EXPECT_EQ(frames, (std::vector<std::uint64_t>{0, 1, 2}));
+  EXPECT_EQ(daemon.stopWith(SIGINT), 0) << daemon.log();
+}
+
+}  // namespace
+}  // namespace thinlod::protocol
