@@ -58,6 +58,15 @@ double staircaseOf(const std::vector<AccuracySample>& frontier, double a) {
   return it == frontier.end() ? kInf : it->resources;
 }
 
+// max over the domain of r_fit / S (exact, see the top comment).
+double worstRatioOf(const AccuracyCurve& fit, const std::vector<AccuracySample>& samples) {
+  double worst = 0.0;
+  for (const AccuracySample& s : frontierOf(samples)) {
+    worst = std::max(worst, fit.resourcesFor(s.accuracy) / s.resources);
+  }
+  return worst;
+}
+
 struct Tightness {
   double worst = 0.0;    // max over the domain of r_fit / S
   double logMean = 0.0;  // mean of r_fit / S over log(a), domain [lowest, highest]
@@ -67,9 +76,7 @@ struct Tightness {
 Tightness tightnessOf(const AccuracyCurve& fit, const std::vector<AccuracySample>& samples) {
   const std::vector<AccuracySample> frontier = frontierOf(samples);
   Tightness t;
-  for (const AccuracySample& s : frontier) {
-    t.worst = std::max(t.worst, fit.resourcesFor(s.accuracy) / s.resources);
-  }
+  t.worst = worstRatioOf(fit, samples);
   const double lo = fit.minAccuracy();
   const double hi = fit.maxAccuracy();
   constexpr int kGrid = 20000;
@@ -232,7 +239,7 @@ TEST(CurveFitTightness, NeverWorseThanTheBestFlatStaircase) {
     auto fit = AccuracyCurve::fitConservative(samples, segments);
     ASSERT_TRUE(fit.ok());
     const double flat = bestFlatWorstRatio(samples, segments);
-    ASSERT_LE(tightnessOf(*fit, samples).worst, flat * (1.0 + 1e-9))
+    ASSERT_LE(worstRatioOf(*fit, samples), flat * (1.0 + 1e-9))
         << "trial " << trial << " segments " << segments;
   }
 }
@@ -250,10 +257,32 @@ TEST(CurveFitTightness, WorstRatioDoesNotGrowWithMoreSegments) {
     for (int segments = 1; segments <= 12; ++segments) {
       auto fit = AccuracyCurve::fitConservative(samples, segments);
       ASSERT_TRUE(fit.ok());
-      const double worst = tightnessOf(*fit, samples).worst;
+      const double worst = worstRatioOf(*fit, samples);
       ASSERT_LE(worst, previous * (1.0 + 1e-9)) << "trial " << trial << " segments " << segments;
       previous = worst;
     }
+  }
+}
+
+TEST(CurveFitTightness, LargeNoisySampleSetsAreThinnedConservativelyAndStayTight) {
+  // 10^5 measurements of r ~ a^1.5 (as bench_curves fits): the frontier is
+  // thinned before fitting, which must stay conservative and tight.
+  std::mt19937_64 rng(5150);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<AccuracySample> samples(100000);
+  for (AccuracySample& s : samples) {
+    s.accuracy = 1.0 + 999.0 * unit(rng);
+    s.resources = std::pow(s.accuracy, 1.5) * (0.9 + 0.2 * unit(rng));
+  }
+  for (int segments : {8, 16}) {
+    auto fit = AccuracyCurve::fitConservative(samples, segments);
+    ASSERT_TRUE(fit.ok()) << fit.status().toString();
+    ASSERT_TRUE(satisfiesInvariants(*fit));
+    ASSERT_LE(fit->segments().size(), static_cast<std::size_t>(segments));
+    ASSERT_TRUE(neverOptimistic(*fit, samples, rng));
+    const Tightness t = tightnessOf(*fit, samples);
+    report(segments == 8 ? "1e5 noisy a^1.5, 8" : "1e5 noisy a^1.5, 16", segments, *fit, t);
+    EXPECT_LE(t.worst, 1.5);
   }
 }
 
