@@ -72,6 +72,12 @@ class Collapser {
       triangle_[t] = {{mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]}, 0};
     }
     liveTriangles_ = triangleCount;
+    inputNormal_.resize(triangleCount);
+    for (std::size_t t = 0; t < triangleCount; ++t) {
+      const glm::dvec3 n = areaNormal(triangle_[t]);
+      const double length = glm::length(n);
+      inputNormal_[t] = length > 0.0 ? glm::vec3(n / length) : glm::vec3(0.0f);
+    }
     removed_.assign(vertexCount, 0);
     kind_.assign(vertexCount, VertexKind::kUnknown);
     target_.assign(vertexCount, kNone);
@@ -160,6 +166,7 @@ class Collapser {
       for (std::uint32_t v : t.v) quadric_[v] += q;
     }
     if (options_.preserveBoundaries) addBoundaryPlanes();
+    if (attributes_.dimension > 0) buildAttributeQuadrics();
     selfCost_.resize(position_.size());
     for (std::size_t v = 0; v < position_.size(); ++v)
       selfCost_[v] = quadric_[v].eval(position_[v]);
@@ -241,16 +248,57 @@ class Collapser {
     listSize_[v] = write - start;
   }
 
+  // Attribute quadric part of u -> w: u's and w's attribute planes at
+  // (p_w, s_w), scaled so that attributeWeight is relative to geometry (a
+  // full-range attribute error weighs like a distance of sqrt(weight) *
+  // diagonal).
   double attributeCost(std::uint32_t u, std::uint32_t w) const {
-    const std::size_t d = attributes_.dimension;
-    double sum = 0.0;
-    for (std::size_t k = 0; k < d; ++k) {
-      const double diff = attributes_.values[u * d + k] - attributes_.values[w * d + k];
-      sum += diff * diff;
+    const std::size_t dimension = attributes_.dimension;
+    double sum = attributeSelfCost_[w];
+    for (std::size_t k = 0; k < dimension; ++k) {
+      sum += attributeQuadric_[u * dimension + k].eval(position_[w],
+                                                       attributes_.values[w * dimension + k]);
     }
-    // Attributes are in [0, 1]: scale to squared length (diagonal^2) over the
-    // area u's quadric stands for, so the weight is relative to geometry.
-    return options_.attributeWeight * diagonal_ * diagonal_ * quadric_[u].weight * sum;
+    return attributeScale_ * std::max(sum, 0.0);
+  }
+
+  double attributeSelfCost(std::uint32_t w) const {
+    const std::size_t dimension = attributes_.dimension;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < dimension; ++k) {
+      sum += attributeQuadric_[w * dimension + k].eval(position_[w],
+                                                       attributes_.values[w * dimension + k]);
+    }
+    return sum;
+  }
+
+  void buildAttributeQuadrics() {
+    const std::size_t dimension = attributes_.dimension;
+    attributeScale_ = options_.attributeWeight * diagonal_ * diagonal_;
+    attributeQuadric_.assign(position_.size() * dimension, AttributeQuadric());
+    for (const Triangle& t : triangle_) {
+      const glm::dvec3& p0 = position_[t.v[0]];
+      const glm::dvec3 e1 = position_[t.v[1]] - p0;
+      const glm::dvec3 e2 = position_[t.v[2]] - p0;
+      const glm::dvec3 n = glm::cross(e1, e2);
+      const double n2 = glm::dot(n, n);
+      if (!(n2 > 0.0)) continue;
+      // Gradient in the triangle's plane: g . e1 = ds1, g . e2 = ds2, g . n = 0.
+      const glm::dvec3 along1 = glm::cross(e2, n) / n2;
+      const glm::dvec3 along2 = glm::cross(n, e1) / n2;
+      const double weight = 0.5 * std::sqrt(n2) / meanArea_;
+      for (std::size_t k = 0; k < dimension; ++k) {
+        const double s0 = attributes_.values[t.v[0] * dimension + k];
+        const double ds1 = attributes_.values[t.v[1] * dimension + k] - s0;
+        const double ds2 = attributes_.values[t.v[2] * dimension + k] - s0;
+        const glm::dvec3 g = ds1 * along1 + ds2 * along2;
+        const AttributeQuadric q = AttributeQuadric::fromGradient(g, s0 - glm::dot(g, p0), weight);
+        for (std::uint32_t v : t.v) attributeQuadric_[v * dimension + k] += q;
+      }
+    }
+    attributeSelfCost_.resize(position_.size());
+    for (std::uint32_t v = 0; v < position_.size(); ++v)
+      attributeSelfCost_[v] = attributeSelfCost(v);
   }
 
   // Quadric part of the cost of u -> w: (Q_u + Q_w)(p_w); w keeps its place.
@@ -400,10 +448,15 @@ class Collapser {
       if (!options_.preventFlips) continue;
       const glm::dvec3& pa = position_[a];
       const glm::dvec3& pb = position_[b];
+      const glm::dvec3 after = glm::cross(pa - pw, pb - pw);
+      // Small turns add up: stay on the front side of the triangle's input
+      // orientation too (each live triangle is an input triangle with
+      // corners renamed), so no triangle ends up facing against the input.
+      const glm::dvec3 inputNormal(inputNormal_[triangleOf(entry)]);
+      if (glm::dot(after, inputNormal) <= 0.0 && inputNormal != glm::dvec3(0.0)) return false;
       const glm::dvec3 before = glm::cross(pa - pu, pb - pu);
       const double beforeLength2 = glm::dot(before, before);
-      if (beforeLength2 == 0.0) continue;  // a zero-area input triangle has no orientation
-      const glm::dvec3 after = glm::cross(pa - pw, pb - pw);
+      if (beforeLength2 == 0.0) continue;  // a zero-area triangle has no orientation to keep
       const double d = glm::dot(before, after);
       if (d <= 0.0 || d * d < kMinFlipCos2 * beforeLength2 * glm::dot(after, after)) return false;
     }
@@ -479,6 +532,13 @@ class Collapser {
 
     quadric_[w] += quadric_[u];
     selfCost_[w] = quadric_[w].eval(position_[w]);
+    if (attributes_.dimension > 0) {
+      for (std::size_t k = 0; k < attributes_.dimension; ++k) {
+        attributeQuadric_[w * attributes_.dimension + k] +=
+            attributeQuadric_[u * attributes_.dimension + k];
+      }
+      attributeSelfCost_[w] = attributeSelfCost(w);
+    }
     removeVertex(u, w);
     // Vertices left without triangles leave the mesh too (parent kNone).
     if (listSize_[w] == 0) removeVertex(w, kNone);
@@ -537,7 +597,13 @@ class Collapser {
   std::vector<glm::dvec3> position_;
   std::vector<Quadric> quadric_;
   std::vector<double> selfCost_;  // quadric_[v].eval(position_[v])
+  // With attributes: dimension quadrics per vertex, and their value at the
+  // vertex itself.
+  std::vector<AttributeQuadric> attributeQuadric_;
+  std::vector<double> attributeSelfCost_;
+  double attributeScale_ = 0.0;
   std::vector<Triangle> triangle_;
+  std::vector<glm::vec3> inputNormal_;  // unit normal of each triangle in the input
   std::size_t liveTriangles_ = 0;
   // Vertex -> corner lists: pool_[listStart_[v] .. + listSize_[v]], may hold
   // dead triangles until the next gather of v.

@@ -37,10 +37,12 @@
 namespace thinlod::simplifier {
 
 struct BuildOptions {
-  bool preserveBoundaries = true;   // add perpendicular penalty planes on boundary edges
-  float boundaryWeight = 10.0f;     // weight of those planes relative to face planes
-  bool preventFlips = true;         // reject collapses that flip a face normal
-  float attributeWeight = 0.0f;     // > 0: penalise uv/color differences (normalised units)
+  bool preserveBoundaries = true;  // add perpendicular penalty planes on boundary edges
+  float boundaryWeight = 10.0f;    // weight of those planes relative to face planes
+  bool preventFlips = true;        // reject collapses that flip a face normal
+  // > 0: attribute quadrics (Hoppe 1999) on uvs and colors, a full-range
+  // attribute error weighing like a distance of sqrt(weight) * bbox diagonal.
+  float attributeWeight = 0.0f;
   float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
   std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
 };

@@ -1,0 +1,154 @@
+#include "qem_test_meshes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <random>
+
+#include "thinlod/common/mesh_io.h"
+
+namespace thinlod::qemtest {
+
+IndexedMesh makeGrid(int cells) {
+  IndexedMesh m;
+  for (int y = 0; y <= cells; ++y) {
+    for (int x = 0; x <= cells; ++x) {
+      m.positions.push_back({static_cast<float>(x) / cells, static_cast<float>(y) / cells, 0.0f});
+    }
+  }
+  const auto at = [cells](int x, int y) { return static_cast<std::uint32_t>(y * (cells + 1) + x); };
+  for (int y = 0; y < cells; ++y) {
+    for (int x = 0; x < cells; ++x) {
+      m.indices.insert(m.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1)});
+      m.indices.insert(m.indices.end(), {at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    }
+  }
+  return m;
+}
+
+IndexedMesh makeIcosphere(int level, const glm::vec3& centre) {
+  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+  std::vector<glm::vec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                              {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                              {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::uint32_t> f = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7, 10, 0, 10, 11,
+                                  1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7, 6,  7, 1,  8,
+                                  3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6, 8,  3, 8,  9,
+                                  4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6, 7,  9, 8,  1};
+  for (glm::vec3& v : p) v = glm::normalize(v);
+  for (int l = 0; l < level; ++l) {
+    std::map<Edge, std::uint32_t> midpoint;
+    auto mid = [&](std::uint32_t a, std::uint32_t b) {
+      const Edge key{std::min(a, b), std::max(a, b)};
+      auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      p.push_back(glm::normalize(p[a] + p[b]));
+      const auto index = static_cast<std::uint32_t>(p.size() - 1);
+      midpoint.emplace(key, index);
+      return index;
+    };
+    std::vector<std::uint32_t> next;
+    for (std::size_t i = 0; i < f.size(); i += 3) {
+      const std::uint32_t a = f[i], b = f[i + 1], c = f[i + 2];
+      const std::uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    f = std::move(next);
+  }
+  IndexedMesh m;
+  for (const glm::vec3& v : p) m.positions.push_back(v + centre);
+  m.indices = std::move(f);
+  return m;
+}
+
+IndexedMesh makeBumpySphere(int level, float amplitude, std::uint32_t seed) {
+  IndexedMesh m = makeIcosphere(level);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> bump(-amplitude, amplitude);
+  for (glm::vec3& p : m.positions) p *= 1.0f + bump(rng);
+  return m;
+}
+
+IndexedMesh concatenate(const IndexedMesh& a, const IndexedMesh& b) {
+  IndexedMesh m = a;
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  m.positions.insert(m.positions.end(), b.positions.begin(), b.positions.end());
+  for (std::uint32_t i : b.indices) m.indices.push_back(i + offset);
+  return m;
+}
+
+IndexedMesh unweld(const IndexedMesh& mesh) {
+  IndexedMesh m;
+  for (std::uint32_t i : mesh.indices) {
+    m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+    m.positions.push_back(mesh.positions[i]);
+  }
+  return m;
+}
+
+Result<IndexedMesh> loadSharedModel(const std::string& name) {
+  Result<LoadedMesh> loaded = loadMeshFile(std::string(THINLOD_SHARED_DIR) + "/models/" + name);
+  if (!loaded.ok()) return loaded.status();
+  IndexedMesh m;
+  m.positions = std::move(loaded->mesh.positions);
+  m.indices = std::move(loaded->mesh.indices);
+  return m;
+}
+
+std::map<Edge, int> edgeTriangleCounts(const IndexedMesh& mesh) {
+  std::map<Edge, int> counts;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
+      ++counts[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  return counts;
+}
+
+int countEdgesWithMoreThanTwoTriangles(const IndexedMesh& mesh) {
+  int count = 0;
+  for (const auto& [edge, triangles] : edgeTriangleCounts(mesh)) count += triangles > 2 ? 1 : 0;
+  return count;
+}
+
+std::set<std::uint32_t> borderVertices(const IndexedMesh& mesh) {
+  std::set<std::uint32_t> border;
+  for (const auto& [edge, triangles] : edgeTriangleCounts(mesh)) {
+    if (triangles == 1) {
+      border.insert(edge.first);
+      border.insert(edge.second);
+    }
+  }
+  return border;
+}
+
+std::multiset<PositionTriangle> positionTriangles(const IndexedMesh& mesh) {
+  std::multiset<PositionTriangle> out;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    PositionTriangle tri;
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& p = mesh.positions[mesh.indices[t + k]];
+      tri[k] = {p.x, p.y, p.z};
+    }
+    std::sort(tri.begin(), tri.end());
+    out.insert(tri);
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> matchVertices(const IndexedMesh& mesh, const IndexedMesh& reference) {
+  std::map<std::array<float, 3>, std::uint32_t> byPosition;
+  for (std::size_t v = 0; v < reference.positions.size(); ++v) {
+    const glm::vec3& p = reference.positions[v];
+    byPosition.emplace(std::array<float, 3>{p.x, p.y, p.z}, static_cast<std::uint32_t>(v));
+  }
+  std::vector<std::uint32_t> out;
+  for (const glm::vec3& p : mesh.positions) {
+    auto it = byPosition.find({p.x, p.y, p.z});
+    out.push_back(it == byPosition.end() ? UINT32_MAX : it->second);
+  }
+  return out;
+}
+
+}  // namespace thinlod::qemtest
