@@ -112,7 +112,8 @@ class AccuracyCurve {
   // (dominated samples are dropped). Errors on no samples, non-finite data,
   // negative resources or maxSegments < 1. Domain [lowest, highest sample
   // accuracy]. With enough segments the result is the staircase itself;
-  // otherwise a dynamic program picks the pieces of least area above it.
+  // otherwise the pieces minimise the worst ratio r(a) / staircase(a) over the
+  // domain (knots at measured steps, vertical jumps allowed).
   static Result<AccuracyCurve> fitConservative(std::vector<AccuracySample> samples,
                                                int maxSegments);
 
