@@ -3,8 +3,11 @@
 // direction) and prints the levels, the fitted (A, R, K) triples and timings,
 // then repeats through a MeshCurveCache to time a cache hit.
 //   curve_measure <model.obj> <cache_dir>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 
 #include "test_meshes.h"
@@ -15,10 +18,22 @@ namespace {
 using namespace thinlod;
 using namespace thinlod::simplifier;
 
-double since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
+// Thread CPU time: insensitive to other processes on a busy machine.
+double cpuNow() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
+
+struct Stopwatch {
+  std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+  double cpu = cpuNow();
+  double wallMs() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall)
+        .count();
+  }
+  double cpuMs() const { return cpuNow() - cpu; }
+};
 
 void printCurve(const char* name, const AccuracyCurve& curve) {
   std::printf("%s curve (maxAccuracy %.6g):", name, curve.maxAccuracy());
@@ -39,21 +54,21 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", mesh.status().toString().c_str());
     return 1;
   }
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch watch;
   Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh);
   if (!pm.ok()) {
     std::fprintf(stderr, "%s\n", pm.status().toString().c_str());
     return 1;
   }
-  std::printf("progressive mesh: %zu..%zu triangles, build %.1f ms\n", pm->minTriangles(),
-              pm->maxTriangles(), since(start));
-  start = std::chrono::steady_clock::now();
+  std::printf("progressive mesh: %zu..%zu triangles, build %.1f ms wall, %.1f ms cpu\n",
+              pm->minTriangles(), pm->maxTriangles(), watch.wallMs(), watch.cpuMs());
+  watch = Stopwatch();
   Result<MeshCurves> curves = measureMeshCurves(*mesh, *pm);
   if (!curves.ok()) {
     std::fprintf(stderr, "%s\n", curves.status().toString().c_str());
     return 1;
   }
-  std::printf("measure curves: %.1f ms\n", since(start));
+  std::printf("measure curves: %.1f ms wall, %.1f ms cpu\n", watch.wallMs(), watch.cpuMs());
   std::printf(
       "triangles,rel_max_error,rel_mean_error,accuracy,position_bits,bytes,"
       "encoded_accuracy\n");
@@ -64,13 +79,43 @@ int main(int argc, char** argv) {
   printCurve("triangles", curves->triangles);
   printCurve("bytes", curves->bytes);
 
+  // How much the fitted triangle curve over-estimates the measured staircase
+  // for several segment budgets: ratio curve / staircase over 2000
+  // log-spaced accuracies across the domain (1 = exact staircase).
+  std::vector<AccuracySample> samples;
+  for (const CurveLevel& l : curves->levels) {
+    samples.push_back({l.accuracy, static_cast<double>(l.triangles)});
+  }
+  auto staircase = [&](double a) {
+    double best = INFINITY;
+    for (const AccuracySample& s : samples) {
+      if (s.accuracy >= a) best = std::min(best, s.resources);
+    }
+    return best;
+  };
+  for (int segments : {1, 2, 3, 4, 6, 8, 12}) {
+    Result<AccuracyCurve> fit = AccuracyCurve::fitConservative(samples, segments);
+    if (!fit.ok()) continue;
+    const double lo = std::log(fit->minAccuracy()), hi = std::log(fit->maxAccuracy());
+    double sumLog = 0.0, worst = 1.0;
+    const int n = 2000;
+    for (int i = 0; i <= n; ++i) {
+      const double a = std::min(std::exp(lo + (hi - lo) * i / n), fit->maxAccuracy());
+      const double ratio = fit->resourcesFor(a) / staircase(a);
+      sumLog += std::log(ratio);
+      worst = std::max(worst, ratio);
+    }
+    std::printf("fit with %2d segments: geometric-mean over-estimate %.3f, worst %.3f\n", segments,
+                std::exp(sumLog / (n + 1)), worst);
+  }
+
   MeshCurveCache cache{std::filesystem::path(argv[2])};
   for (int run = 0; run < 2; ++run) {
-    start = std::chrono::steady_clock::now();
+    watch = Stopwatch();
     Result<MeshCurves> cached = cache.getOrMeasure(*mesh, "qem default", *pm);
-    std::printf("cache run %d: %s, %.1f ms (hits %d, misses %d, rejected %d)\n", run,
-                cached.ok() ? "ok" : cached.status().toString().c_str(), since(start),
-                cache.stats().hits, cache.stats().misses, cache.stats().rejected);
+    std::printf("cache run %d: %s, %.1f ms wall, %.1f ms cpu (hits %d, misses %d, rejected %d)\n",
+                run, cached.ok() ? "ok" : cached.status().toString().c_str(), watch.wallMs(),
+                watch.cpuMs(), cache.stats().hits, cache.stats().misses, cache.stats().rejected);
   }
   return 0;
 }

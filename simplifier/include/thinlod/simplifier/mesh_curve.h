@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/status.h"
-#include "thinlod/common/codec/encoding.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/surface_error.h"
 
@@ -46,12 +46,12 @@ inline constexpr int kMeshCurveFormatVersion = 1;
 
 struct MeshCurveOptions {
   int levels = 12;                 // ladder rungs (duplicates after rounding merge)
-  int maxSegments = 4;             // per fitted curve
+  int maxSegments = 6;             // per fitted curve (see error-validation.md)
   double minRelativeError = 1e-4;  // floor on d: accuracy at most 10^4
   SurfaceErrorOptions error{};
   bool measureEncodedBytes = true;
   double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
-  codec::MeshEncodeOptions encode{};              // positionBits is chosen per level
+  codec::MeshEncodeOptions encode{};        // positionBits is chosen per level
 };
 
 struct CurveLevel {
