@@ -231,6 +231,33 @@ TEST(BackboneCorePose, SyncWaitReplanSendsInTheSameUpdate) {
   }
 }
 
+TEST(BackboneCorePose, RemovalsOfTheFirstPlanSurviveTheReplan) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  FrontendModel frontend;
+  for (int step = 0; step < 3; ++step) {
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    frontend.apply(core->finishPose().update);
+  }
+  const std::size_t shown = frontend.triangles.size();
+  ASSERT_GT(shown, 0u);
+  // Turn around: every object is behind the viewer. The first plan retires
+  // them; the re-plan (as after a sync wait) has nothing more to say.
+  const glm::vec3 behind = kEntrance + glm::vec3(0.0f, 0.0f, 5.0f);
+  ASSERT_TRUE(core->beginPose(poseAt(3, 1.5, kEntrance, behind)).ok());
+  answer(*core, fake, submitAll(*core));
+  ASSERT_TRUE(core->replan().ok());
+  PoseOutcome outcome = core->finishPose();
+  EXPECT_EQ(outcome.plans, 2);
+  EXPECT_EQ(outcome.removes, shown);
+  frontend.apply(outcome.update);
+  EXPECT_TRUE(frontend.triangles.empty());
+  EXPECT_EQ(core->frontendTriangles(), 0.0);
+}
+
 TEST(BackboneCorePose, PlanningFailureStillAnswersWithAnEmptyUpdate) {
   auto core = makeCore(polygonBudget(200));
   ASSERT_NE(core, nullptr);

@@ -570,6 +570,9 @@ Status BackboneCore::runPlan() {
   requestsThisPose_ += static_cast<std::uint32_t>(plan_->requests.size());
   schedulingMicrosecondsThisPose_ += plan_->row.schedulingMicroseconds;
   const double now = viewer_.timeSeconds;
+  for (const backbone::ObjectDecision& d : plan_->decisions)
+    if (d.action == backbone::ObjectAction::kRemove) retiredThisPose_.push_back(d.object);
+  for (const backbone::Removal& r : plan_->removals) retiredThisPose_.push_back(r.object);
   for (const backbone::ObjectDecision& d : plan_->decisions) {
     if (d.action != backbone::ObjectAction::kSend || d.option < 0) continue;
     const backbone::RepresentationCopy& copy = scene_.options[d.option].atBackbone;
@@ -591,6 +594,7 @@ Status BackboneCore::beginPose(const protocol::ViewerPose& pose) {
   plansThisPose_ = 0;
   requestsThisPose_ = 0;
   schedulingMicrosecondsThisPose_ = 0.0;
+  retiredThisPose_.clear();
 
   const double time = std::max(lastTime_, double(pose.timestampNs) * 1e-9);
   lastTime_ = time;
@@ -723,18 +727,12 @@ PoseOutcome BackboneCore::finishPose() {
         break;
     }
   }
-  for (const backbone::ObjectDecision& d : plan.decisions) {
-    if (d.action == backbone::ObjectAction::kRemove && d.object < scene_.objects.size() &&
-        !rendered[d.object] && frontendTrianglesOf(d.object) > 0.0) {
-      rendered[d.object] = 2;
-      removes.push_back(d.object);
-    }
-  }
-  for (const backbone::Removal& r : plan.removals) {
-    if (r.object < scene_.objects.size() && !rendered[r.object] &&
-        frontendTrianglesOf(r.object) > 0.0) {
-      rendered[r.object] = 2;
-      removes.push_back(r.object);
+  // Removals of every plan of this pose (the scheduler retires an object
+  // once; a re-plan does not list it again) unless the final plan renders it.
+  for (std::uint32_t object : retiredThisPose_) {
+    if (object < scene_.objects.size() && !rendered[object] && frontendTrianglesOf(object) > 0.0) {
+      rendered[object] = 2;
+      removes.push_back(object);
     }
   }
 

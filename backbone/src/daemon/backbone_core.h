@@ -215,6 +215,8 @@ class BackboneCore {
   int plansThisPose_ = 0;
   std::uint32_t requestsThisPose_ = 0;
   double schedulingMicrosecondsThisPose_ = 0.0;
+  // Objects a plan of this pose retired: a re-plan does not repeat them.
+  std::vector<std::uint32_t> retiredThisPose_;
 
   // Frontend session.
   double lastTime_ = -1e300;
