@@ -97,7 +97,16 @@ class Collapser {
       const double key = chooseTarget(v, /*exact=*/false);
       if (key < kInfinity) heap_.push(v, key);
     }
+    const std::size_t removable =
+        triangle_.size() - std::min(triangle_.size(), options_.stopAtTriangles);
+    const std::size_t reportEvery = std::max<std::size_t>(removable / 100, 1);
+    std::size_t nextReport = triangle_.size() - reportEvery;
     while (!heap_.empty() && liveTriangles_ > options_.stopAtTriangles) {
+      if (options_.progress && liveTriangles_ <= nextReport) {
+        options_.progress(static_cast<double>(triangle_.size() - liveTriangles_) /
+                          static_cast<double>(removable));
+        nextReport = liveTriangles_ > reportEvery ? liveTriangles_ - reportEvery : 0;
+      }
       const std::uint32_t u = heap_.top();
       if (exact_[u]) {
         // Changes nearby since the key was computed may have made the move
@@ -121,6 +130,7 @@ class Collapser {
       rekey(u, key);
       if (key < kInfinity && heap_.top() == u) collapse(u, target_[u], key);
     }
+    if (options_.progress) options_.progress(1.0);
     CollapseRecord record = std::move(record_);
     record.triangleRemovedAtStep.resize(triangle_.size());
     for (std::size_t t = 0; t < triangle_.size(); ++t) {

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <vector>
@@ -45,6 +46,9 @@ struct BuildOptions {
   float attributeWeight = 0.0f;
   float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
   std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
+  // Called on the building thread about every 1% of the collapses with the
+  // fraction of triangles removed so far (0..1); may be empty.
+  std::function<void(double fraction)> progress;
 };
 
 class ProgressiveMesh {
