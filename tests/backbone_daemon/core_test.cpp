@@ -579,6 +579,50 @@ TEST_F(BackboneCoreImpostors, RequestCarriesRegionCentreBoundAndTextureSize) {
   EXPECT_TRUE(core_->onImpostorResult(good()).ok());
 }
 
+// Under a budget the bound is what the planned relative accuracy allows at
+// the region's distance, and a copy is credited exactly that.
+TEST_F(BackboneCoreImpostors, BoundFollowsThePlannedAccuracyAndTheCopyKeepsIt) {
+  const backbone::Plan* plan = core_->latestPlan();
+  ASSERT_NE(plan, nullptr);
+  const auto& request = std::get<protocol::ImpostorRequest>(impostors_[0].message);
+  const backbone::RepresentationRequest* planned = nullptr;
+  for (const auto& r : plan->requests)
+    if (core_->objects()[r.object].id == request.objectIds[0]) planned = &r;
+  ASSERT_NE(planned, nullptr);
+  const ObjectRecord& record = core_->objects()[planned->object];
+  const double distance =
+      backbone::conversionDistance(planned->viewRegion.center, planned->viewRegion.radius,
+                                   record.bounds, core_->options().config.minimalDistance);
+  const double absolute = planned->relativeAccuracy * distance / record.diameter;
+  EXPECT_NEAR(request.accuracyBound, 1.0 / absolute, 1e-9 / absolute);
+  ASSERT_TRUE(core_->onImpostorResult(good()).ok());
+  const auto& option = core_->schedulingScene().options[planned->option];
+  ASSERT_TRUE(option.atBackbone.present);
+  EXPECT_NEAR(option.atBackbone.relativeAccuracy, planned->relativeAccuracy,
+              1e-9 * planned->relativeAccuracy);
+}
+
+TEST(BackboneCoreImpostorBound, FixedAccuracyLoosensTheBoundToWhatItNeeds) {
+  CoreOptions options;
+  options.config.maxSpeed = 0.1;
+  options.budget.fixedAccuracy = 20.0;  // far below what an impostor can reach
+  options.simpleImpostorRadii = 3.0;
+  options.meshedImpostorRadii = 0.0;
+  auto core = makeCore(options);
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  int impostors = 0;
+  for (const OutgoingRequest& r : submitAll(*core)) {
+    if (const auto* i = std::get_if<protocol::ImpostorRequest>(&r.message)) {
+      ++impostors;
+      EXPECT_NEAR(i->accuracyBound, 1.0 / 20.0, 1e-12);
+    }
+  }
+  EXPECT_GT(impostors, 0);
+  (void)core->finishPose();
+}
+
 TEST_F(BackboneCoreImpostors, WrongKindIsRejected) {
   protocol::ImpostorResult result = good();
   result.representation.kind = protocol::RepresentationKind::kMeshedImpostor;

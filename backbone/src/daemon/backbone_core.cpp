@@ -344,13 +344,16 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     message = std::move(simplify);
   } else {
     request.impostor = true;
-    // The angular error the target allows at the region's distance: the
-    // impostor's validity cone is where its parallax error stays below it.
+    // The angular error the planned accuracy allows at the region's
+    // distance: the impostor's validity cone is where its parallax error
+    // stays below it. A fixed accuracy caps every target, so nothing more
+    // is needed (a looser bound gives a wider cone, a longer life). Under a
+    // budget the target may rise later: deliver what the option promises.
     const double distance = backbone::conversionDistance(
         r.viewRegion.center, r.viewRegion.radius, record.bounds, options_.config.minimalDistance);
     double absolute = r.relativeAccuracy * distance / record.diameter;
-    if (plan_ && std::isfinite(plan_->targetAccuracy) && plan_->targetAccuracy > 0.0)
-      absolute = std::min(absolute, plan_->targetAccuracy);
+    if (options_.budget.fixedAccuracy)
+      absolute = std::min(absolute, *options_.budget.fixedAccuracy);
     if (!std::isfinite(absolute) || absolute <= 0.0) absolute = 1.0;
     request.requestedAccuracy = absolute * record.diameter / distance;
     if (existing != nullptr && existing->impostor && existing->kind == request.kind &&

@@ -132,6 +132,8 @@ class BackboneCore {
   const std::vector<scene::SceneObject>& sceneObjects() const { return sceneObjects_; }
   std::uint32_t lodNodes() const { return converted_.lodNodes; }
   double frontendTriangles() const { return frontendTriangles_; }
+  // The latest plan of the current (or last) pose; null before the first.
+  const backbone::Plan* latestPlan() const { return plan_ ? &*plan_ : nullptr; }
   std::size_t outstandingRequests() const { return byTicket_.size(); }
   const CoreOptions& options() const { return options_; }
   const char* schedulerName() const;

@@ -330,6 +330,7 @@ class Daemon {
     }
     const auto started = Clock::now();
     Status planned = core_.beginPose(pose);
+    logRequests(pose.sequence);
     submitRequests();
     if (planned.ok() && settings_.syncWaitMs > 0 && core_.awaitedResults() > 0) {
       const auto deadline = started + std::chrono::milliseconds(settings_.syncWaitMs);
@@ -342,7 +343,7 @@ class Daemon {
       }
       if (resultsAccepted_ > before) {
         // A failed re-plan keeps the first plan's error for finishPose.
-        (void)core_.replan();
+        if (core_.replan().ok()) logRequests(pose.sequence);
         submitRequests();
       }
     }
@@ -370,6 +371,20 @@ class Daemon {
     if (csv_ != nullptr) {
       *csv_ << thinlod::backbone::decisionRowCsv(outcome.row) << "\n";
       csv_->flush();
+    }
+  }
+
+  void logRequests(std::uint64_t frame) {
+    const thinlod::backbone::Plan* plan = core_.latestPlan();
+    if (plan == nullptr || !spdlog::should_log(spdlog::level::debug)) return;
+    static constexpr const char* kReasons[] = {"missing", "expiring", "insufficient", "cheaper"};
+    for (const thinlod::backbone::RepresentationRequest& r : plan->requests) {
+      spdlog::debug(
+          "event=request frame={} object={} kind={} reason={} relative_accuracy={:.4g} "
+          "triangles={:.0f} bytes={:.0f}",
+          frame, core_.objects()[r.object].id, thinlod::backbone::representationKindName(r.kind),
+          kReasons[static_cast<int>(r.reason) & 3], r.relativeAccuracy, r.expectedTriangles,
+          r.expectedBytes);
     }
   }
 
