@@ -349,8 +349,9 @@ TEST(BackboneDaemonProcess, ServesPosesSurvivesBadBytesAndStopsOnSigterm) {
   ASSERT_TRUE(pumpUntil(step, [&] { return !(*frontend)->connected(); }));
 }
 
-TEST(BackboneDaemonProcess, BecomesReadyWithoutASimplifierAndKeepsAnswering) {
-  BackboneProcess daemon({"--accuracy", "100", "--curve-timeout-s", "0.3"});
+TEST(BackboneDaemonProcess, ServesWithoutASimplifierAndCatchesUpWhenOneJoins) {
+  BackboneProcess daemon(
+      {"--accuracy", "100", "--curve-timeout-s", "0.3", "--sync-wait-ms", "3000"});
   ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
   const auto end = Clock::now() + kDeadline;
   while (Clock::now() < end && !daemon.logContains("event=ready"))
@@ -365,19 +366,46 @@ TEST(BackboneDaemonProcess, BecomesReadyWithoutASimplifierAndKeepsAnswering) {
   options.transport = testTransport();
   auto frontend = Channel::connect(options);
   ASSERT_TRUE(frontend.ok());
-  std::vector<std::uint64_t> frames;
+  std::vector<SceneUpdate> updates;
+  std::unique_ptr<FakeWorker> worker;
   auto step = [&] {
-    for (ChannelEvent& e : (*frontend)->poll(10ms)) {
+    if (worker) worker->poll(5ms);
+    for (ChannelEvent& e : (*frontend)->poll(5ms)) {
       if (e.kind == ChannelEvent::Kind::kMessage)
-        if (auto* u = std::get_if<SceneUpdate>(&e.message)) frames.push_back(u->frame);
+        if (auto* u = std::get_if<SceneUpdate>(&e.message)) updates.push_back(*u);
     }
   };
   ASSERT_TRUE(pumpUntil(step, [&] { return (*frontend)->connected(); }));
+  const auto started = Clock::now();
   for (std::uint64_t i = 0; i < 3; ++i)
     ASSERT_TRUE((*frontend)->send(entrancePose(i, i * 0.5)).ok());
-  ASSERT_TRUE(pumpUntil(step, [&] { return frames.size() >= 3; })) << daemon.log();
-  // Every pose is answered (an older one may be answered empty when a newer waits).
-  EXPECT_EQ(frames, (std::vector<std::uint64_t>{0, 1, 2}));
+  ASSERT_TRUE(pumpUntil(step, [&] { return updates.size() >= 3; })) << daemon.log();
+  // No worker: the sync wait is skipped (three waits would take 9 s).
+  EXPECT_LT(Clock::now() - started, 8s);
+  // Every pose is answered, in order, with nothing to show yet.
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(updates[i].frame, i);
+    EXPECT_TRUE(updates[i].operations.empty());
+  }
+
+  // A worker joins: the queued requests (the cow's curve among them) go out
+  // and the next poses get representations.
+  worker = std::make_unique<FakeWorker>(daemon.simplifierAddress());
+  ASSERT_TRUE(pumpUntil(step, [&] { return worker->curveRequests == 1; })) << daemon.log();
+  std::uint64_t sequence = 3;
+  auto hasOperations = [&] {
+    for (const SceneUpdate& u : updates)
+      if (!u.operations.empty()) return true;
+    return false;
+  };
+  const auto deadline = Clock::now() + kDeadline;
+  while (!hasOperations() && Clock::now() < deadline) {
+    ASSERT_TRUE((*frontend)->send(entrancePose(sequence, sequence * 0.5)).ok());
+    const std::size_t before = updates.size();
+    ASSERT_TRUE(pumpUntil(step, [&] { return updates.size() > before; })) << daemon.log();
+    ++sequence;
+  }
+  EXPECT_TRUE(hasOperations()) << daemon.log();
   EXPECT_EQ(daemon.stopWith(SIGINT), 0) << daemon.log();
 }
 

@@ -335,8 +335,9 @@ class Daemon {
     if (planned.ok() && settings_.syncWaitMs > 0 && core_.awaitedResults() > 0) {
       const auto deadline = started + std::chrono::milliseconds(settings_.syncWaitMs);
       const std::uint64_t before = resultsAccepted_;
+      // Without a worker no result can come (requests wait in the pool).
       while (!runtime_.shutdownRequested() && core_.awaitedResults() > 0 &&
-             Clock::now() < deadline) {
+             workers_.liveWorkers() > 0 && Clock::now() < deadline) {
         const auto left =
             std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
         pump(std::clamp(left, 1ms, 50ms));
