@@ -19,5 +19,6 @@ class App;
 namespace thinlod::simplifier::tool {
 
 void addSimplifyCommand(CLI::App& app);  // simplify IN (--ratio R | --triangles N) -o OUT
+void addServeCommand(CLI::App& app);     // serve: the simplifier daemon (serve_command.cpp)
 
 }  // namespace thinlod::simplifier::tool
