@@ -164,6 +164,41 @@ Shape { geometry Sphere { radius 0.5 } }
   EXPECT_TRUE(backbone::validateScene(withOptions).ok());
 }
 
+TEST(BackboneCoreScene, LodLevelIsChosenByTheViewerDistance) {
+  const std::string text = R"(#VRML V2.0 utf8
+Transform {
+  translation 10 0 0
+  children LOD {
+    range [ 8 ]
+    level [
+      Shape { geometry Sphere { radius 1 } }
+      Shape { geometry Box { size 1 1 1 } }
+    ]
+  }
+}
+)";
+  Result<scene::Scene> parsed = scene::parseScene(text, "lod.wrl");
+  ASSERT_TRUE(parsed.ok());
+  CoreOptions options = polygonBudget(2000);
+  options.simpleImpostorRadii = 0.0;
+  options.meshedImpostorRadii = 0.0;
+  auto created = BackboneCore::create(std::move(parsed).value(), "/scenes/lod.wrl", options);
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  auto requestedObjects = [&](glm::vec3 eye, double seconds) {
+    std::set<std::uint64_t> ids;
+    EXPECT_TRUE(core.beginPose(poseAt(0, seconds, eye, {10.0f, 0.0f, 0.0f})).ok());
+    for (const OutgoingRequest& r : submitAll(core))
+      ids.insert(std::get<protocol::SimplifyRequest>(r.message).objectId);
+    (void)core.finishPose();
+    return ids;
+  };
+  // Near: the sphere (object 1); far: the box (object 2).
+  EXPECT_EQ(requestedObjects({10.0f, 0.0f, 4.0f}, 0.0), std::set<std::uint64_t>{1});
+  core.resetFrontend();
+  EXPECT_EQ(requestedObjects({10.0f, 0.0f, 20.0f}, 0.0), std::set<std::uint64_t>{2});
+}
+
 // ------------------------------------------------------------ pose -> update
 
 TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {
