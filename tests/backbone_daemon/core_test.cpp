@@ -199,6 +199,24 @@ Transform {
   EXPECT_EQ(requestedObjects({10.0f, 0.0f, 20.0f}, 0.0), std::set<std::uint64_t>{2});
 }
 
+TEST(BackboneCoreScene, SceneWithoutObjectsAnswersEmptyUpdates) {
+  Result<scene::Scene> parsed = scene::parseScene(
+      "#VRML V2.0 utf8\nViewpoint { position 0 1 5 }\nGroup { children [ ] }\n", "empty.wrl");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().toString();
+  auto created =
+      BackboneCore::create(std::move(parsed).value(), "/scenes/empty.wrl", polygonBudget(100));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  EXPECT_TRUE(core.objects().empty());
+  EXPECT_EQ(core.curvesPending(), 0u);
+  EXPECT_TRUE(core.beginPose(poseAt(9, 0.0, {0.0f, 1.0f, 5.0f}, {0.0f, 0.0f, 0.0f})).ok());
+  EXPECT_TRUE(submitAll(core).empty());
+  PoseOutcome outcome = core.finishPose();
+  EXPECT_TRUE(outcome.planned) << outcome.planError.toString();
+  EXPECT_EQ(outcome.update.frame, 9u);
+  EXPECT_TRUE(outcome.update.operations.empty());
+}
+
 // ------------------------------------------------------------ pose -> update
 
 TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {

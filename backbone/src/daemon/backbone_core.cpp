@@ -274,6 +274,11 @@ void BackboneCore::forgetTicket(std::uint64_t ticket) {
   auto it = byTicket_.find(ticket);
   if (it == byTicket_.end()) return;
   if (it->second.wireId != 0) ticketOfWire_.erase(it->second.wireId);
+  if (!it->second.curve) {
+    auto byOption = ticketOfOption_.find(it->second.option);
+    if (byOption != ticketOfOption_.end() && byOption->second == ticket)
+      ticketOfOption_.erase(byOption);
+  }
   byTicket_.erase(it);
   queued_.erase(std::remove_if(queued_.begin(), queued_.end(),
                                [&](const OutgoingRequest& r) { return r.ticket == ticket; }),
@@ -309,8 +314,9 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
   const OptionState& state = optionStates_[r.option];
 
   Outstanding* existing = nullptr;
-  for (auto& entry : byTicket_) {
-    if (!entry.second.curve && entry.second.option == r.option) existing = &entry.second;
+  if (auto found = ticketOfOption_.find(r.option); found != ticketOfOption_.end()) {
+    auto entry = byTicket_.find(found->second);
+    if (entry != byTicket_.end()) existing = &entry->second;
   }
 
   Outstanding request;
@@ -385,6 +391,7 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
   request.ticket = nextTicket_++;
   std::visit([&](auto& m) { m.requestId = request.ticket; }, message);
   byTicket_.emplace(request.ticket, request);
+  ticketOfOption_[request.option] = request.ticket;
   queued_.push_back({request.ticket, std::move(message)});
 }
 
@@ -712,7 +719,7 @@ PoseOutcome BackboneCore::finishPose() {
       case backbone::ObjectAction::kSend:
       case backbone::ObjectAction::kAwait: {
         rendered[d.object] = 1;
-        if (d.option < 0) break;
+        if (d.option < 0 || static_cast<std::size_t>(d.option) >= scene_.options.size()) break;
         const auto index = static_cast<std::uint32_t>(d.option);
         const backbone::RepresentationCopy& back = scene_.options[index].atBackbone;
         if (!back.present || !optionStates_[index].backbonePayload) break;

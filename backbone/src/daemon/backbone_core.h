@@ -204,6 +204,7 @@ class BackboneCore {
   std::uint64_t nextTicket_ = 1;
   std::map<std::uint64_t, Outstanding> byTicket_;
   std::map<std::uint64_t, std::uint64_t> ticketOfWire_;
+  std::map<std::uint32_t, std::uint64_t> ticketOfOption_;  // non-curve requests
   std::vector<OutgoingRequest> queued_;
   std::vector<std::uint64_t> cancellations_;
 
