@@ -217,6 +217,30 @@ TEST(BackboneCoreScene, SceneWithoutObjectsAnswersEmptyUpdates) {
   EXPECT_TRUE(outcome.update.operations.empty());
 }
 
+TEST(BackboneCoreScene, PrimitiveOnlySceneMakesTheSimplifierLoadIt) {
+  Result<scene::Scene> parsed =
+      scene::parseScene("#VRML V2.0 utf8\nShape { geometry Sphere { radius 1 } }\n", "ball.wrl");
+  ASSERT_TRUE(parsed.ok());
+  auto created =
+      BackboneCore::create(std::move(parsed).value(), "/scenes/ball.wrl", polygonBudget(100));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  EXPECT_TRUE(core.objectsWithoutMeasuredCurve().empty());  // analytic
+  EXPECT_EQ(core.curvesPending(), 1u);
+  const std::vector<OutgoingRequest> requests = submitAll(core);
+  ASSERT_EQ(requests.size(), 1u);
+  const auto& warmup = std::get<protocol::SimplifyRequest>(requests[0].message);
+  EXPECT_EQ(warmup.sourcePath, "/scenes/ball.wrl");
+  EXPECT_EQ(warmup.curvePoints, 0u);
+  const AccuracyCurve before = core.schedulingScene().options[0].relativeTriangles;
+  answer(core, FakeSimplifier(core), requests);
+  EXPECT_EQ(core.curvesPending(), 0u);
+  // The answer only loaded the scene: the analytic curve stays, no copy kept.
+  EXPECT_EQ(core.schedulingScene().options[0].relativeTriangles.segments().size(),
+            before.segments().size());
+  EXPECT_FALSE(core.schedulingScene().options[0].atBackbone.present);
+}
+
 // ------------------------------------------------------------ pose -> update
 
 TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {

@@ -161,22 +161,7 @@ Status BackboneCore::initialize() {
         // Until the simplifier's curve arrives: only the full mesh, exact.
         state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy * record.meshToScheduler,
                                                    record.fullTriangles);
-        Outstanding request;
-        request.ticket = nextTicket_++;
-        request.object = k;
-        request.option = static_cast<std::uint32_t>(scene_.options.size());
-        request.curve = true;
-        request.targetTriangles = static_cast<std::uint32_t>(
-            std::clamp<double>(record.fullTriangles, 1.0, options_.curveRequestTriangles));
-        protocol::SimplifyRequest message;
-        message.requestId = request.ticket;
-        message.objectId = record.id;
-        message.sourcePath = scenePath_;
-        message.target = protocol::SimplifyRequest::Target::kTriangles;
-        message.targetTriangles = request.targetTriangles;
-        message.curvePoints = options_.curvePoints;
-        byTicket_.emplace(request.ticket, request);
-        queued_.push_back({request.ticket, std::move(message)});
+        queueStartupRequest(k, static_cast<std::uint32_t>(scene_.options.size()), false);
       }
       scene_.options.push_back(std::move(option));
       optionStates_.push_back(std::move(state));
@@ -213,9 +198,33 @@ Status BackboneCore::initialize() {
                                         options_.simpleImpostorRadii, 2.0));
     object.optionCount = static_cast<std::uint32_t>(scene_.options.size()) - object.firstOption;
   }
+  // ImpostorRequests carry no scene path: the simplifier renders from the
+  // scene it loaded last. Without a mesh curve request, make it load ours.
+  if (byTicket_.empty() && !scene_.objects.empty()) queueStartupRequest(0, 0, true);
   backbone::updateSubtreeVersions(scene_);
   dirty_ = false;
   return backbone::validateScene(scene_);
+}
+
+void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t option, bool warmup) {
+  const ObjectRecord& record = converted_.records[object];
+  Outstanding request;
+  request.ticket = nextTicket_++;
+  request.object = object;
+  request.option = option;
+  request.curve = true;
+  request.warmup = warmup;
+  request.targetTriangles = static_cast<std::uint32_t>(std::clamp<double>(
+      record.fullTriangles, 1.0, warmup ? 12.0 : double(options_.curveRequestTriangles)));
+  protocol::SimplifyRequest message;
+  message.requestId = request.ticket;
+  message.objectId = record.id;
+  message.sourcePath = scenePath_;
+  message.target = protocol::SimplifyRequest::Target::kTriangles;
+  message.targetTriangles = request.targetTriangles;
+  message.curvePoints = warmup ? 0 : options_.curvePoints;
+  byTicket_.emplace(request.ticket, request);
+  queued_.push_back({request.ticket, std::move(message)});
 }
 
 void BackboneCore::rebuildCurves(std::uint32_t index) {
@@ -450,6 +459,7 @@ Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
   if (!std::isfinite(result.accuracy) || result.accuracy <= 0.0)
     return invalid(where + ": accuracy must be finite and > 0");
 
+  if (request.warmup) return Status();  // the scene is loaded; nothing to keep
   OptionState& state = optionStates_[request.option];
   if (request.curve) {
     if (result.curve.empty()) return invalid(where + ": no curve samples");

@@ -161,7 +161,8 @@ class BackboneCore {
     std::uint64_t wireId = 0;
     std::uint32_t object = 0;
     std::uint32_t option = 0;
-    bool curve = false;
+    bool curve = false;   // startup request (curve samples, or warm-up)
+    bool warmup = false;  // only makes the simplifier load the scene
     bool impostor = false;
     protocol::RepresentationKind kind = protocol::RepresentationKind::kMesh;
     std::uint64_t schedulerId = 0;   // the copy id the scheduler knows it by
@@ -173,6 +174,7 @@ class BackboneCore {
 
   BackboneCore(scene::Scene scene, std::string scenePath, CoreOptions options);
   Status initialize();
+  void queueStartupRequest(std::uint32_t object, std::uint32_t option, bool warmup);
   void rebuildCurves(std::uint32_t option);
   void touchObject(std::uint32_t object);
   Status runPlan();
