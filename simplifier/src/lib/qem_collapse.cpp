@@ -63,9 +63,9 @@ class Collapser {
     for (const glm::vec3& p : mesh.positions) bounds.extend(p);
     const glm::dvec3 centre = glm::dvec3(bounds.center());
     diagonal_ = bounds.diagonal();
-    position_.resize(vertexCount);
+    point_.resize(vertexCount);
     for (std::size_t v = 0; v < vertexCount; ++v) {
-      position_[v] = glm::dvec3(mesh.positions[v]) - centre;
+      point_[v].p = glm::dvec3(mesh.positions[v]) - centre;
     }
     triangle_.resize(triangleCount);
     for (std::size_t t = 0; t < triangleCount; ++t) {
@@ -93,7 +93,7 @@ class Collapser {
   // its exact key (all candidates, full cost, legal only) and is collapsed
   // once an exact key is the smallest.
   CollapseRecord run() {
-    for (std::uint32_t v = 0; v < position_.size(); ++v) {
+    for (std::uint32_t v = 0; v < point_.size(); ++v) {
       const double key = chooseTarget(v, /*exact=*/false);
       if (key < kInfinity) heap_.push(v, key);
     }
@@ -160,7 +160,7 @@ class Collapser {
   }
 
   void buildQuadrics() {
-    quadric_.assign(position_.size(), Quadric());
+    quadric_.assign(point_.size(), Quadric());
     // Plane weights are area / mean area: area weighting resists uneven
     // sampling, the normalisation keeps costs in squared length units.
     double totalArea = 0.0;
@@ -172,37 +172,49 @@ class Collapser {
       if (!(length > 0.0)) continue;  // zero area: no plane
       const glm::dvec3 n = n2 / length;
       const Quadric q =
-          Quadric::fromPlane(n, -glm::dot(n, position_[t.v[0]]), 0.5 * length / meanArea_);
+          Quadric::fromPlane(n, -glm::dot(n, point_[t.v[0]].p), 0.5 * length / meanArea_);
       for (std::uint32_t v : t.v) quadric_[v] += q;
     }
-    if (options_.preserveBoundaries) addBoundaryPlanes();
+    classifyAndAddBoundaryPlanes();
     if (attributes_.dimension > 0) buildAttributeQuadrics();
-    selfCost_.resize(position_.size());
-    for (std::size_t v = 0; v < position_.size(); ++v)
-      selfCost_[v] = quadric_[v].eval(position_[v]);
+
+    for (std::size_t v = 0; v < point_.size(); ++v)
+      point_[v].selfCost = quadric_[v].eval(point_[v].p);
   }
 
+  // Classifies every vertex (one neighbour gather each) and adds the
   // Garland-Heckbert boundary constraint: a plane through each border edge,
   // perpendicular to its triangle, so that collapses keep the border in place.
-  // Every triangle edge is visited once, from its first corner's list.
-  void addBoundaryPlanes() {
-    for (std::uint32_t v = 0; v < position_.size(); ++v) {
-      for (std::uint32_t i = listStart_[v], end = i + listSize_[v]; i < end; ++i) {
-        const std::uint32_t entry = pool_[i];
-        const Triangle& t = triangle_[triangleOf(entry)];
-        const std::uint32_t next = t.v[kNextCorner[cornerOf(entry)]];
-        if (edgeTriangleCount(v, next) != 1) continue;  // each border edge once: from v to next
-        const glm::dvec3 edge = position_[next] - position_[v];
+  void classifyAndAddBoundaryPlanes() {
+    for (std::uint32_t v = 0; v < point_.size(); ++v) {
+      gather(v, neighborsU_);
+      kind_[v] = classify(neighborsU_);
+      if (kind_[v] == VertexKind::kInterior || !options_.preserveBoundaries) continue;
+      for (const Neighbor& nb : neighborsU_) {
+        // Each border edge once, from its lower vertex.
+        if (nb.triangles != 1 || nb.vertex < v) continue;
+        const Triangle& t = triangle_[triangleOn(v, nb.vertex)];
+        const glm::dvec3 edge = point_[nb.vertex].p - point_[v].p;
         glm::dvec3 n = glm::cross(edge, areaNormal(t));
         const double length = glm::length(n);
         if (!(length > 0.0)) continue;
         n /= length;
         const double weight = options_.boundaryWeight * glm::dot(edge, edge) / meanArea_;
-        const Quadric q = Quadric::fromPlane(n, -glm::dot(n, position_[v]), weight);
+        const Quadric q = Quadric::fromPlane(n, -glm::dot(n, point_[v].p), weight);
         quadric_[v] += q;
-        quadric_[next] += q;
+        quadric_[nb.vertex] += q;
       }
     }
+  }
+
+  // A live triangle on edge ab (precondition: there is one).
+  std::uint32_t triangleOn(std::uint32_t a, std::uint32_t b) const {
+    std::uint32_t i = listStart_[a];
+    while (triangle_[triangleOf(pool_[i])].removedAt != 0 ||
+           !triangle_[triangleOf(pool_[i])].has(b)) {
+      ++i;
+    }
+    return triangleOf(pool_[i]);
   }
 
   // Live triangles on edge ab.
@@ -216,8 +228,8 @@ class Collapser {
   }
 
   glm::dvec3 areaNormal(const Triangle& t) const {
-    const glm::dvec3& a = position_[t.v[0]];
-    return glm::cross(position_[t.v[1]] - a, position_[t.v[2]] - a);
+    const glm::dvec3& a = point_[t.v[0]].p;
+    return glm::cross(point_[t.v[1]].p - a, point_[t.v[2]].p - a);
   }
 
   // Drops dead triangles from v's list (lazy deletion).
@@ -266,7 +278,7 @@ class Collapser {
     const std::size_t dimension = attributes_.dimension;
     double sum = attributeSelfCost_[w];
     for (std::size_t k = 0; k < dimension; ++k) {
-      sum += attributeQuadric_[u * dimension + k].eval(position_[w],
+      sum += attributeQuadric_[u * dimension + k].eval(point_[w].p,
                                                        attributes_.values[w * dimension + k]);
     }
     return attributeScale_ * std::max(sum, 0.0);
@@ -276,7 +288,7 @@ class Collapser {
     const std::size_t dimension = attributes_.dimension;
     double sum = 0.0;
     for (std::size_t k = 0; k < dimension; ++k) {
-      sum += attributeQuadric_[w * dimension + k].eval(position_[w],
+      sum += attributeQuadric_[w * dimension + k].eval(point_[w].p,
                                                        attributes_.values[w * dimension + k]);
     }
     return sum;
@@ -285,11 +297,11 @@ class Collapser {
   void buildAttributeQuadrics() {
     const std::size_t dimension = attributes_.dimension;
     attributeScale_ = options_.attributeWeight * diagonal_ * diagonal_;
-    attributeQuadric_.assign(position_.size() * dimension, AttributeQuadric());
+    attributeQuadric_.assign(point_.size() * dimension, AttributeQuadric());
     for (const Triangle& t : triangle_) {
-      const glm::dvec3& p0 = position_[t.v[0]];
-      const glm::dvec3 e1 = position_[t.v[1]] - p0;
-      const glm::dvec3 e2 = position_[t.v[2]] - p0;
+      const glm::dvec3& p0 = point_[t.v[0]].p;
+      const glm::dvec3 e1 = point_[t.v[1]].p - p0;
+      const glm::dvec3 e2 = point_[t.v[2]].p - p0;
       const glm::dvec3 n = glm::cross(e1, e2);
       const double n2 = glm::dot(n, n);
       if (!(n2 > 0.0)) continue;
@@ -306,14 +318,13 @@ class Collapser {
         for (std::uint32_t v : t.v) attributeQuadric_[v * dimension + k] += q;
       }
     }
-    attributeSelfCost_.resize(position_.size());
-    for (std::uint32_t v = 0; v < position_.size(); ++v)
-      attributeSelfCost_[v] = attributeSelfCost(v);
+    attributeSelfCost_.resize(point_.size());
+    for (std::uint32_t v = 0; v < point_.size(); ++v) attributeSelfCost_[v] = attributeSelfCost(v);
   }
 
   // Quadric part of the cost of u -> w: (Q_u + Q_w)(p_w); w keeps its place.
   double quadricCost(std::uint32_t u, std::uint32_t w) const {
-    double cost = quadric_[u].eval(position_[w]) + selfCost_[w];
+    double cost = quadric_[u].eval(point_[w].p) + point_[w].selfCost;
     if (attributes_.dimension > 0) cost += attributeCost(u, w);
     return std::max(cost, 0.0);  // rounding can make a zero cost slightly negative
   }
@@ -323,8 +334,8 @@ class Collapser {
   // thin feature: all of u's planes pass near p_w, yet the tip is cut off.
   // Skips dead triangles, so u's list need not be compacted.
   double fanCost(std::uint32_t u, std::uint32_t w) const {
-    const glm::dvec3 pu = position_[u];
-    const glm::dvec3 pw = position_[w];
+    const glm::dvec3 pu = point_[u].p;
+    const glm::dvec3 pw = point_[w].p;
     double fan = 0.0;
     for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
@@ -332,7 +343,7 @@ class Collapser {
       const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
       const std::uint32_t b = t.v[kPrevCorner[cornerOf(entry)]];
       if (t.removedAt != 0 || a == w || b == w) continue;
-      const glm::dvec3 after = glm::cross(position_[a] - pw, position_[b] - pw);
+      const glm::dvec3 after = glm::cross(point_[a].p - pw, point_[b].p - pw);
       const double afterLength2 = glm::dot(after, after);
       if (afterLength2 > 0.0) {
         const double d = glm::dot(after, pu - pw);
@@ -392,17 +403,19 @@ class Collapser {
       target_[u] = best->second;
       return best->first + fanCost(u, best->second);
     }
-    // Full costs first (the fan term needs only u's list), then validate in
-    // cost order: usually the first candidate passes.
-    for (auto& [cost, w] : candidates_) cost += fanCost(u, w);
+    // In quadric order; the quadric cost is a lower bound of the full cost,
+    // so candidates past the best legal full cost need no fan term.
     std::sort(candidates_.begin(), candidates_.end());
-    for (const auto& [cost, w] : candidates_) {
-      if (isValidCollapse(u, w)) {
+    double best = kInfinity;
+    for (const auto& [quadric, w] : candidates_) {
+      if (quadric >= best) break;
+      const double cost = quadric + fanCost(u, w);
+      if (cost < best && isValidCollapse(u, w)) {
+        best = cost;
         target_[u] = w;
-        return cost;
       }
     }
-    return kInfinity;
+    return best;
   }
 
   // Topology and geometry checks for u -> w; u's list is compacted.
@@ -443,8 +456,8 @@ class Collapser {
         mark_[x] = common;
       }
     }
-    const glm::dvec3 pu = position_[u];
-    const glm::dvec3 pw = position_[w];
+    const glm::dvec3 pu = point_[u].p;
+    const glm::dvec3 pw = point_[w].p;
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
@@ -456,8 +469,8 @@ class Collapser {
       // collapse of a tetrahedron). Needs a and b both common neighbours.
       if (mark_[a] == common && mark_[b] == common && hasTriangleOn(w, a, b)) return false;
       if (!options_.preventFlips) continue;
-      const glm::dvec3& pa = position_[a];
-      const glm::dvec3& pb = position_[b];
+      const glm::dvec3& pa = point_[a].p;
+      const glm::dvec3& pb = point_[b].p;
       const glm::dvec3 after = glm::cross(pa - pw, pb - pw);
       // Small turns add up: stay on the front side of the triangle's input
       // orientation too (each live triangle is an input triangle with
@@ -541,7 +554,7 @@ class Collapser {
     listSize_[u] = 0;
 
     quadric_[w] += quadric_[u];
-    selfCost_[w] = quadric_[w].eval(position_[w]);
+    point_[w].selfCost = quadric_[w].eval(point_[w].p);
     if (attributes_.dimension > 0) {
       for (std::size_t k = 0; k < attributes_.dimension; ++k) {
         attributeQuadric_[w * attributes_.dimension + k] +=
@@ -604,9 +617,14 @@ class Collapser {
   const VertexAttributes& attributes_;
   double diagonal_ = 0.0;
   double meanArea_ = 1.0;
-  std::vector<glm::dvec3> position_;
+  // Position and the vertex's own quadric error there, side by side: a
+  // candidate's cost reads both.
+  struct Point {
+    glm::dvec3 p;
+    double selfCost = 0.0;  // quadric_[v].eval(p)
+  };
+  std::vector<Point> point_;
   std::vector<Quadric> quadric_;
-  std::vector<double> selfCost_;  // quadric_[v].eval(position_[v])
   // With attributes: dimension quadrics per vertex, and their value at the
   // vertex itself.
   std::vector<AttributeQuadric> attributeQuadric_;

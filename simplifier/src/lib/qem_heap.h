@@ -13,19 +13,16 @@ class IndexedMinHeap {
     heap_.clear();
     heap_.reserve(idCount);
     slot_.assign(idCount, kAbsent);
-    key_.assign(idCount, 0.0);
   }
   bool empty() const { return heap_.empty(); }
   bool contains(std::uint32_t id) const { return slot_[id] != kAbsent; }
-  std::uint32_t top() const { return heap_.front(); }
-  double topKey() const { return key_[heap_.front()]; }
-  double key(std::uint32_t id) const { return key_[id]; }  // valid while contained
+  std::uint32_t top() const { return heap_.front().id; }
+  double topKey() const { return heap_.front().key; }
+  double key(std::uint32_t id) const { return heap_[slot_[id]].key; }  // precondition: contains
 
   void push(std::uint32_t id, double key) {
-    key_[id] = key;
-    slot_[id] = static_cast<std::uint32_t>(heap_.size());
-    heap_.push_back(id);
-    siftUp(slot_[id]);
+    heap_.push_back({key, id});
+    siftUp(static_cast<std::uint32_t>(heap_.size() - 1));
   }
 
   // Inserts id when absent.
@@ -34,8 +31,8 @@ class IndexedMinHeap {
       push(id, key);
       return;
     }
-    const double old = key_[id];
-    key_[id] = key;
+    const double old = heap_[slot_[id]].key;
+    heap_[slot_[id]].key = key;
     if (key < old) {
       siftUp(slot_[id]);
     } else {
@@ -48,53 +45,55 @@ class IndexedMinHeap {
     const std::uint32_t slot = slot_[id];
     if (slot == kAbsent) return;
     slot_[id] = kAbsent;
-    const std::uint32_t last = heap_.back();
+    const Entry last = heap_.back();
     heap_.pop_back();
-    if (last == id) return;
-    heap_[slot] = last;
-    slot_[last] = slot;
+    if (last.id == id) return;
+    place(slot, last);
     siftUp(slot);
-    siftDown(slot_[last]);
+    siftDown(slot_[last.id]);
   }
 
  private:
   static constexpr std::uint32_t kAbsent = 0xffffffffu;
+  // Keys live in the heap array: sifting compares neighbours in memory
+  // instead of chasing ids into a key table.
+  struct Entry {
+    double key;
+    std::uint32_t id;
+  };
 
-  void place(std::uint32_t slot, std::uint32_t id) {
-    heap_[slot] = id;
-    slot_[id] = slot;
+  void place(std::uint32_t slot, const Entry& entry) {
+    heap_[slot] = entry;
+    slot_[entry.id] = slot;
   }
 
   void siftUp(std::uint32_t slot) {
-    const std::uint32_t id = heap_[slot];
-    const double key = key_[id];
+    const Entry entry = heap_[slot];
     while (slot > 0) {
       const std::uint32_t parent = (slot - 1) / 2;
-      if (!(key < key_[heap_[parent]])) break;
+      if (!(entry.key < heap_[parent].key)) break;
       place(slot, heap_[parent]);
       slot = parent;
     }
-    place(slot, id);
+    place(slot, entry);
   }
 
   void siftDown(std::uint32_t slot) {
-    const std::uint32_t id = heap_[slot];
-    const double key = key_[id];
+    const Entry entry = heap_[slot];
     const std::uint32_t size = static_cast<std::uint32_t>(heap_.size());
     for (;;) {
       std::uint32_t child = 2 * slot + 1;
       if (child >= size) break;
-      if (child + 1 < size && key_[heap_[child + 1]] < key_[heap_[child]]) ++child;
-      if (!(key_[heap_[child]] < key)) break;
+      if (child + 1 < size && heap_[child + 1].key < heap_[child].key) ++child;
+      if (!(heap_[child].key < entry.key)) break;
       place(slot, heap_[child]);
       slot = child;
     }
-    place(slot, id);
+    place(slot, entry);
   }
 
-  std::vector<std::uint32_t> heap_;  // ids in heap order
+  std::vector<Entry> heap_;          // heap order
   std::vector<std::uint32_t> slot_;  // id -> index in heap_, kAbsent if not queued
-  std::vector<double> key_;
 };
 
 }  // namespace thinlod::simplifier::qem
