@@ -680,6 +680,7 @@ void BackboneCore::moveToFrontend(std::uint32_t index) {
   option.atBackbone = backbone::RepresentationCopy();
   state.backbonePayload.reset();
   frontendTriangles_ += option.atFrontend.triangles;
+  promised_.erase(option.atFrontend.id);  // delivered: a later await needs a new promise
   touchObject(state.object);
 }
 
