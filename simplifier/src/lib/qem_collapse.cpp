@@ -347,7 +347,7 @@ class Collapser {
       const double afterLength2 = glm::dot(after, after);
       if (afterLength2 > 0.0) {
         const double d = glm::dot(after, pu - pw);
-        fan += 0.5 * std::sqrt(afterLength2) * (d * d / afterLength2);
+        fan += 0.5 * d * d / std::sqrt(afterLength2);  // area * squared distance
       }
     }
     return kFanWeight * fan / meanArea_;
@@ -380,12 +380,12 @@ class Collapser {
     }
     const VertexKind kind = kind_[u];
     if (kind == VertexKind::kLocked) return kInfinity;
-    candidates_.clear();
+    candidateVertices_.clear();
     if (kind == VertexKind::kBoundary) {
       gather(u, neighborsU_);
       for (const Neighbor& nb : neighborsU_) {
         // Stay on the border: only along border edges.
-        if (nb.triangles == 1) candidates_.push_back({quadricCost(u, nb.vertex), nb.vertex});
+        if (nb.triangles == 1) candidateVertices_.push_back(nb.vertex);
       }
     } else {
       // Interior of an oriented manifold: every neighbour is the next
@@ -393,26 +393,35 @@ class Collapser {
       compact(u);
       for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
         const std::uint32_t entry = pool_[i];
-        const std::uint32_t x = triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]];
-        candidates_.push_back({quadricCost(u, x), x});
+        candidateVertices_.push_back(triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]]);
       }
     }
-    if (candidates_.empty()) return kInfinity;
     if (!exact) {
-      const auto best = std::min_element(candidates_.begin(), candidates_.end());
-      target_[u] = best->second;
-      return best->first + fanCost(u, best->second);
+      double best = kInfinity;
+      for (std::uint32_t w : candidateVertices_) {
+        const double cost = quadricCost(u, w);
+        if (cost < best) {
+          best = cost;
+          target_[u] = w;
+        }
+      }
+      return best < kInfinity ? best + fanCost(u, target_[u]) : kInfinity;
     }
     // In quadric order; the quadric cost is a lower bound of the full cost,
     // so candidates past the best legal full cost need no fan term.
+    candidates_.resize(candidateVertices_.size());
+    for (std::size_t i = 0; i < candidateVertices_.size(); ++i) {
+      candidates_[i].cost = quadricCost(u, candidateVertices_[i]);
+      candidates_[i].vertex = candidateVertices_[i];
+    }
     std::sort(candidates_.begin(), candidates_.end());
     double best = kInfinity;
-    for (const auto& [quadric, w] : candidates_) {
-      if (quadric >= best) break;
-      const double cost = quadric + fanCost(u, w);
-      if (cost < best && isValidCollapse(u, w)) {
+    for (const Candidate& c : candidates_) {
+      if (c.cost >= best) break;
+      const double cost = c.cost + fanCost(u, c.vertex);
+      if (cost < best && isValidCollapse(u, c.vertex)) {
         best = cost;
-        target_[u] = w;
+        target_[u] = c.vertex;
       }
     }
     return best;
@@ -647,7 +656,15 @@ class Collapser {
   // Scratch, reused to avoid allocation per collapse.
   std::vector<Neighbor> neighborsU_;
   std::vector<std::uint32_t> opposite_;
-  std::vector<std::pair<double, std::uint32_t>> candidates_;
+  struct Candidate {
+    double cost;
+    std::uint32_t vertex;
+    bool operator<(const Candidate& o) const {
+      return cost < o.cost || (cost == o.cost && vertex < o.vertex);
+    }
+  };
+  std::vector<std::uint32_t> candidateVertices_;
+  std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> mark_;
   std::uint32_t stamp_ = 0;
 };
