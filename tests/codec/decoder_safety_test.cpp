@@ -136,6 +136,16 @@ TEST(DecoderSafety, RandomPayloadCorruptionsReachTheCodecSafely) {
   }
 }
 
+TEST(DecoderSafety, TruncatedPngPayloadIsRejectedBeforeTheImageLibrary) {
+  Bytes frame = textureFrame(TextureCodec::kPng);
+  frame.resize(frame.size() - 5);  // cuts into the IEND chunk
+  resealFrame(frame);
+  Result<TextureRGBA8> decoded = decodeTexture(frame.data(), frame.size());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kParseError);
+  EXPECT_NE(decoded.status().message().find("truncated"), std::string::npos)
+      << decoded.status().message();
+}
+
 TEST(DecoderSafety, UnknownVersionIsVersionMismatch) {
   Bytes frame = meshFrame();
   frame[4] = 2;

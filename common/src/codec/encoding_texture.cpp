@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <new>
@@ -127,8 +128,30 @@ Status decodeZstd(const std::uint8_t* payload, std::size_t size, TextureRGBA8& o
   return Status();
 }
 
+// True when the bytes are a PNG signature followed by whole chunks ending
+// exactly with IEND. OpenImageIO 2.4 leaks a string each time libpng hits
+// the end of a short stream (PNGInput::PngReadCallback formats an error,
+// then libpng longjmps past its destructor), so short PNGs never reach it.
+bool pngChunksComplete(const std::uint8_t* data, std::size_t size) {
+  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || !std::equal(kSignature, kSignature + 8, data)) return false;
+  std::size_t at = 8;
+  while (size - at >= 12) {
+    const std::size_t length = (std::size_t{data[at]} << 24) | (std::size_t{data[at + 1]} << 16) |
+                               (std::size_t{data[at + 2]} << 8) | data[at + 3];
+    if (length > size - at - 12) return false;
+    const bool end = std::equal(data + at + 4, data + at + 8, "IEND");
+    at += 12 + length;
+    if (end) return at == size;
+  }
+  return false;
+}
+
 Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
                    TextureRGBA8& out) {
+  if (codec == TextureCodec::kPng && !pngChunksComplete(payload, size)) {
+    return textureError(ErrorCode::kParseError, "PNG payload is truncated or malformed");
+  }
   OIIO::Filesystem::IOMemReader proxy(payload, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
