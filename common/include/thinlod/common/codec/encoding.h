@@ -73,8 +73,9 @@ struct TextureRGBA8 {
 
 enum class TextureCodec : std::uint8_t { kZstd = 1, kPng = 2, kJpeg = 3 };
 
-// Codec choice (measured on a 256x256 impostor, PLATFORM.md: zstd-1 0.25 ms
-// / 20 KB, PNG 4.8 ms / 15 KB, JPEG q85 0.4 ms / 5.8 KB):
+// Codec choice (256x256 impostor-like image, CPU ms encode / decode, bytes;
+// docs/results/error-validation.md): zstd-1 0.09 / 0.04 / 7.9 KB, PNG-6
+// 2.1 / 0.5 / 7.8 KB, JPEG q85 (opaque only) 0.19 / 0.18 / 3.6 KB:
 // - kFastest: zstd only; for impostors refreshed every few frames.
 // - kSmallestLossless: PNG and zstd both, the smaller wins (costs both).
 // - kSmallest: as kSmallestLossless, plus JPEG when every alpha is 255 and
