@@ -81,8 +81,14 @@ def summarize_run(run_dir):
         for i, t0 in enumerate(times):
             total = sum(b for t, b in zip(times[i:], link[i:]) if t < t0 + 1.0)
             worst = max(worst, total)
+        # A token bucket guarantees rate * T + burst over any window of length T.
+        burst = meta.get("link_burst", 0.0)
         summary["budget_link_bytes_per_s"] = rate
+        summary["link_burst_bytes"] = burst
         summary["link_bytes_max_1s_window"] = worst
+        summary["link_bytes_1s_window_bound"] = rate * 1.0 + burst
+        span = times[-1] - times[0] if len(times) > 1 else 0.0
+        summary["link_bytes_per_s_mean"] = (sum(link) / span) if span > 0 else None
     return summary, rows
 
 
@@ -181,7 +187,9 @@ def main():
                      f"{s['link_bytes_total'] / 1000:>8.1f}")
         if s.get("budget_link_bytes_per_s"):
             lines.append(f"{'':<20} link: worst 1 s window {s['link_bytes_max_1s_window']:.0f} bytes "
-                         f"vs budget {s['budget_link_bytes_per_s']:.0f} bytes/s")
+                         f"(bound rate x 1 s + burst = {s['link_bytes_1s_window_bound']:.0f}); "
+                         f"mean {fmt(s['link_bytes_per_s_mean'], 0)} bytes/s "
+                         f"vs budget {s['budget_link_bytes_per_s']:.0f}")
     text = "\n".join(lines) + "\n"
     with open(os.path.join(out_dir, "summary.txt"), "w") as f:
         f.write(text)
