@@ -20,6 +20,7 @@ Usage: simplifier_restart.py BUILD_DIR MODELS_DIR OUT_DIR
 Every process is torn down on any exit; every wait has a deadline.
 """
 import csv
+import ctypes
 import json
 import os
 import re
@@ -46,6 +47,16 @@ class Failure(Exception):
     pass
 
 
+_libc = ctypes.CDLL(None, use_errno=True)
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent():
+    """In the child before exec: the kernel kills it if this script dies first
+    (e.g. a ctest timeout), so no daemon outlives the test."""
+    _libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
 class Daemon:
     """One daemon process with its log file; killed on teardown."""
 
@@ -54,7 +65,7 @@ class Daemon:
         self.log_path = log_path
         self.log_file = open(log_path, "w")
         self.process = subprocess.Popen(argv, stdout=self.log_file, stderr=subprocess.STDOUT,
-                                        start_new_session=True)
+                                        start_new_session=True, preexec_fn=_die_with_parent)
 
     def log(self):
         with open(self.log_path, errors="replace") as f:
@@ -242,4 +253,6 @@ def main(build, models, out):
 if __name__ == "__main__":
     if len(sys.argv) != 4:
         sys.exit(__doc__)
+    # SIGTERM/SIGINT unwind through main's `finally`, which stops the daemons.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     sys.exit(main(*sys.argv[1:4]))
