@@ -112,6 +112,43 @@ int countEdgesWithMoreThanTwoTriangles(const IndexedMesh& mesh) {
   return count;
 }
 
+std::set<std::uint32_t> nonManifoldVertices(const IndexedMesh& mesh) {
+  std::set<std::uint32_t> out;
+  for (const auto& [edge, triangles] : edgeTriangleCounts(mesh)) {
+    if (triangles > 2) out.insert({edge.first, edge.second});
+  }
+  // Fans: union the triangles around each vertex that share an edge at it.
+  std::vector<std::vector<std::size_t>> around(mesh.vertexCount());
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    for (int k = 0; k < 3; ++k) around[mesh.indices[t + k]].push_back(t);
+  }
+  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
+    const std::vector<std::size_t>& fan = around[v];
+    std::vector<std::size_t> group(fan.size());
+    for (std::size_t i = 0; i < fan.size(); ++i) group[i] = i;
+    const auto root = [&group](std::size_t i) {
+      while (group[i] != i) i = group[i] = group[group[i]];
+      return i;
+    };
+    for (std::size_t i = 0; i < fan.size(); ++i) {
+      for (std::size_t j = i + 1; j < fan.size(); ++j) {
+        int shared = 0;  // corners other than v in common
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) {
+            const std::uint32_t x = mesh.indices[fan[i] + a];
+            if (x != v && x == mesh.indices[fan[j] + b]) ++shared;
+          }
+        }
+        if (shared > 0) group[root(i)] = root(j);
+      }
+    }
+    std::set<std::size_t> roots;
+    for (std::size_t i = 0; i < fan.size(); ++i) roots.insert(root(i));
+    if (roots.size() > 1) out.insert(v);
+  }
+  return out;
+}
+
 std::set<std::uint32_t> borderVertices(const IndexedMesh& mesh) {
   std::set<std::uint32_t> border;
   for (const auto& [edge, triangles] : edgeTriangleCounts(mesh)) {

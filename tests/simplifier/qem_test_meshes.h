@@ -34,6 +34,9 @@ using Edge = std::pair<std::uint32_t, std::uint32_t>;  // (min, max)
 // Undirected edge -> number of triangles using it.
 std::map<Edge, int> edgeTriangleCounts(const IndexedMesh& mesh);
 int countEdgesWithMoreThanTwoTriangles(const IndexedMesh& mesh);
+// Vertices on an edge with more than two triangles, or whose triangles form
+// more than one fan (connected through edges at the vertex): bow ties.
+std::set<std::uint32_t> nonManifoldVertices(const IndexedMesh& mesh);
 // Vertices on an edge used by exactly one triangle.
 std::set<std::uint32_t> borderVertices(const IndexedMesh& mesh);
 // Triangles as sorted triples of their corner positions: equal sets mean the

@@ -135,3 +135,28 @@ TEST(SimplifierCli, DegenerateInputFails) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SimplifierCli, CurveReportsLevelsAndCurves) {
+  const std::string out = tempPath("cow_curves.json");
+  const ProcessResult r =
+      run("curve " + model("cow.obj") + " --levels 5 --samples 2000 --no-bytes --json -o " + out);
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const nlohmann::json result = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(result["ok"].get<bool>());
+  ASSERT_GE(result["levels"].size(), 3u);
+  EXPECT_FALSE(result["triangles_curve"]["triples"].empty());
+  // Coarser levels are less accurate.
+  const nlohmann::json& levels = result["levels"];
+  EXPECT_GT(levels.front()["relative_max_error"].get<double>(),
+            levels.back()["relative_max_error"].get<double>());
+  EXPECT_TRUE(std::filesystem::exists(out));
+  std::filesystem::remove(out);
+}
+
+TEST(SimplifierCli, CurveOfMissingFileFails) {
+  EXPECT_NE(run("curve /nonexistent/x.obj --json").exitCode, 0);
+}
+
+}  // namespace

@@ -19,6 +19,7 @@ class App;
 namespace thinlod::simplifier::tool {
 
 void addSimplifyCommand(CLI::App& app);  // simplify IN (--ratio R | --triangles N) -o OUT
+void addCurveCommand(CLI::App& app);     // curve IN [-o CURVES.json]: measured accuracy curves
 void addServeCommand(CLI::App& app);     // serve: the simplifier daemon (serve_command.cpp)
 
 }  // namespace thinlod::simplifier::tool

@@ -9,11 +9,12 @@
 //   triangle is left), then collapses down to stopAtTriangles (0: as far as the
 //   topology rules allow) and stores the collapse order.
 // - Greedy by cost: QEM (Garland-Heckbert, area-weighted planes) plus a fan
-//   term that keeps thin tips. Collapses keep original vertex positions
-//   (vertex substitution, see progressive_mesh.cpp for why), keep
-//   boundary vertices on the boundary, reject face flips (preventFlips), never
-//   create a non-manifold edge or close a hole, and never move a vertex that
-//   lies on a non-manifold edge of the input.
+//   term (distance of the removed vertex to its new fan) that keeps thin
+//   tips. Collapses keep input vertex positions (vertex substitution, see
+//   progressive_mesh.cpp for why), keep manifold boundary vertices on the
+//   boundary, never create a non-manifold edge or close a hole, never move a
+//   vertex on a non-manifold edge of the input, and (preventFlips) reject
+//   triangles that turn over or face against the input surface.
 // - extract(n): the state after the first collapse that leaves at most n
 //   triangles; exactly n when the order passes through n, else the next lower
 //   count (a collapse removes >= 1 triangle). n >= maxTriangles(): the cleaned
