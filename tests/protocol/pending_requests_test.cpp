@@ -109,6 +109,27 @@ TEST(PendingRequests, AFailedSendCountsAsAnAttemptOfThatRequestOnly) {
   EXPECT_TRUE(t.attemptFailed(99).retry.empty());
 }
 
+TEST(PendingRequests, ReturnedUnsentDispatchIsNotAnAttempt) {
+  auto t = table(2);
+  ASSERT_TRUE(t.add(1).ok());
+  // Many more unsent returns than maxAttempts: the request is never given up.
+  for (int i = 0; i < 5; ++i) {
+    auto sent = t.dispatch({{10, 1}}, kT0);
+    ASSERT_EQ(sent.size(), 1u);
+    EXPECT_EQ(sent[0].attempt, 1);
+    EXPECT_TRUE(t.returnUnsent(1));
+    EXPECT_EQ(t.waiting(), 1u);
+    EXPECT_EQ(t.inFlightOn(10), 0u);
+  }
+  EXPECT_FALSE(t.returnUnsent(1));   // not in flight
+  EXPECT_FALSE(t.returnUnsent(99));  // unknown
+  // The vanished worker is avoided when another one has room.
+  auto sent = t.dispatch({{10, 1}, {20, 1}}, kT0);
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].workerId, 20u);
+  EXPECT_EQ(sent[0].attempt, 1);
+}
+
 TEST(PendingRequests, FirstResultWinsDuplicatesAreRecognised) {
   auto t = table();
   ASSERT_TRUE(t.add(1).ok());

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <zmq.hpp>
 
 #include "seed_messages.h"
 #include "thinlod/protocol/codec.h"
@@ -297,6 +298,98 @@ TEST(WorkerPool, UnansweredRequestFailsWithTimeoutAfterEveryAttempt) {
   EXPECT_EQ(failed->simplify.status.code(), ErrorCode::kTimeout);
   EXPECT_EQ(silent.simplify.size(), 2u);  // both attempts reached the only worker
   EXPECT_EQ(pool->pendingRequests(), 0u);
+}
+
+// A worker process killed with SIGKILL: it says Hello, then its socket is
+// closed without a Shutdown, so the ROUTER forgets its connection long before
+// the liveness timeout.
+struct AbruptWorker {
+  zmq::context_t context{1};
+  zmq::socket_t socket{context, zmq::socket_type::dealer};
+  AbruptWorker(const std::string& address, const std::string& name, std::uint32_t capacity) {
+    socket.set(zmq::sockopt::linger, 0);
+    socket.connect(address);
+    const Bytes hello = *encode(helloAs(Role::kSimplifier, name, capacity));
+    socket.send(zmq::buffer(hello.data(), hello.size()), zmq::send_flags::none);
+  }
+  void die() {
+    socket.close();
+    context.close();
+  }
+};
+
+TEST(WorkerPool, SendToAVanishedWorkerDoesNotSpendAttemptsAndTheRequestGoesToALiveOne) {
+  // Liveness 5 s: the test checks the pool does not wait for it (the vanished
+  // worker is dropped when a send to it fails), yet a slow machine still
+  // finishes through the timeout path instead of failing.
+  WorkerPool::Options options;
+  options.address = "tcp://127.0.0.1:0";
+  options.transport = fastTransport(50, 100);
+  options.requests.maxAttempts = 3;
+  auto bound = WorkerPool::bind(options);
+  ASSERT_TRUE(bound.ok()) << bound.status().toString();
+  WorkerPool& pool = **bound;
+  FakeWorker live(pool.endpoint().address(), "simplifier-live", 1);
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(pool);
+    live.poll();
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool.liveWorkers() == 1; }));
+  // The live worker is busy with another request.
+  auto busy = pool.submit(simplifyRequest(1));
+  ASSERT_TRUE(busy.ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return live.simplify.size() == 1; }));
+  ASSERT_EQ(live.simplify[0].requestId, *busy);
+  AbruptWorker doomed(pool.endpoint().address(), "simplifier-doomed", 4);
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool.liveWorkers() == 2; }));
+
+  doomed.die();
+  // Give the ROUTER time to see the connection close (loopback: well under 1 ms).
+  pumpUntil(
+      step, [] { return false; }, 300ms);
+  auto orphan = pool.submit(simplifyRequest(2));
+  ASSERT_TRUE(orphan.ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool.liveWorkers() == 1; }));
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kWorkerLeft), 1u);
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kSimplifyResult), 0u);  // not given up
+  EXPECT_EQ(pool.pendingRequests(), 2u);
+
+  ASSERT_TRUE(live.answer(live.simplify[0], 5).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return live.simplify.size() == 2; }));
+  EXPECT_EQ(live.simplify[1].requestId, *orphan);
+  ASSERT_TRUE(live.answer(live.simplify[1], 6).ok());
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 2; }));
+  for (const auto& e : r.events) {
+    if (e.kind != WorkerPoolEvent::Kind::kSimplifyResult) continue;
+    EXPECT_TRUE(e.simplify.status.ok()) << e.simplify.status.toString();
+    if (e.simplify.requestId == *orphan) {
+      EXPECT_EQ(e.simplify.triangleCount, 6u);
+    }
+  }
+  EXPECT_EQ(pool.pendingRequests(), 0u);
+}
+
+TEST(WorkerPool, AWorkerDroppedAfterAFailedSendIsReportedLeftOnce) {
+  // Liveness 1 s: the Endpoint's own kLeft for the vanished worker comes
+  // during the test and must not be reported again.
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  AbruptWorker doomed(pool->endpoint().address(), "simplifier-doomed", 1);
+  PoolRecorder r;
+  auto step = [&] { r.poll(*pool); };
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->liveWorkers() == 1; }));
+  doomed.die();
+  pumpUntil(
+      step, [] { return false; }, 300ms);
+  ASSERT_TRUE(pool->submit(simplifyRequest(7)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->liveWorkers() == 0; }));
+  // The poll in which the Endpoint drops the peer also hands its kLeft to the pool.
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->endpoint().peers().empty(); }));
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kWorkerLeft), 1u);
+  EXPECT_EQ(r.count(WorkerPoolEvent::Kind::kSimplifyResult), 0u);  // waits for a worker
+  EXPECT_EQ(pool->pendingRequests(), 1u);
 }
 
 }  // namespace

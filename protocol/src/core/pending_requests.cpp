@@ -98,6 +98,17 @@ PendingRequests::Released PendingRequests::attemptFailed(std::uint64_t requestId
   return released;
 }
 
+bool PendingRequests::returnUnsent(std::uint64_t requestId) {
+  auto it = entries_.find(requestId);
+  if (it == entries_.end() || !it->second.inFlight) return false;
+  Entry& entry = it->second;
+  entry.inFlight = false;
+  entry.lastWorkerId = entry.workerId;
+  entry.workerId = 0;
+  if (entry.attempts > 0) --entry.attempts;
+  return true;
+}
+
 bool PendingRequests::complete(std::uint64_t requestId) { return entries_.erase(requestId) != 0; }
 bool PendingRequests::cancel(std::uint64_t requestId) { return entries_.erase(requestId) != 0; }
 

@@ -4,6 +4,7 @@
 
 #include <map>
 #include <random>
+#include <set>
 
 #include "net/socket_impl.h"
 
@@ -16,6 +17,10 @@ struct WorkerPool::Impl {
   PendingRequests pending;
   std::map<std::uint64_t, Message> requests;       // by request id
   std::map<std::uint64_t, std::uint32_t> workers;  // PeerId -> capacity
+  // Workers dropped because a send found their connection gone; the
+  // Endpoint still lists them until its liveness check, whose kLeft is then
+  // not reported a second time.
+  std::set<std::uint64_t> vanished;
   std::uint64_t nextRequestId = 1;
   std::vector<WorkerPoolEvent> events;
 
@@ -24,6 +29,9 @@ struct WorkerPool::Impl {
   Result<std::uint64_t> submit(Message request);
   void fail(const std::vector<std::uint64_t>& ids, ErrorCode code, const std::string& why);
   void onResult(PeerId worker, std::uint64_t requestId, WorkerPoolEvent event);
+  // The worker is gone: its requests go back to waiting (or fail after
+  // their last attempt) and kWorkerLeft is reported once.
+  void workerLost(PeerId worker, const std::string& why);
   void dispatch(Clock::time_point now);
 };
 
@@ -126,22 +134,61 @@ void WorkerPool::Impl::onResult(PeerId worker, std::uint64_t requestId, WorkerPo
   events.push_back(std::move(event));
 }
 
+void WorkerPool::Impl::workerLost(PeerId worker, const std::string& why) {
+  workers.erase(worker.value);
+  auto released = pending.workerLost(worker.value);
+  if (!released.retry.empty()) {
+    spdlog::info("event=requests_resent_after_worker_loss worker={} count={}", worker.value,
+                 released.retry.size());
+  }
+  fail(released.failed, ErrorCode::kUnavailable, "its worker was lost on every attempt");
+  spdlog::info("event=worker_lost worker={} reason=\"{}\"", worker.value, why);
+  WorkerPoolEvent event;
+  event.kind = WorkerPoolEvent::Kind::kWorkerLeft;
+  event.worker = worker;
+  events.push_back(std::move(event));
+}
+
 void WorkerPool::Impl::dispatch(Clock::time_point now) {
-  std::vector<PendingRequests::Worker> live;
-  for (const auto& [id, capacity] : workers) live.push_back({id, capacity});
-  for (const auto& d : pending.dispatch(live, now)) {
-    const Status sent = endpoint->send(PeerId{d.workerId}, requests.at(d.requestId));
-    if (sent.ok()) {
-      spdlog::debug("event=request_sent request={} worker={} attempt={}", d.requestId, d.workerId,
-                    d.attempt);
-      continue;
+  // Each round either sends everything it dispatched or drops at least one
+  // worker, so this ends after at most workers.size() + 1 rounds.
+  for (;;) {
+    std::vector<PendingRequests::Worker> live;
+    for (const auto& [id, capacity] : workers) live.push_back({id, capacity});
+    std::set<std::uint64_t> gone;
+    for (const auto& d : pending.dispatch(live, now)) {
+      if (gone.count(d.workerId) != 0) {
+        pending.returnUnsent(d.requestId);
+        continue;
+      }
+      const Status sent = endpoint->send(PeerId{d.workerId}, requests.at(d.requestId));
+      if (sent.ok()) {
+        spdlog::debug("event=request_sent request={} worker={} attempt={}", d.requestId, d.workerId,
+                      d.attempt);
+        continue;
+      }
+      spdlog::warn("event=request_send_failed request={} worker={} error=\"{}\"", d.requestId,
+                   d.workerId, sent.toString());
+      if (sent.code() == ErrorCode::kNotFound) {
+        // The worker's connection is gone (e.g. the process was killed): a
+        // retry on it fails the same way at once, so it is lost now, not at
+        // the liveness timeout, and this request did not reach anyone.
+        pending.returnUnsent(d.requestId);
+        gone.insert(d.workerId);
+        continue;
+      }
+      // Full or another failure: this attempt failed; the request waits for
+      // the next poll.
+      auto released = pending.attemptFailed(d.requestId);
+      fail(released.failed, ErrorCode::kUnavailable, "could not be delivered to a worker");
     }
-    // Gone or full: this attempt failed; the request waits for the next
-    // poll (the Endpoint reports a vanished worker as kLeft on its own).
-    spdlog::warn("event=request_send_failed request={} worker={} error=\"{}\"", d.requestId,
-                 d.workerId, sent.toString());
-    auto released = pending.attemptFailed(d.requestId);
-    fail(released.failed, ErrorCode::kUnavailable, "could not be delivered to a worker");
+    if (gone.empty()) return;
+    // Dropped after the batch so that requests returned unsent above are not
+    // also charged an attempt by workerLost().
+    for (std::uint64_t worker : gone) {
+      vanished.insert(worker);
+      workerLost(PeerId{worker}, "its connection is gone (send failed)");
+    }
   }
 }
 
@@ -158,20 +205,11 @@ std::vector<WorkerPoolEvent> WorkerPool::poll(std::chrono::milliseconds timeout)
         s.events.push_back(std::move(event));
         break;
       }
-      case EndpointEvent::Kind::kLeft: {
-        s.workers.erase(e.peer.value);
-        auto released = s.pending.workerLost(e.peer.value);
-        if (!released.retry.empty()) {
-          spdlog::info("event=requests_resent_after_worker_loss worker={} count={}", e.peer.value,
-                       released.retry.size());
-        }
-        s.fail(released.failed, ErrorCode::kUnavailable, "its worker was lost on every attempt");
-        WorkerPoolEvent event;
-        event.kind = WorkerPoolEvent::Kind::kWorkerLeft;
-        event.worker = e.peer;
-        s.events.push_back(std::move(event));
+      case EndpointEvent::Kind::kLeft:
+        // Already dropped after a failed send: reported then.
+        if (s.vanished.erase(e.peer.value) != 0) break;
+        s.workerLost(e.peer, e.reason.toString());
         break;
-      }
       case EndpointEvent::Kind::kMessage:
         if (auto* result = std::get_if<SimplifyResult>(&e.message)) {
           WorkerPoolEvent event;

@@ -12,9 +12,10 @@
 //   the live worker with the most free capacity, avoiding the worker whose
 //   attempt last failed when another one is free; ties go to the smaller
 //   worker id. A worker never holds more than its capacity.
-// - Every dispatch is an attempt. After `maxAttempts` attempts without a
-//   result (worker lost or timeout each time) the request fails: it is
-//   removed and reported in Released::failed for the caller to answer.
+// - Every dispatch is an attempt, unless the caller hands it back with
+//   returnUnsent() (nothing left: the worker was already gone). After
+//   `maxAttempts` attempts without a result (worker lost or timeout each
+//   time) the request fails: it is removed and reported in Released::failed.
 // - Requests that wait for a worker do not time out (there was no attempt);
 //   cancel() removes them.
 #pragma once
@@ -64,6 +65,10 @@ class PendingRequests {
   // The running attempt of one request failed (e.g. it could not be sent):
   // like workerLost, for that request only.
   Released attemptFailed(std::uint64_t requestId);
+  // The dispatch just made could not be sent because its worker is gone:
+  // back to waiting without counting the attempt (a dead worker must not
+  // use up a request's attempts). False when the request is not in flight.
+  bool returnUnsent(std::uint64_t requestId);
   // True when the id was pending (the first result); false for a duplicate
   // or an unknown id.
   bool complete(std::uint64_t requestId);
