@@ -14,7 +14,7 @@ rm -rf "$out"; mkdir -p "$out"
 THINLOD_BUILD_DIR=$build THINLOD_READY_TIMEOUT_S=300 "$root/deploy/run-local" "$out" \
   --backbone "--scene $root/deploy/data/paper-room.wrl --models-dir $models --max-speed 0.1 --lifetime 1.0 --sync-wait-ms 5000 $args --decisions-csv $out/decisions.csv" \
   --simplifier "--scene $root/deploy/data/paper-room.wrl --models-dir $models --scene-root / --cache-dir $build/cache" \
-  --frontend "--scene $root/deploy/data/paper-room.wrl --models-dir $models --trace $root/deploy/data/paper-flight.trace --lockstep --lockstep-timeout-ms 20000 --frames 20 --width 320 --height 240 --csv $out/frames.csv"
+  --frontend "--scene $root/deploy/data/paper-room.wrl --models-dir $models --trace $root/deploy/data/paper-flight.trace --lockstep --lockstep-timeout-ms 20000 --rate -1 --frames 20 --width 320 --height 240 --csv $out/frames.csv"
 python3 - "$out/frames.csv" "$args" <<'PY'
 import csv, math, shlex, sys
 path, args = sys.argv[1], shlex.split(sys.argv[2])
