@@ -102,22 +102,28 @@ def gnuplot(script):
 def plot_run(run_dir, name):
     csv_path = os.path.join(run_dir, "frames.csv")
     png = os.path.join(run_dir, "snr_accuracy_triangles.png")
-    # In the style of the paper's Figures 12 and 13: SNR, target accuracy and triangles per frame.
+    # In the style of the paper's Figures 12 and 13: SNR with the target accuracy above,
+    # triangles at the frontend below.
     gnuplot(f"""
 set datafile separator ','
-set terminal pngcairo size 900,500 noenhanced
+set terminal pngcairo size 900,650 noenhanced
 set output '{png}'
-set title '{name}: SNR, target accuracy and triangles per frame'
+set multiplot layout 2,1 title '{name}'
+set key outside bottom center horizontal
+set grid
 set xlabel 'frame'
-set ylabel 'SNR (dB) / triangles / 10'
+set ylabel 'SNR (dB)'
 set y2label 'target accuracy (rad^-1)'
 set y2tics
 set ytics nomirror
-set key outside bottom center horizontal
-set grid
 plot '{csv_path}' using 'frame':'snr_db' with linespoints pt 7 ps 0.4 title 'SNR (dB)', \\
-     '' using 'frame':(column('polygons')/10.0) with steps title 'triangles / 10', \\
      '' using 'frame':'target_accuracy' axes x1y2 with lines dt 2 title 'target accuracy'
+unset y2label
+unset y2tics
+set ytics mirror
+set ylabel 'triangles'
+plot '{csv_path}' using 'frame':'polygons' with steps title 'triangles at the frontend'
+unset multiplot
 """)
 
 
