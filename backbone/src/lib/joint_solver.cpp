@@ -8,20 +8,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::int32_t sourceTie(CandidateSource source) {
-  switch (source) {
-    case CandidateSource::kFrontendCopy:
-      return 0;
-    case CandidateSource::kPending:
-      return 1;
-    case CandidateSource::kBackboneCopy:
-      return 2;
-    case CandidateSource::kNew:
-      return 3;
-  }
-  return 4;
-}
-
 }  // namespace
 
 JointSolver::JointSolver(const SchedulingScene& scene, const SchedulerConfig& config,
@@ -403,8 +389,8 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy, double
       const LeafCandidate& c = candidates_[n.firstCandidate + i];
       if (!(c.maxRelativeAccuracy >= x * (1.0 - kAccuracyTolerance))) continue;
       const CandidateCost cost = candidateCost(c, std::min(x, c.maxRelativeAccuracy));
-      arena_.push_back(
-          {cost.triangles, cost.linkBytes, static_cast<std::int32_t>(i), -1, sourceTie(c.source)});
+      arena_.push_back({cost.triangles, cost.linkBytes, static_cast<std::int32_t>(i), -1,
+                        candidateSourceRank(c.source)});
     }
     nodeSet_[k] = finish(begin, limitTriangles, limitLink);
     return nodeSet_[k];

@@ -11,20 +11,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNever = 1e30;  // "does not expire", finite so it sorts and prints
 
-int sourceRank(CandidateSource source) {
-  switch (source) {
-    case CandidateSource::kFrontendCopy:
-      return 0;
-    case CandidateSource::kPending:
-      return 1;
-    case CandidateSource::kBackboneCopy:
-      return 2;
-    case CandidateSource::kNew:
-      return 3;
-  }
-  return 4;
-}
-
 std::uint64_t fingerprint(const SchedulerConfig& c) {
   // Bitwise hash of the plain-double config (no padding-sensitive memcmp).
   const double fields[] = {c.maxSpeed,
@@ -104,6 +90,20 @@ void removeAllCopies(const PlanContext& ctx, std::uint32_t object, Plan& plan, b
 
 }  // namespace
 
+int candidateSourceRank(CandidateSource source) {
+  switch (source) {
+    case CandidateSource::kFrontendCopy:
+      return 0;
+    case CandidateSource::kPending:
+      return 1;
+    case CandidateSource::kBackboneCopy:
+      return 2;
+    case CandidateSource::kNew:
+      return 3;
+  }
+  return 4;
+}
+
 int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst) {
   int best = -1;
   CandidateCost bestCost;
@@ -119,7 +119,9 @@ int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, boo
       if (p > bp) continue;
       if (p == bp) {
         if (s > bs) continue;
-        if (s == bs && sourceRank(c.source) >= sourceRank(candidates[best].source)) continue;
+        if (s == bs &&
+            candidateSourceRank(c.source) >= candidateSourceRank(candidates[best].source))
+          continue;
       }
     }
     best = static_cast<int>(i);

@@ -30,6 +30,9 @@ struct LeafSelection {
   double absoluteAccuracy() const { return frameAccuracy * distance / diameter; }
 };
 
+// Tie-break rank among equal-cost candidates: copies already on (or on their
+// way to) the frontend first, new generations last (lower is preferred).
+int candidateSourceRank(CandidateSource source);
 // Index of the cheapest candidate reaching `need` (primary resource first,
 // then the other, then copies before new ones, then option order), or -1.
 int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst);
