@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "renderer_checks.h"
 #include "texture_fit.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/render_target.h"
@@ -23,15 +24,6 @@ double millisecondsSince(Clock::time_point start) {
 
 std::uint8_t toByte(float v) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-}
-
-bool finiteMatrix(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c) {
-    for (int r = 0; r < 4; ++r) {
-      if (!std::isfinite(m[c][r])) return false;
-    }
-  }
-  return true;
 }
 
 // Which merged draw a representation belongs to.
@@ -272,17 +264,8 @@ FrontendRenderer::~FrontendRenderer() = default;
 
 Result<std::unique_ptr<FrontendRenderer>> FrontendRenderer::create(
     render::OffscreenContext& context, const FrontendRendererOptions& options) {
-  if (!context.isCurrent()) {
-    return Status(ErrorCode::kUnavailable,
-                  "FrontendRenderer::create: the GL context is not current on this thread");
-  }
-  const int maxSize = context.maxRenderTargetSize();
-  if (options.width < 1 || options.height < 1 || options.width > maxSize ||
-      options.height > maxSize) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "FrontendRenderer: frame " + std::to_string(options.width) + "x" +
-                      std::to_string(options.height) + " outside 1.." + std::to_string(maxSize));
-  }
+  THINLOD_RETURN_IF_ERROR(
+      detail::checkFrameContext(context, options.width, options.height, "FrontendRenderer"));
   if (options.layerSize < 2 || options.layerSize > 4096 || options.layersPerPage < 2 ||
       options.layersPerPage > 2048) {
     return Status(ErrorCode::kInvalidArgument,
@@ -323,7 +306,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
     return Status(ErrorCode::kUnavailable,
                   "FrontendRenderer::renderFrame: the GL context is not current on this thread");
   }
-  if (!finiteMatrix(camera.view) || !finiteMatrix(camera.projection)) {
+  if (!detail::finiteMatrix(camera.view) || !detail::finiteMatrix(camera.projection)) {
     return Status(ErrorCode::kInvalidArgument, "renderFrame: camera matrices are not finite");
   }
   if (lighting.lights.size() > static_cast<std::size_t>(render::kMaxLights)) {

@@ -7,17 +7,10 @@
 #include <unordered_set>
 #include <utility>
 
+#include "renderer_checks.h"
+
 namespace thinlod::frontend {
 namespace {
-
-bool finiteMatrix(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c) {
-    for (int r = 0; r < 4; ++r) {
-      if (!std::isfinite(m[c][r])) return false;
-    }
-  }
-  return true;
-}
 
 // Checks one add/replace operation; `what` names it ("batch plan 7, operation 3 (object 12)").
 Status validateRepresentation(const Representation& rep, const std::string& what) {
@@ -26,7 +19,7 @@ Status validateRepresentation(const Representation& rep, const std::string& what
     return Status(ErrorCode::kInvalidArgument,
                   what + ": unknown representation kind " + std::to_string(kind));
   }
-  if (!finiteMatrix(rep.transform)) {
+  if (!detail::finiteMatrix(rep.transform)) {
     return Status(ErrorCode::kInvalidArgument, what + ": transform is not finite");
   }
   const float det = glm::determinant(glm::mat3(rep.transform));

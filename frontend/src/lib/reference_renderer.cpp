@@ -6,6 +6,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "renderer_checks.h"
 #include "thinlod/common/render/render_target.h"
 
 namespace thinlod::frontend {
@@ -82,17 +83,8 @@ ReferenceRenderer::~ReferenceRenderer() = default;
 
 Result<std::unique_ptr<ReferenceRenderer>> ReferenceRenderer::create(
     render::OffscreenContext& context, const ReferenceRendererOptions& options) {
-  if (!context.isCurrent()) {
-    return Status(ErrorCode::kUnavailable,
-                  "ReferenceRenderer::create: the GL context is not current on this thread");
-  }
-  const int maxSize = context.maxRenderTargetSize();
-  if (options.width < 1 || options.height < 1 || options.width > maxSize ||
-      options.height > maxSize) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "ReferenceRenderer: frame " + std::to_string(options.width) + "x" +
-                      std::to_string(options.height) + " outside 1.." + std::to_string(maxSize));
-  }
+  THINLOD_RETURN_IF_ERROR(
+      detail::checkFrameContext(context, options.width, options.height, "ReferenceRenderer"));
   auto impl = std::make_unique<Impl>();
   impl->context = &context;
   impl->options = options;
