@@ -20,6 +20,7 @@ namespace thinlod::simplifier::tool {
 
 void addSimplifyCommand(CLI::App& app);  // simplify IN (--ratio R | --triangles N) -o OUT
 void addCurveCommand(CLI::App& app);     // curve IN [-o CURVES.json]: measured accuracy curves
+void addImpostorCommand(CLI::App& app);  // impostor IN [--meshed] [--size N]: render one impostor
 void addServeCommand(CLI::App& app);     // serve: the simplifier daemon (serve_command.cpp)
 
 }  // namespace thinlod::simplifier::tool

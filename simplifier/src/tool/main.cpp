@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   thinlod::simplifier::tool::addSimplifyCommand(app);
   thinlod::simplifier::tool::addCurveCommand(app);
+  thinlod::simplifier::tool::addImpostorCommand(app);
   thinlod::simplifier::tool::addServeCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
