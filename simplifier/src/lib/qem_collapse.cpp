@@ -20,8 +20,8 @@ constexpr double kMinFlipCos2 = 0.01;
 // kFarthestWeight mean-sized triangles so that a small but tall feature (a
 // one-vertex spike, a thin tip) is not cheap to cut. Chosen on the shared
 // models against meshoptimizer: the sum alone lowered the mean surface error
-// by ~22% at equal max error; the farthest term then lowered the max error by
-// ~13% for ~5% of that mean gain (docs/results/simplifier.md).
+// by ~10% at equal max error; the farthest term then lowered the max error by
+// ~11% for ~5% of mean (docs/results/simplifier.md).
 constexpr double kFanWeight = 1.0;
 constexpr double kFarthestWeight = 100.0;
 
