@@ -118,7 +118,9 @@ TEST(PaperRoom, FlightPathPassesCloseWithoutEnteringObjects) {
     }
     EXPECT_GT(closest, 0.2) << def << " is entered or grazed";
     // "closely between two spheres and a cylinder, and then approached a cow"
-    if (std::string(def) != "SphereLeft") EXPECT_LT(closest, 1.0) << def << " is never passed";
+    if (std::string(def) != "SphereLeft") {
+      EXPECT_LT(closest, 1.0) << def << " is never passed";
+    }
   }
   const Pose& last = trace->poses.back();
   const Bounds cow = instanceOf(all, *s, "Cow")->worldBounds;
