@@ -369,6 +369,33 @@ TEST(ProgressiveMeshTopology, SeparatePartsAllSurviveCoarseLevels) {
   EXPECT_GE(right, 4);
 }
 
+// Two cones base to base: both apexes have thousands of triangles (the
+// adjacency and cost updates must not scan a whole fan per collapse).
+TEST(ProgressiveMeshTopology, HugeFansSimplifyToAClosedManifold) {
+  const int segments = 5000;
+  IndexedMesh m;
+  m.positions = {{0, 0, 1}, {0, 0, -1}};
+  for (int i = 0; i < segments; ++i) {
+    const float a = 6.2831853f * static_cast<float>(i) / segments;
+    m.positions.push_back({std::cos(a), std::sin(a), 0.0f});
+  }
+  for (int i = 0; i < segments; ++i) {
+    const auto a = static_cast<std::uint32_t>(2 + i);
+    const auto b = static_cast<std::uint32_t>(2 + (i + 1) % segments);
+    m.indices.insert(m.indices.end(), {0, a, b, 1, b, a});
+  }
+  const ProgressiveMesh pm = buildOrDie(m);
+  EXPECT_EQ(pm.minTriangles(), 4u);
+  for (std::size_t n : {5000u, 500u, 50u}) {
+    const IndexedMesh out = pm.extract(n);
+    for (const auto& [edge, triangles] : edgeTriangleCounts(out)) ASSERT_EQ(triangles, 2);
+    // The apexes are the most expensive vertices to remove: they stay.
+    int apexes = 0;
+    for (const glm::vec3& p : out.positions) apexes += std::abs(p.z) == 1.0f ? 1 : 0;
+    EXPECT_EQ(apexes, 2) << "target " << n;
+  }
+}
+
 TEST(ProgressiveMeshTopology, NonManifoldEdgeIsKeptAndNoneIsCreated) {
   // A fin: one extra triangle standing on an interior edge of a sheet.
   IndexedMesh m = makeGrid(8);

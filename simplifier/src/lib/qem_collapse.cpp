@@ -24,6 +24,8 @@ constexpr double kMinFlipCos2 = 0.01;
 // ~11% for ~5% of mean (docs/results/simplifier.md).
 constexpr double kFanWeight = 1.0;
 constexpr double kFarthestWeight = 100.0;
+// Valence above which a vertex's fan counts as huge (see rekeyAround).
+constexpr std::size_t kLargeFan = 64;
 
 // Corners and removal step in one 16-byte record: the adjacency walks read
 // both, one cache line instead of two.
@@ -99,6 +101,8 @@ class Collapser {
     target_.assign(vertexCount, kNone);
     exact_.assign(vertexCount, 0);
     mark_.assign(vertexCount, 0);
+    slot_.assign(vertexCount, 0);
+    gatherMark_.assign(vertexCount, 0);
     buildAdjacency(vertexCount);
     buildQuadrics();
     heap_.reset(vertexCount);
@@ -173,6 +177,7 @@ class Collapser {
       }
     }
     listStart_.resize(vertexCount);
+    liveCount_ = listSize_;
   }
 
   void buildQuadrics() {
@@ -266,7 +271,21 @@ class Collapser {
     out.clear();
     const std::uint32_t start = listStart_[v];
     std::uint32_t write = start;
-    auto add = [&out](std::uint32_t x) {
+    // Small fans: linear search. Large ones (poles, cone apexes with
+    // thousands of triangles) index their neighbours through stamped slots.
+    const bool large = listSize_[v] > 32;
+    const std::uint32_t stamp = large ? ++gatherStamp_ : 0;
+    auto add = [&](std::uint32_t x) {
+      if (large) {
+        if (gatherMark_[x] == stamp) {
+          ++out[slot_[x]].triangles;
+        } else {
+          gatherMark_[x] = stamp;
+          slot_[x] = static_cast<std::uint32_t>(out.size());
+          out.push_back({x, 1});
+        }
+        return;
+      }
       for (Neighbor& n : out) {
         if (n.vertex == x) {
           ++n.triangles;
@@ -433,6 +452,9 @@ class Collapser {
       candidates_[i].vertex = candidateVertices_[i];
     }
     std::sort(candidates_.begin(), candidates_.end());
+    // Huge fans: only the kLargeFan cheapest by quadric get the O(valence)
+    // fan term, or one exact evaluation would cost O(valence^2).
+    if (candidates_.size() > kLargeFan) candidates_.resize(kLargeFan);
     double best = kInfinity;
     for (const Candidate& c : candidates_) {
       if (c.cost >= best) break;
@@ -528,13 +550,6 @@ class Collapser {
     return false;
   }
 
-  bool hasLiveTriangle(std::uint32_t v) const {
-    for (std::uint32_t i = listStart_[v], end = i + listSize_[v]; i < end; ++i) {
-      if (triangle_[triangleOf(pool_[i])].removedAt == 0) return true;
-    }
-    return false;
-  }
-
   void removeVertex(std::uint32_t v, std::uint32_t parent) {
     removed_[v] = 1;
     record_.removedVertex.push_back(v);
@@ -556,6 +571,7 @@ class Collapser {
       if (t.removedAt != 0 || (a != w && b != w)) continue;
       t.removedAt = step;
       --liveTriangles_;
+      for (std::uint32_t x : t.v) --liveCount_[x];
       opposite_.push_back(a == w ? b : a);
     }
     // w's new list: its live triangles, then u's survivors renamed to w.
@@ -582,7 +598,9 @@ class Collapser {
       if (t.removedAt != 0) continue;
       t.v[cornerOf(entry)] = w;
       pool_.push_back(entry);
+      ++liveCount_[w];
     }
+    liveCount_[u] = 0;
     listStart_[w] = newStart;
     listSize_[w] = static_cast<std::uint32_t>(pool_.size()) - newStart;
     listSize_[u] = 0;
@@ -600,7 +618,7 @@ class Collapser {
     // Vertices left without triangles leave the mesh too (parent kNone).
     if (listSize_[w] == 0) removeVertex(w, kNone);
     for (std::uint32_t x : opposite_) {
-      if (!removed_[x] && !hasLiveTriangle(x)) removeVertex(x, kNone);
+      if (!removed_[x] && liveCount_[x] == 0) removeVertex(x, kNone);
     }
     record_.removalsAfterStep.push_back(static_cast<std::uint32_t>(record_.removedVertex.size()));
     record_.trianglesAfterStep.push_back(static_cast<std::uint32_t>(liveTriangles_));
@@ -627,6 +645,9 @@ class Collapser {
           continue;
         }
         if (kind_[x] == VertexKind::kLocked) continue;
+        // A huge fan (a pole, a cone apex) would pay O(valence) here on every
+        // collapse around it; its key may stay high until it is re-chosen.
+        if (liveCount_[x] > kLargeFan) continue;
         if (kind_[x] == VertexKind::kBoundary && edgeTriangleCount(x, w) != 1) continue;
         double cost = quadricCost(x, w);
         if (cost < heap_.key(x)) cost += fanCost(x, w);
@@ -672,6 +693,7 @@ class Collapser {
   // dead triangles until the next gather of v.
   std::vector<std::uint32_t> listStart_;
   std::vector<std::uint32_t> listSize_;
+  std::vector<std::uint32_t> liveCount_;  // live triangles per vertex (the lists lag behind)
   std::vector<std::uint32_t> pool_;
   std::vector<std::uint8_t> removed_;
   std::vector<VertexKind> kind_;
@@ -692,6 +714,10 @@ class Collapser {
   std::vector<std::uint32_t> candidateVertices_;
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> mark_;
+  // Gather of large fans: stamp and index in the output per neighbour.
+  std::vector<std::uint32_t> gatherMark_;
+  std::vector<std::uint32_t> slot_;
+  std::uint32_t gatherStamp_ = 0;
   std::uint32_t stamp_ = 0;
 };
 
