@@ -1,8 +1,9 @@
-// Private: the QEM half-edge collapse loop. Greedy by collapse cost with an
-// indexed binary heap over vertices (each vertex keyed by its cheapest
-// outgoing collapse, validity checked lazily when it reaches the top), on a
-// vertex -> triangle adjacency of flat arrays. Pure; the input is a CleanMesh
-// (no repeated corners, no duplicate triangles).
+// Private: the QEM half-edge collapse loop. Greedy by collapse cost (quadric
+// plus fan term) with an indexed binary heap over vertices: each vertex is
+// keyed by an estimate of its cheapest outgoing collapse, replaced by the
+// exact legal cost when it reaches the top. Vertex -> corner adjacency in
+// flat arrays. Pure; the input is a CleanMesh (no repeated corners, no
+// duplicate triangles, vertices in spatial order).
 #pragma once
 
 #include <cstdint>
