@@ -5,6 +5,7 @@
 #include <glm/geometric.hpp>
 #include <random>
 
+#include "test_meshes.h"  // tests/simplifier_error: shared test meshes
 #include "thinlod/common/mesh_io.h"
 
 namespace thinlod::qemtest {
@@ -27,37 +28,9 @@ IndexedMesh makeGrid(int cells) {
 }
 
 IndexedMesh makeIcosphere(int level, const glm::vec3& centre) {
-  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  std::vector<glm::vec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                              {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                              {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::uint32_t> f = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7, 10, 0, 10, 11,
-                                  1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7, 6,  7, 1,  8,
-                                  3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6, 8,  3, 8,  9,
-                                  4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6, 7,  9, 8,  1};
-  for (glm::vec3& v : p) v = glm::normalize(v);
-  for (int l = 0; l < level; ++l) {
-    std::map<Edge, std::uint32_t> midpoint;
-    auto mid = [&](std::uint32_t a, std::uint32_t b) {
-      const Edge key{std::min(a, b), std::max(a, b)};
-      auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      p.push_back(glm::normalize(p[a] + p[b]));
-      const auto index = static_cast<std::uint32_t>(p.size() - 1);
-      midpoint.emplace(key, index);
-      return index;
-    };
-    std::vector<std::uint32_t> next;
-    for (std::size_t i = 0; i < f.size(); i += 3) {
-      const std::uint32_t a = f[i], b = f[i + 1], c = f[i + 2];
-      const std::uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
-      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    f = std::move(next);
-  }
-  IndexedMesh m;
-  for (const glm::vec3& v : p) m.positions.push_back(v + centre);
-  m.indices = std::move(f);
+  // The same subdivided icosahedron as the error tests' (one construction).
+  IndexedMesh m = testing::makeIcosphere(level, 1.0f);
+  for (glm::vec3& v : m.positions) v += centre;
   return m;
 }
 
