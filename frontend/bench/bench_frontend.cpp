@@ -9,6 +9,10 @@
 //   frontend   FrontendRenderer::renderFrame (uploads, commit, draw, readback)
 //   bare       the same 350 triangles pre-merged, one draw call, one texture
 //              bind, readback (MeshRenderer directly: the floor for this work)
+//   raw GL     the same pre-merged triangles with plain GL calls (GLVND's
+//              libOpenGL, EGL back-end only): one GLSL 3.30 program, one VBO,
+//              one sampler2DArray, one glDrawArrays into a 640x480 FBO with
+//              depth test, glReadPixels RGBA (raw_gl_baseline.h)
 //   full       the objects at full resolution (full spheres, cow.obj) through
 //              ReferenceRenderer, same camera/lights/size
 //   burst      20 impostors replaced at once (new 256x256 textures): every
@@ -28,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "raw_gl_baseline.h"
 #include "thinlod/common/mesh_io.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/mesh_renderer.h"
@@ -387,6 +392,25 @@ int main(int argc, char** argv) {
   bareItem.material.texture = bareTexture;
   bareItem.material.alphaMode = render::AlphaMode::kMask;
 
+  // Raw-GL baseline: same merged mesh and layers, plain GL calls. GLVND's
+  // libOpenGL dispatches to the current EGL context; OSMesa's context is not
+  // reachable that way, so the raw baseline runs with EGL only.
+  std::unique_ptr<bench::RawGlBaseline> rawGl;
+  if (context->backend() == render::Backend::kEgl) {
+    std::vector<const render::RgbaImage*> layers{&white};
+    for (const SceneOperation& op : initial) {
+      const Representation& rep = op.representation;
+      layers.push_back(rep.texture != nullptr ? rep.texture.get() : &white);
+    }
+    rawGl = orDie(bench::RawGlBaseline::create(kWidth, kHeight, bareBatch.mesh(),
+                                               bareBatch.textureLayers(), layers),
+                  "raw GL baseline");
+  } else {
+    std::fprintf(stderr,
+                 "bench_frontend: raw-GL baseline is EGL-only (OSMesa exports its own gl* "
+                 "symbols); run with --backend egl for it\n");
+  }
+
   // A slow pan so no two frames are the same view.
   auto cameraAt = [&](int frame) {
     const float yaw = 0.05f * std::sin(0.02f * static_cast<float>(frame));
@@ -396,6 +420,22 @@ int main(int argc, char** argv) {
   };
 
   render::RgbaImage frontendFrame, bareFrame, fullFrame;
+  std::vector<std::uint8_t> rawFrame;
+  // The raw baseline must draw the scene, not an empty frame: count pixels
+  // that differ from the black clear colour.
+  std::size_t rawCoveredPixels = 0;
+  if (rawGl != nullptr) {
+    const render::Camera camera = cameraAt(0);
+    rawGl->renderFrame(camera.projection * camera.view, rawFrame);
+    for (std::size_t p = 0; p + 3 < rawFrame.size(); p += 4) {
+      if (rawFrame[p] != 0 || rawFrame[p + 1] != 0 || rawFrame[p + 2] != 0) ++rawCoveredPixels;
+    }
+    if (rawCoveredPixels < 1000) {
+      std::fprintf(stderr, "bench_frontend: raw-GL frame is empty (%zu non-background pixels)\n",
+                   rawCoveredPixels);
+      return 1;
+    }
+  }
   FrameReport lastReport;
   // Warm-up: the initial scene arrives through the upload bound.
   int warmup = 0;
@@ -408,7 +448,7 @@ int main(int argc, char** argv) {
 
   // ------------------------------------------------------------ steady frames
   const double loadBefore = loadAverage();
-  std::vector<double> frontendMs, bareMs, frontendCpuMs, bareCpuMs;
+  std::vector<double> frontendMs, bareMs, frontendCpuMs, bareCpuMs, rawMs, rawCpuMs;
   std::size_t frontendCalls = 0, frontendTriangles = 0;
   for (int f = 0; f < frames; ++f) {
     const render::Camera camera = cameraAt(f);
@@ -426,6 +466,13 @@ int main(int argc, char** argv) {
     orDie(bareTarget->readColor(bareFrame), "bare readback");
     bareMs.push_back(msSince(start));
     bareCpuMs.push_back(cpuMs() - cpuStart);
+    if (rawGl != nullptr) {
+      cpuStart = cpuMs();
+      const Clock::time_point rawStart = Clock::now();
+      rawGl->renderFrame(camera.projection * camera.view, rawFrame);
+      rawMs.push_back(msSince(rawStart));
+      rawCpuMs.push_back(cpuMs() - cpuStart);
+    }
   }
   std::vector<double> fullMs;
   for (int f = 0; f < fullFrames; ++f) {
@@ -486,6 +533,8 @@ int main(int argc, char** argv) {
   const Percentiles fullStats = percentiles(fullMs);
   const double p99Ratio = frontendStats.p99 / bareStats.p99;
   const double cpuMedian = percentiles(frontendCpuMs).median;
+  const Percentiles rawStats = rawGl != nullptr ? percentiles(rawMs) : Percentiles{};
+  const double p99OverRaw = rawGl != nullptr ? frontendStats.p99 / rawStats.p99 : 0.0;
   const double burstRatio = bounded.worstMs / frontendStats.median;
   const double burstCpuRatio = bounded.worstCpuMs / cpuMedian;
   nlohmann::json json{
@@ -506,6 +555,12 @@ int main(int argc, char** argv) {
       {"full_resolution", stats(fullMs)},
       {"frontend_draw_calls", frontendCalls},
       {"p99_frontend_over_bare", p99Ratio},
+      {"raw_gl_single_draw", rawGl != nullptr
+                                 ? nlohmann::json{{"wall", stats(rawMs)},
+                                                  {"cpu", stats(rawCpuMs)},
+                                                  {"non_background_pixels", rawCoveredPixels},
+                                                  {"p99_frontend_over_raw_gl", p99OverRaw}}
+                                 : nlohmann::json("EGL-only: not measured with this back-end")},
       {"target_p99_within_1_25x_bare", p99Ratio <= 1.25},
       {"snr_db_vs_full", quality.snrDb},
       {"psnr_db_vs_full", quality.psnrDb},
@@ -552,6 +607,16 @@ int main(int argc, char** argv) {
       unboundedBurst.worstMs / frontendStats.median, unboundedBurst.worstCpuMs,
       unboundedBurst.worstCpuMs / cpuMedian, unboundedBurst.worstExtraMs, quality.snrDb,
       quality.psnrDb);
+  if (rawGl != nullptr) {
+    std::fprintf(stderr,
+                 "  raw GL     median %.3f ms  p99 %.3f ms  max %.3f ms  (cpu median %.3f ms, "
+                 "%zu non-background pixels)\n"
+                 "  p99 frontend / raw GL = %.3f\n",
+                 rawStats.median, rawStats.p99, rawStats.max, percentiles(rawCpuMs).median,
+                 rawCoveredPixels, p99OverRaw);
+  } else {
+    std::fprintf(stderr, "  raw GL     not measured (EGL-only)\n");
+  }
   const std::string text = json.dump(2);
   std::printf("%s\n", text.c_str());
   if (!jsonPath.empty()) {
@@ -569,5 +634,6 @@ int main(int argc, char** argv) {
   full.reset();
   bareRenderer.reset();
   bareTarget.reset();
+  rawGl.reset();
   return 0;
 }
