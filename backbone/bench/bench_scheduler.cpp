@@ -38,19 +38,7 @@ SchedulerConfig paperConfig() {
   return c;
 }
 
-SchedulerConfig exactConfig() {
-  SchedulerConfig c = paperConfig();
-  c.mergeDistanceFactor = kInf;
-  c.cacheDistanceMargin = 0.0;
-  c.cacheAngleMargin = 0.0;
-  c.curveTolerance = 0.0;
-  c.maxParetoPasses = 100000;
-  c.budgetReserveShare = 0.0;
-  c.preferCurrentShare = 0.0;
-  c.switchDelaySteps = 0;
-  c.targetHysteresis = 0.0;
-  return c;
-}
+SchedulerConfig exactConfig() { return withoutApproximations(paperConfig()); }
 
 ViewerState viewer(glm::dvec3 p, glm::dvec3 d, double t, std::uint64_t frame) {
   ViewerState v;

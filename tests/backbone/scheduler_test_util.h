@@ -142,17 +142,7 @@ inline SchedulerConfig exactConfig() {
   c.plannedLifetime = 1.0;
   c.linkDelay = 0.05;
   c.generationDelay = 0.1;
-  c.mergeDistanceFactor = kInf;
-  c.cacheDistanceMargin = 0.0;
-  c.cacheAngleMargin = 0.0;
-  c.curveTolerance = 0.0;
-  c.maxParetoPasses = 100000;
-  c.budgetReserveShare = 0.0;
-  c.preferCurrentShare = 0.0;
-  c.switchDelaySteps = 0;
-  c.targetHysteresis = 0.0;
-  c.rangeHysteresis = 0.0;
-  return c;
+  return withoutApproximations(c);
 }
 
 inline ViewerState viewerAt(glm::dvec3 position, glm::dvec3 direction, double time = 0.0,

@@ -28,6 +28,20 @@ double angleBetween(const glm::dvec3& a, const glm::dvec3& b) {
 
 }  // namespace
 
+SchedulerConfig withoutApproximations(SchedulerConfig c) {
+  c.mergeDistanceFactor = std::numeric_limits<double>::infinity();
+  c.cacheDistanceMargin = 0.0;
+  c.cacheAngleMargin = 0.0;
+  c.curveTolerance = 0.0;
+  c.maxParetoPasses = 100000;
+  c.budgetReserveShare = 0.0;
+  c.preferCurrentShare = 0.0;
+  c.switchDelaySteps = 0;
+  c.targetHysteresis = 0.0;
+  c.rangeHysteresis = 0.0;
+  return c;
+}
+
 Status validateConfig(const SchedulerConfig& c) {
   const char* o = "SchedulerConfig";
   auto nonNegative = [](double v) { return std::isfinite(v) && v >= 0.0; };

@@ -79,6 +79,12 @@ struct SchedulerConfig {
 };
 
 Status validateConfig(const SchedulerConfig& config);
+// `config` with every approximation and stability device off (no merging, no
+// cache growth, exact curves, unlimited Pareto passes, no reserve, no
+// preference for current copies, no delays or hysteresis): the plain model
+// of the paper, whose target the brute-force scheduler reproduces exactly.
+// Prediction settings (speeds, lifetime, delays, distances) are kept.
+SchedulerConfig withoutApproximations(SchedulerConfig config);
 Status validateViewer(const ViewerState& viewer);
 
 struct PredictedRegion {
