@@ -208,7 +208,7 @@ nlohmann::json stats(const std::vector<double>& samples) {
 
 int main(int argc, char** argv) {
   CLI::App app{"thinlod frontend frame-cost benchmark"};
-  int frames = 400;
+  int frames = 1000;  // p99 of 1000 is the 10th worst: robust to a single hiccup
   int fullFrames = 20;
   int bursts = 5;
   std::string backendName = "auto";
@@ -535,6 +535,11 @@ int main(int argc, char** argv) {
   const double cpuMedian = percentiles(frontendCpuMs).median;
   const Percentiles rawStats = rawGl != nullptr ? percentiles(rawMs) : Percentiles{};
   const double p99OverRaw = rawGl != nullptr ? frontendStats.p99 / rawStats.p99 : 0.0;
+  const double medianOverRaw = rawGl != nullptr ? frontendStats.median / rawStats.median : 0.0;
+  // The target is against a bare GL draw; without EGL (no raw GL
+  // baseline) it falls back to MeshRenderer's single draw, and says so.
+  const bool targetAgainstRaw = rawGl != nullptr;
+  const double targetRatio = targetAgainstRaw ? p99OverRaw : p99Ratio;
   const double burstRatio = bounded.worstMs / frontendStats.median;
   const double burstCpuRatio = bounded.worstCpuMs / cpuMedian;
   nlohmann::json json{
@@ -559,9 +564,13 @@ int main(int argc, char** argv) {
                                  ? nlohmann::json{{"wall", stats(rawMs)},
                                                   {"cpu", stats(rawCpuMs)},
                                                   {"non_background_pixels", rawCoveredPixels},
-                                                  {"p99_frontend_over_raw_gl", p99OverRaw}}
+                                                  {"p99_frontend_over_raw_gl", p99OverRaw},
+                                                  {"median_frontend_over_raw_gl", medianOverRaw}}
                                  : nlohmann::json("EGL-only: not measured with this back-end")},
-      {"target_p99_within_1_25x_bare", p99Ratio <= 1.25},
+      {"target_p99_within_1_25x",
+       {{"against", targetAgainstRaw ? "raw_gl_single_draw" : "bare_single_draw"},
+        {"ratio", targetRatio},
+        {"met", targetRatio <= 1.25}}},
       {"snr_db_vs_full", quality.snrDb},
       {"psnr_db_vs_full", quality.psnrDb},
       {"burst",
@@ -592,7 +601,7 @@ int main(int argc, char** argv) {
       "  frontend   median %.3f ms  p99 %.3f ms  max %.3f ms  (cpu median %.3f ms)\n"
       "  bare draw  median %.3f ms  p99 %.3f ms  max %.3f ms  (cpu median %.3f ms)\n"
       "  full res   median %.3f ms  p99 %.3f ms\n"
-      "  p99 frontend / bare = %.3f (target <= 1.25)\n"
+      "  p99 frontend / bare = %.3f\n"
       "  burst of 20, bound %zu B/frame: applied after %d frames; worst frame %.3f ms = %.2fx "
       "median, worst cpu %.3f ms = %.2fx cpu median; upload+commit <= %.3f ms (target < 2x)\n"
       "  burst of 20, no bound: applied after %d frames; worst frame %.3f ms = %.2fx median, "
@@ -611,11 +620,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "  raw GL     median %.3f ms  p99 %.3f ms  max %.3f ms  (cpu median %.3f ms, "
                  "%zu non-background pixels)\n"
-                 "  p99 frontend / raw GL = %.3f\n",
+                 "  p99 frontend / raw GL = %.3f (target <= 1.25), median %.3f\n",
                  rawStats.median, rawStats.p99, rawStats.max, percentiles(rawCpuMs).median,
-                 rawCoveredPixels, p99OverRaw);
+                 rawCoveredPixels, p99OverRaw, medianOverRaw);
   } else {
-    std::fprintf(stderr, "  raw GL     not measured (EGL-only)\n");
+    std::fprintf(stderr,
+                 "  raw GL     not measured (EGL-only); target judged against bare: %.3f\n",
+                 p99Ratio);
   }
   const std::string text = json.dump(2);
   std::printf("%s\n", text.c_str());

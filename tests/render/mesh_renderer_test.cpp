@@ -121,6 +121,70 @@ TEST_P(MeshRendererTest, PointLightFallsOffWithDistance) {
   EXPECT_LT(image.at(0, 0)[0], image.at(kSize / 2, kSize / 2)[0] / 2);
 }
 
+TEST_P(MeshRendererTest, SpecularHighlightOnlyWhenTheMaterialHasOne) {
+  Material material;
+  material.diffuse = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  material.shininess = 32.0f;
+  Lighting lighting;
+  lighting.ambient = glm::vec3(0.0f);
+  Light light;
+  light.vector = glm::vec3(0, 0, -1);
+  lighting.lights = {light};
+  const MeshHandle quad = upload(makeQuad(-1, -1, 1, 1, 0));
+  const RgbaImage matte = render({{quad, glm::mat4(1.0f), material}}, lighting);
+  EXPECT_TRUE(pixelNear(matte, kSize / 2, kSize / 2, 128, 128, 128, 255, 2));
+  // At the centre light, normal and eye (0,0,5) line up: the half vector is
+  // the normal, so the specular term is specular * 1^shininess.
+  material.specular = glm::vec3(0.3f, 0.0f, 0.0f);
+  const RgbaImage shiny = render({{quad, glm::mat4(1.0f), material}}, lighting);
+  EXPECT_TRUE(pixelNear(shiny, kSize / 2, kSize / 2, 204, 128, 128, 255, 3));
+  // Off-centre the eye is oblique, so the highlight is weaker but not gone.
+  EXPECT_GT(shiny.at(2, 2)[0], matte.at(2, 2)[0]);
+  EXPECT_LT(shiny.at(2, 2)[0], shiny.at(kSize / 2, kSize / 2)[0]);
+}
+
+TEST_P(MeshRendererTest, LightsOfMixedTypesAddUpInEitherOrder) {
+  Material material;
+  material.diffuse = glm::vec4(1.0f);
+  Lighting lighting;
+  lighting.ambient = glm::vec3(0.0f);
+  Light directional;
+  directional.vector = glm::vec3(0, 0, -1);
+  directional.color = glm::vec3(0.25f, 0.0f, 0.0f);
+  Light point;
+  point.type = Light::Type::kPoint;
+  point.vector = glm::vec3(0.0f, 0.0f, 1.0f);
+  point.color = glm::vec3(0.0f, 1.0f, 0.0f);
+  point.attenuation = 1.0f;
+  const DrawItem item{upload(makeQuad(-1, -1, 1, 1, 0)), glm::mat4(1.0f), material};
+  for (const auto& lights : {std::vector<Light>{directional, point},
+                             std::vector<Light>{point, directional}}) {
+    lighting.lights = lights;
+    const RgbaImage image = render({item}, lighting);
+    // 0.25 red from the directional light; 1 / (1 + 1 * 1^2) = 0.5 green from the point light.
+    EXPECT_TRUE(pixelNear(image, kSize / 2, kSize / 2, 64, 128, 0, 255, 3));
+  }
+}
+
+TEST_P(MeshRendererTest, ItemsOfDifferentShaderVariantsKeepTheirOwnSettings) {
+  IndexedMesh redVertices = makeQuad(0, -1, 1, 1, 0);
+  redVertices.colors.assign(4, {255, 0, 0, 255});
+  Material lit;
+  lit.diffuse = glm::vec4(0.0f, 0.5f, 0.0f, 1.0f);
+  Material unlitIgnoringVertexColours = unlitColor(0, 0, 1);  // useVertexColors is false
+  Lighting lighting;
+  lighting.ambient = glm::vec3(1.0f);
+  const RgbaImage image =
+      render({{upload(makeQuad(-1, -1, 0, 0, 0)), glm::mat4(1.0f), lit},
+              {upload(redVertices), glm::mat4(1.0f), unlitIgnoringVertexColours},
+              {upload(makeQuad(-1, 0, 0, 1, 0)), glm::mat4(1.0f), lit}},
+             lighting);
+  EXPECT_TRUE(pixelNear(image, 16, 48, 0, 128, 0, 255, 2));  // first lit quad (bottom left)
+  EXPECT_TRUE(pixelNear(image, 48, 32, 0, 0, 255, 255, 1));  // unlit, vertex colours unused
+  EXPECT_TRUE(pixelNear(image, 16, 16, 0, 128, 0, 255, 2));  // lit again after the switch
+  EXPECT_EQ(rig_.renderer->stats().drawCalls, 3u);
+}
+
 TEST_P(MeshRendererTest, VertexColoursMultiplyDiffuse) {
   IndexedMesh quad = makeQuad(-1, -1, 1, 1, 0);
   quad.colors.assign(4, {255, 128, 0, 255});
@@ -255,6 +319,11 @@ TEST_P(MeshRendererTest, InvalidDrawInputsAreRejectedBeforeDrawing) {
   DrawItem item{mesh, glm::mat4(1.0f), unlitColor(1, 1, 1)};
   EXPECT_EQ(rig_.renderer->draw(&item, 1, orthoCamera(), tooMany).code(),
             ErrorCode::kInvalidArgument);
+  EXPECT_EQ(rig_.renderer->prepare(Material(), false, tooMany).code(),
+            ErrorCode::kInvalidArgument);
+  Lighting two;
+  two.lights.resize(2);
+  EXPECT_TRUE(rig_.renderer->prepare(Material(), true, two).ok());
   auto texture = rig_.renderer->uploadTexture(checkerImage());
   ASSERT_TRUE(texture.ok());
   item.material.texture = *texture;

@@ -56,9 +56,11 @@ bool finite(const glm::mat4& m) {
   return finite(m[0]) && finite(m[1]) && finite(m[2]) && finite(m[3]);
 }
 
-Status compileShader(const GlFunctions& gl, GLenum type, const char* source, GLuint& shader) {
+Status compileShader(const GlFunctions& gl, GLenum type, const std::string& defines,
+                     const char* body, GLuint& shader) {
   shader = gl.glCreateShader(type);
-  gl.glShaderSource(shader, 1, &source, nullptr);
+  const char* parts[] = {"#version 330 core\n", defines.c_str(), body};
+  gl.glShaderSource(shader, 3, parts, nullptr);
   gl.glCompileShader(shader);
   GLint ok = GL_FALSE;
   gl.glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
@@ -70,15 +72,120 @@ Status compileShader(const GlFunctions& gl, GLenum type, const char* source, GLu
                     " shader failed to compile: " + log);
 }
 
+// One compiled shader variant (see shaders.h) and its uniform locations.
+struct Program {
+  GLuint id = 0;
+  struct {
+    GLint model, viewProjection, normalMatrix, diffuse, specular, shininess, layer, alphaCutoff,
+        texture, ambient, lightVector, lightColor, lightAttenuation, eyePosition;
+  } uniform{};
+  bool frameUniformsSet = false;  // within the current draw()
+};
+
+// A variant's key packs what shaders.h's #defines fix. Lighting enters the
+// key (count and type of each light) so the light loop is unrolled with
+// constant types; a scene has one lighting set-up, so few variants are built.
+using VariantKey = std::uint32_t;
+constexpr VariantKey kLit = 1u << 0;
+constexpr VariantKey kSpecular = 1u << 1;
+constexpr VariantKey kTextured = 1u << 2;
+constexpr VariantKey kVertexColors = 1u << 3;
+constexpr VariantKey kVertexLayers = 1u << 4;
+constexpr int kAlphaShift = 5;       // 2 bits
+constexpr int kLightCountShift = 7;  // 3 bits
+constexpr int kLightTypeShift = 10;  // one bit per light: 1 = point
+
+bool hasSpecular(const Material& m) { return m.specular != glm::vec3(0.0f); }
+
+VariantKey variantOf(const Material& m, bool meshHasLayers, const Lighting& lighting) {
+  VariantKey key = static_cast<VariantKey>(m.alphaMode == AlphaMode::kOpaque ? 0
+                                           : m.alphaMode == AlphaMode::kMask ? 1
+                                                                             : 2)
+                   << kAlphaShift;
+  if (m.useVertexColors) key |= kVertexColors;
+  if (m.texture.valid()) {
+    key |= kTextured;
+    if (meshHasLayers) key |= kVertexLayers;
+  }
+  if (m.lit) {
+    key |= kLit;
+    if (hasSpecular(m)) key |= kSpecular;
+    key |= static_cast<VariantKey>(lighting.lights.size()) << kLightCountShift;
+    for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
+      if (lighting.lights[i].type != Light::Type::kDirectional) key |= 1u << (kLightTypeShift + i);
+    }
+  }
+  return key;
+}
+
+std::string definesOf(VariantKey key) {
+  auto flag = [&](const char* name, VariantKey bit) {
+    return std::string("#define ") + name + ((key & bit) != 0 ? " 1\n" : " 0\n");
+  };
+  const unsigned lightCount = (key >> kLightCountShift) & 7u;
+  std::string types = "int[" + std::to_string(kMaxLights) + "](";
+  for (int i = 0; i < kMaxLights; ++i) {
+    types += std::string(i > 0 ? "," : "") + (((key >> (kLightTypeShift + i)) & 1u) ? "1" : "0");
+  }
+  return flag("LIT", kLit) + flag("SPECULAR", kSpecular) + flag("TEXTURED", kTextured) +
+         flag("VERTEX_COLORS", kVertexColors) + flag("VERTEX_LAYERS", kVertexLayers) +
+         "#define ALPHA_MODE " + std::to_string((key >> kAlphaShift) & 3u) + "\n" +
+         "#define LIGHT_COUNT " + std::to_string(lightCount) + "\n" + "#define LIGHT_TYPES " +
+         types + ")\n";
+}
+
+Status buildProgram(const GlFunctions& gl, VariantKey key, Program& program) {
+  const std::string defines = definesOf(key);
+  GLuint vertexShader = 0;
+  GLuint fragmentShader = 0;
+  Status vertexStatus =
+      compileShader(gl, GL_VERTEX_SHADER, defines, kMeshVertexShader, vertexShader);
+  Status fragmentStatus =
+      compileShader(gl, GL_FRAGMENT_SHADER, defines, kMeshFragmentShader, fragmentShader);
+  const GLuint id = gl.glCreateProgram();
+  gl.glAttachShader(id, vertexShader);
+  gl.glAttachShader(id, fragmentShader);
+  if (vertexStatus.ok() && fragmentStatus.ok()) gl.glLinkProgram(id);
+  gl.glDeleteShader(vertexShader);  // flagged; freed with the program
+  gl.glDeleteShader(fragmentShader);
+  GLint linked = GL_FALSE;
+  if (vertexStatus.ok() && fragmentStatus.ok()) gl.glGetProgramiv(id, GL_LINK_STATUS, &linked);
+  if (linked != GL_TRUE) {
+    char log[2048] = {0};
+    gl.glGetProgramInfoLog(id, sizeof(log) - 1, nullptr, log);
+    gl.glDeleteProgram(id);
+    THINLOD_RETURN_IF_ERROR(vertexStatus);
+    THINLOD_RETURN_IF_ERROR(fragmentStatus);
+    return Status(ErrorCode::kInternal, std::string("mesh shader program failed to link: ") + log);
+  }
+  // Uniforms a variant does not declare get location -1, which GL ignores.
+  auto location = [&](const char* name) { return gl.glGetUniformLocation(id, name); };
+  auto& u = program.uniform;
+  u.model = location("uModel");
+  u.viewProjection = location("uViewProjection");
+  u.normalMatrix = location("uNormalMatrix");
+  u.diffuse = location("uDiffuse");
+  u.specular = location("uSpecular");
+  u.shininess = location("uShininess");
+  u.layer = location("uLayer");
+  u.alphaCutoff = location("uAlphaCutoff");
+  u.texture = location("uTexture");
+  u.ambient = location("uAmbient");
+  u.lightVector = location("uLightVector");
+  u.lightColor = location("uLightColor");
+  u.lightAttenuation = location("uLightAttenuation");
+  u.eyePosition = location("uEyePosition");
+  gl.glUseProgram(id);
+  gl.glUniform1i(u.texture, 0);
+  gl.glUseProgram(0);
+  program.id = id;
+  return checkGlErrors(gl, "building a mesh shader variant");
+}
+
 }  // namespace
 
 struct MeshRenderer::Impl {
-  GLuint program = 0;
-  struct {
-    GLint model, viewProjection, normalMatrix, diffuse, specular, shininess, lit, useVertexColors,
-        textured, useVertexLayer, layer, alphaMode, alphaCutoff, texture, ambient, lightCount,
-        lightType, lightVector, lightColor, lightAttenuation, eyePosition;
-  } uniform{};
+  std::unordered_map<VariantKey, Program> programs;  // built on first use
   std::unordered_map<std::uint32_t, MeshRecord> meshes;
   std::unordered_map<std::uint32_t, TextureRecord> textures;
   std::uint32_t nextId = 1;
@@ -87,6 +194,14 @@ struct MeshRenderer::Impl {
   GLint maxTextureLayers = 0;
   std::vector<GpuVertex> vertexScratch;
   std::vector<std::uint8_t> pixelScratch;
+
+  Status ensureProgram(const GlFunctions& gl, VariantKey key) {
+    Program& program = programs[key];
+    if (program.id != 0) return Status();
+    Status status = buildProgram(gl, key, program);
+    if (!status.ok()) programs.erase(key);
+    return status;
+  }
 
   std::uint32_t newId() {
     // Ids are never reused while the renderer lives, so a stale handle is kNotFound.
@@ -106,7 +221,9 @@ MeshRenderer::~MeshRenderer() {
     gl.glDeleteBuffers(1, &entry.second.indexBuffer);
   }
   for (auto& entry : impl_->textures) gl.glDeleteTextures(1, &entry.second.texture);
-  if (impl_->program != 0) gl.glDeleteProgram(impl_->program);
+  for (const auto& [key, program] : impl_->programs) {
+    if (program.id != 0) gl.glDeleteProgram(program.id);
+  }
 }
 
 Result<std::unique_ptr<MeshRenderer>> MeshRenderer::create(OffscreenContext& context) {
@@ -114,55 +231,11 @@ Result<std::unique_ptr<MeshRenderer>> MeshRenderer::create(OffscreenContext& con
   std::unique_ptr<MeshRenderer> renderer(new MeshRenderer(context));
   const GlFunctions& gl = context.gl();
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "before MeshRenderer::create"));
-  GLuint vertexShader = 0;
-  GLuint fragmentShader = 0;
-  Status vertexStatus = compileShader(gl, GL_VERTEX_SHADER, kMeshVertexShader, vertexShader);
-  Status fragmentStatus =
-      compileShader(gl, GL_FRAGMENT_SHADER, kMeshFragmentShader, fragmentShader);
   Impl& impl = *renderer->impl_;
-  impl.program = gl.glCreateProgram();
-  gl.glAttachShader(impl.program, vertexShader);
-  gl.glAttachShader(impl.program, fragmentShader);
-  if (vertexStatus.ok() && fragmentStatus.ok()) gl.glLinkProgram(impl.program);
-  gl.glDeleteShader(vertexShader);  // flagged; freed with the program
-  gl.glDeleteShader(fragmentShader);
-  THINLOD_RETURN_IF_ERROR(vertexStatus);
-  THINLOD_RETURN_IF_ERROR(fragmentStatus);
-  GLint linked = GL_FALSE;
-  gl.glGetProgramiv(impl.program, GL_LINK_STATUS, &linked);
-  if (linked != GL_TRUE) {
-    char log[2048] = {0};
-    gl.glGetProgramInfoLog(impl.program, sizeof(log) - 1, nullptr, log);
-    return Status(ErrorCode::kInternal, std::string("mesh shader program failed to link: ") + log);
-  }
-  auto location = [&](const char* name) { return gl.glGetUniformLocation(impl.program, name); };
-  auto& u = impl.uniform;
-  u.model = location("uModel");
-  u.viewProjection = location("uViewProjection");
-  u.normalMatrix = location("uNormalMatrix");
-  u.diffuse = location("uDiffuse");
-  u.specular = location("uSpecular");
-  u.shininess = location("uShininess");
-  u.lit = location("uLit");
-  u.useVertexColors = location("uUseVertexColors");
-  u.textured = location("uTextured");
-  u.useVertexLayer = location("uUseVertexLayer");
-  u.layer = location("uLayer");
-  u.alphaMode = location("uAlphaMode");
-  u.alphaCutoff = location("uAlphaCutoff");
-  u.texture = location("uTexture");
-  u.ambient = location("uAmbient");
-  u.lightCount = location("uLightCount");
-  u.lightType = location("uLightType");
-  u.lightVector = location("uLightVector");
-  u.lightColor = location("uLightColor");
-  u.lightAttenuation = location("uLightAttenuation");
-  u.eyePosition = location("uEyePosition");
+  // The default variant is built now so a broken GL fails here, not mid-frame.
+  THINLOD_RETURN_IF_ERROR(impl.ensureProgram(gl, variantOf(Material(), false, Lighting())));
   gl.glGetIntegerv(GL_MAX_TEXTURE_SIZE, &impl.maxTextureSize);
   gl.glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &impl.maxTextureLayers);
-  gl.glUseProgram(impl.program);
-  gl.glUniform1i(u.texture, 0);
-  gl.glUseProgram(0);
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "MeshRenderer::create"));
   return renderer;
 }
@@ -482,33 +555,47 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   }
 
   const GlFunctions& gl = context_->gl();
-  const auto& u = impl_->uniform;
+  // Every variant the list needs exists before anything is drawn.
+  for (std::size_t i = 0; i < count; ++i) {
+    const bool hasLayers = impl_->meshes.find(items[i].mesh.id)->second.hasLayers;
+    THINLOD_RETURN_IF_ERROR(
+        impl_->ensureProgram(gl, variantOf(items[i].material, hasLayers, lighting)));
+  }
   THINLOD_RETURN_IF_ERROR(impl_->target->bind());
-  gl.glUseProgram(impl_->program);
   const glm::mat4 viewProjection = camera.projection * camera.view;
-  gl.glUniformMatrix4fv(u.viewProjection, 1, GL_FALSE, glm::value_ptr(viewProjection));
   const glm::vec3 eye = glm::vec3(glm::inverse(camera.view)[3]);
-  gl.glUniform3fv(u.eyePosition, 1, glm::value_ptr(eye));
-  gl.glUniform3fv(u.ambient, 1, glm::value_ptr(lighting.ambient));
-  GLint lightTypes[kMaxLights] = {0};
   float lightVectors[kMaxLights * 3] = {0};
   float lightColors[kMaxLights * 3] = {0};
   float lightAttenuations[kMaxLights] = {0};
   const int lightCount = static_cast<int>(lighting.lights.size());
   for (int i = 0; i < lightCount; ++i) {
     const Light& light = lighting.lights[i];
-    lightTypes[i] = light.type == Light::Type::kDirectional ? 0 : 1;
     for (int c = 0; c < 3; ++c) {
       lightVectors[i * 3 + c] = light.vector[c];
       lightColors[i * 3 + c] = light.color[c];
     }
     lightAttenuations[i] = light.attenuation;
   }
-  gl.glUniform1i(u.lightCount, lightCount);
-  gl.glUniform1iv(u.lightType, kMaxLights, lightTypes);
-  gl.glUniform3fv(u.lightVector, kMaxLights, lightVectors);
-  gl.glUniform3fv(u.lightColor, kMaxLights, lightColors);
-  gl.glUniform1fv(u.lightAttenuation, kMaxLights, lightAttenuations);
+  for (auto& [key, program] : impl_->programs) program.frameUniformsSet = false;
+  // Switches to the item's variant; camera and lights go to each variant once per draw().
+  const Program* current = nullptr;
+  auto useProgram = [&](const Material& m, bool hasLayers) -> const Program& {
+    Program& program = impl_->programs.find(variantOf(m, hasLayers, lighting))->second;
+    if (&program == current) return program;
+    current = &program;
+    gl.glUseProgram(program.id);
+    if (program.frameUniformsSet) return program;
+    program.frameUniformsSet = true;
+    const auto& u = program.uniform;
+    gl.glUniformMatrix4fv(u.viewProjection, 1, GL_FALSE, glm::value_ptr(viewProjection));
+    if (!m.lit) return program;
+    gl.glUniform3fv(u.eyePosition, 1, glm::value_ptr(eye));
+    gl.glUniform3fv(u.ambient, 1, glm::value_ptr(lighting.ambient));
+    gl.glUniform3fv(u.lightVector, kMaxLights, lightVectors);
+    gl.glUniform3fv(u.lightColor, kMaxLights, lightColors);
+    gl.glUniform1fv(u.lightAttenuation, kMaxLights, lightAttenuations);
+    return program;
+  };
 
   gl.glEnable(GL_DEPTH_TEST);
   gl.glDepthFunc(GL_LEQUAL);
@@ -541,29 +628,26 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
       } else {
         gl.glEnable(GL_CULL_FACE);
       }
+      const auto& u = useProgram(m, mesh.hasLayers).uniform;
       gl.glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
-      const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(item.model)));
-      gl.glUniformMatrix3fv(u.normalMatrix, 1, GL_FALSE, glm::value_ptr(normalMatrix));
       gl.glUniform4fv(u.diffuse, 1, glm::value_ptr(m.diffuse));
-      gl.glUniform3fv(u.specular, 1, glm::value_ptr(m.specular));
-      gl.glUniform1f(u.shininess, m.shininess);
-      gl.glUniform1i(u.lit, m.lit ? 1 : 0);
-      gl.glUniform1i(u.useVertexColors, m.useVertexColors ? 1 : 0);
-      gl.glUniform1i(u.alphaMode, m.alphaMode == AlphaMode::kOpaque ? 0
-                                  : m.alphaMode == AlphaMode::kMask ? 1
-                                                                    : 2);
-      gl.glUniform1f(u.alphaCutoff, m.alphaCutoff);
-      const bool textured = m.texture.valid();
-      gl.glUniform1i(u.textured, textured ? 1 : 0);
-      if (textured) {
+      if (m.lit) {
+        const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(item.model)));
+        gl.glUniformMatrix3fv(u.normalMatrix, 1, GL_FALSE, glm::value_ptr(normalMatrix));
+        if (hasSpecular(m)) {
+          gl.glUniform3fv(u.specular, 1, glm::value_ptr(m.specular));
+          gl.glUniform1f(u.shininess, m.shininess);
+        }
+      }
+      if (m.alphaMode == AlphaMode::kMask) gl.glUniform1f(u.alphaCutoff, m.alphaCutoff);
+      if (m.texture.valid()) {
         const GLuint texture = impl_->textures.find(m.texture.id)->second.texture;
         if (texture != boundTexture) {
           gl.glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
           boundTexture = texture;
           ++stats_.textureBinds;
         }
-        gl.glUniform1i(u.useVertexLayer, mesh.hasLayers ? 1 : 0);
-        gl.glUniform1f(u.layer, static_cast<float>(m.textureLayer));
+        if (!mesh.hasLayers) gl.glUniform1f(u.layer, static_cast<float>(m.textureLayer));
       }
       gl.glBindVertexArray(mesh.vertexArray);
       gl.glDrawElements(GL_TRIANGLES, mesh.indexCount, GL_UNSIGNED_INT, nullptr);
@@ -576,6 +660,17 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   gl.glDepthMask(GL_TRUE);
   gl.glUseProgram(0);
   return checkGlErrors(gl, "MeshRenderer::draw");
+}
+
+Status MeshRenderer::prepare(const Material& material, bool meshHasLayers,
+                             const Lighting& lighting) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::prepare");
+  if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "prepare: " + std::to_string(lighting.lights.size()) + " lights, at most " +
+                      std::to_string(kMaxLights));
+  }
+  return impl_->ensureProgram(context_->gl(), variantOf(material, meshHasLayers, lighting));
 }
 
 Status MeshRenderer::finish() {

@@ -331,6 +331,11 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   THINLOD_RETURN_IF_ERROR(impl.rebuildDirtyBatches(report));
   report.timing.commitMs = millisecondsSince(commitStart);
 
+  // Both kinds of batch have their shader before any batch of that kind
+  // exists, so the first mesh to arrive does not pay for a compile.
+  for (const bool lit : {false, true}) {
+    THINLOD_RETURN_IF_ERROR(impl.renderer->prepare(impl.materialFor({0, lit}), true, lighting));
+  }
   const Clock::time_point drawStart = Clock::now();
   impl.items.clear();
   for (const auto& [key, batch] : impl.batches) {

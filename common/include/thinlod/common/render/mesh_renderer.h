@@ -1,6 +1,6 @@
 // MeshRenderer: draws lit/unlit, coloured/textured triangle meshes into a
-// RenderTarget with one GL 3.3 core shader program. GPU-resident resources:
-// upload once, get a handle, draw many handles per frame, delete handles.
+// RenderTarget with GL 3.3 core shaders. GPU-resident resources: upload once,
+// get a handle, draw many handles per frame, delete handles.
 //
 // Contract:
 // - create()/every method needs the renderer's context current on the calling
@@ -18,6 +18,11 @@
 // - Handles are plain ids; a deleted or unknown handle is kNotFound at draw
 //   time. Handle 0 means "none" (e.g. an untextured material). deleteMesh /
 //   deleteTexture do nothing unless the context is current.
+// - Shaders: one program per variant (lit, specular, textured, vertex colours,
+//   per-vertex layers, alpha mode, and the count and types of the lights), so
+//   no pixel pays for a feature it does not use. A variant is compiled the
+//   first time a draw needs it; prepare() compiles it ahead (e.g. before a
+//   frame with a deadline).
 // - Errors: invalid input is kInvalidArgument; GL errors are kInternal, GL
 //   out-of-memory is kResourceExhausted; the message names the GL call.
 #pragma once
@@ -112,6 +117,9 @@ class MeshRenderer {
   Status draw(const std::vector<DrawItem>& items, const Camera& camera, const Lighting& lighting) {
     return draw(items.data(), items.size(), camera, lighting);
   }
+  // Compiles the shader variant that drawing `material` on a mesh with (or
+  // without) per-vertex layers under `lighting` needs; cheap once it exists.
+  Status prepare(const Material& material, bool meshHasLayers, const Lighting& lighting);
   // Waits for the GPU (for timing); readback already synchronises.
   Status finish();
 
