@@ -53,6 +53,7 @@ def summarize_run(run_dir):
     times = [number(r["time_s"]) for r in rows]
     render = [number(r["render_ms"]) for r in rows]
     latency = [number(r["pose_to_frame_ms"]) for r in rows]
+    update_latency = [number(r.get("update_latency_ms")) for r in rows]
     # Blank frames (nothing in view: the reference is uniform) have no meaningful SNR.
     finite_snr = [s for s in snr if math.isfinite(s)]
     summary = {
@@ -66,7 +67,11 @@ def summarize_run(run_dir):
         "polygons_median": statistics.median(polygons) if polygons else None,
         "render_ms_p99": finite_or_none(percentile(render, 0.99)),
         "render_ms_median": finite_or_none(percentile(render, 0.5)),
+        "pose_to_frame_ms_median": finite_or_none(percentile(latency, 0.5)),
         "pose_to_frame_ms_p99": finite_or_none(percentile(latency, 0.99)),
+        "update_latency_ms_median": finite_or_none(percentile(update_latency, 0.5)),
+        "update_latency_ms_p99": finite_or_none(percentile(update_latency, 0.99)),
+        "lockstep": meta.get("lockstep", True),
         "link_bytes_total": sum(x for x in link if math.isfinite(x)),
     }
     budget = meta.get("budget_polygons")
@@ -127,6 +132,25 @@ unset multiplot
 """)
 
 
+def plot_latency(run_dir, name):
+    csv_path = os.path.join(run_dir, "frames.csv")
+    png = os.path.join(run_dir, "latency.png")
+    gnuplot(f"""
+set datafile separator ','
+set terminal pngcairo size 900,400 noenhanced
+set output '{png}'
+set title '{name}: latency per frame'
+set xlabel 'frame'
+set ylabel 'ms'
+set logscale y
+set grid
+set key outside bottom center horizontal
+plot '{csv_path}' using 'frame':'pose_to_frame_ms' with linespoints pt 7 ps 0.4 title 'pose -> frame', \\
+     '' using 'frame':'update_latency_ms' with points pt 6 ps 0.6 title 'pose -> its update visible', \\
+     8 with lines dt 2 title 'paper: 8 ms'
+""")
+
+
 def plot_comparison(out_dir, runs):
     png = os.path.join(out_dir, "snr_comparison.png")
     parts = [f"'{os.path.join(out_dir, r, 'frames.csv')}' using 'frame':'snr_db' with lines title '{r}'"
@@ -177,19 +201,25 @@ def main():
     for r in runs:
         summary, _ = summarize_run(os.path.join(out_dir, r))
         summaries.append(summary)
-        plot_run(os.path.join(out_dir, r), r)
+        # A run without SNR (a latency run, --no-reference) gets only the latency plot.
+        if summary["frames_with_finite_snr"]:
+            plot_run(os.path.join(out_dir, r), r)
+        plot_latency(os.path.join(out_dir, r), r)
         if summary.get("budget_link_bytes_per_s"):
             plot_link(os.path.join(out_dir, r), r, summary["budget_link_bytes_per_s"])
-    plot_comparison(out_dir, runs)
+    plot_comparison(out_dir, [r for r, s in zip(runs, summaries) if s["frames_with_finite_snr"]])
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump({"runs": summaries}, f, indent=2)
     lines = [f"{'run':<20} {'frames':>6} {'SNR med':>8} {'SNR min':>8} {'tris max':>8} "
-             f"{'over budget':>11} {'p99 ms':>7} {'link KB':>8}"]
+             f"{'over budget':>11} {'render':>7} {'pose->frame':>11} {'update':>7} {'link KB':>8}",
+             f"{'':<20} {'':>6} {'dB':>8} {'dB':>8} {'':>8} {'frames':>11} {'p99 ms':>7} "
+             f"{'p99 ms':>11} {'med ms':>7}"]
     for s in summaries:
         over = s.get("frames_over_polygon_budget")
         lines.append(f"{s['name']:<20} {s['frames']:>6} {fmt(s['snr_db_median']):>8} "
                      f"{fmt(s['snr_db_min']):>8} {fmt(s['polygons_max'], 0):>8} "
                      f"{('-' if over is None else str(over)):>11} {fmt(s['render_ms_p99']):>7} "
+                     f"{fmt(s['pose_to_frame_ms_p99']):>11} {fmt(s['update_latency_ms_median']):>7} "
                      f"{s['link_bytes_total'] / 1000:>8.1f}")
         if s.get("budget_link_bytes_per_s"):
             lines.append(f"{'':<20} link: worst 1 s window {s['link_bytes_max_1s_window']:.0f} bytes "

@@ -26,6 +26,7 @@ FrameRecord sampleRecord() {
   r.psnrDb = 30.5;
   r.renderMs = 2.6;
   r.poseToFrameMs = 7.125;
+  r.updateLatencyMs = 31.5;
   r.plan = 3;
   r.drawCalls = 2;
   r.uploadedBytes = 524288;
@@ -39,12 +40,12 @@ std::string tempPath(const std::string& name) {
 TEST(FrameRecord, HeaderHasTheRequiredColumnsInOrder) {
   EXPECT_EQ(frameCsvHeader(),
             "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
-            "pose_to_frame_ms,plan,draw_calls,uploaded_bytes\n");
+            "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes\n");
 }
 
 TEST(FrameRecord, RowFormatsEveryColumn) {
   EXPECT_EQ(formatFrameCsvRow(sampleRecord()),
-            "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,3,2,524288\n");
+            "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,31.5000,3,2,524288\n");
 }
 
 TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
@@ -52,7 +53,7 @@ TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
   r.frame = 1;
   r.snrDb = kInf;
   r.psnrDb = kInf;
-  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,0,0,0\n");
+  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0\n");
   r.snrDb = -kInf;
   EXPECT_NE(formatFrameCsvRow(r).find(",-inf,"), std::string::npos);
 }
@@ -117,11 +118,16 @@ TEST(FrameRecord, SummaryJsonRoundTrips) {
   std::vector<FrameRecord> records(3, sampleRecord());
   records[1].snrDb = kInf;
   records[2].poseToFrameMs = FrameRecord::kMissing;
+  records[0].updateLatencyMs = 12.0;
+  records[1].updateLatencyMs = FrameRecord::kMissing;
   const nlohmann::json json = nlohmann::json::parse(summaryJson(summarizeFrames(records)));
   EXPECT_EQ(json["frames"], 3);
   EXPECT_EQ(json["render_ms"]["median"], 2.6);
   EXPECT_EQ(json["render_ms"]["p99"], 2.6);
   EXPECT_EQ(json["pose_to_frame_ms"]["count"], 2);
+  EXPECT_EQ(json["update_latency_ms"]["count"], 2);
+  EXPECT_EQ(json["update_latency_ms"]["median"], 12.0);
+  EXPECT_EQ(json["update_latency_ms"]["max"], 31.5);
   EXPECT_EQ(json["snr_db"]["median"], 11.25);
   EXPECT_EQ(json["snr_db"]["min"], 11.25);
   EXPECT_EQ(json["snr_db"]["count"], 3);

@@ -201,8 +201,10 @@ TEST_F(ReplayLoopTest, LockstepAppliesEachAnswerInTheFrameOfItsPose) {
     EXPECT_EQ(r.plan, i + 1);
     EXPECT_DOUBLE_EQ(r.targetAccuracy, 10.0 * (i + 1));
     EXPECT_EQ(r.polygons, (i == 0 ? 1 : 2) * kSphereTriangles);
-    // Answer after 3 ms, then 5 ms of rendering.
+    // Answer after 3 ms, then 5 ms of rendering: in lockstep the frame's own
+    // latency includes the wait, and the update shown is this pose's answer.
     EXPECT_DOUBLE_EQ(r.poseToFrameMs, 8.0);
+    EXPECT_DOUBLE_EQ(r.updateLatencyMs, 8.0);
     EXPECT_DOUBLE_EQ(result.extras[i].waitMs, 3.0);
     EXPECT_DOUBLE_EQ(r.renderMs, 5.0);
     EXPECT_DOUBLE_EQ(r.snrDb, 12.0);
@@ -246,7 +248,8 @@ TEST_F(ReplayLoopTest, LockstepTimeoutRendersWhatItHolds) {
     EXPECT_EQ(result.records[i].polygons, kSphereTriangles);
     EXPECT_EQ(result.records[i].plan, 1u);
     EXPECT_DOUBLE_EQ(result.records[i].targetAccuracy, 5.0);
-    EXPECT_TRUE(std::isnan(result.records[i].poseToFrameMs));
+    EXPECT_TRUE(std::isnan(result.records[i].updateLatencyMs));  // nothing new shown
+    EXPECT_DOUBLE_EQ(result.records[i].poseToFrameMs, 45.0);      // the whole wait + render
   }
 }
 
@@ -268,8 +271,10 @@ TEST_F(ReplayLoopTest, LiveModeAppliesALateAnswerWhenItArrivesWithItsTrueLatency
   EXPECT_EQ(result.records[1].polygons, 0u);
   EXPECT_EQ(result.records[2].polygons, kSphereTriangles);
   EXPECT_EQ(result.records[2].plan, 1u);
-  EXPECT_DOUBLE_EQ(result.records[2].poseToFrameMs, 205.0);  // slot 200 + 5 ms render
-  EXPECT_TRUE(std::isnan(result.records[3].poseToFrameMs));  // nothing new in frame 3
+  EXPECT_DOUBLE_EQ(result.records[2].updateLatencyMs, 205.0);  // slot 200 + 5 ms render
+  EXPECT_TRUE(std::isnan(result.records[3].updateLatencyMs));  // nothing new in frame 3
+  // Live frames do not wait: each pose is drawn 5 ms (the render) after it was sampled.
+  for (const FrameRecord& record : result.records) EXPECT_DOUBLE_EQ(record.poseToFrameMs, 5.0);
   EXPECT_EQ(result.records[2].linkBytes, link.bytes);
   EXPECT_EQ(result.records[3].linkBytes, 0u);
 }

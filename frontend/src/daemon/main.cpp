@@ -35,9 +35,9 @@ class DaemonObserver final : public ReplayObserver {
   void onFrame(const FrameRecord& record, const FrameExtras& extras) override {
     spdlog::debug(
         "event=frame frame={} polygons={} link_bytes={} snr_db={:.2f} render_ms={:.2f} "
-        "reference_ms={:.2f} pose_to_frame_ms={:.2f} plan={}",
+        "reference_ms={:.2f} pose_to_frame_ms={:.2f} update_latency_ms={:.2f} plan={}",
         record.frame, record.polygons, record.linkBytes, record.snrDb, record.renderMs,
-        extras.referenceMs, record.poseToFrameMs, record.plan);
+        extras.referenceMs, record.poseToFrameMs, record.updateLatencyMs, record.plan);
     if (record.frame % kProgressEveryFrames == 0) {
       spdlog::info("event=progress frame={} polygons={} snr_db={:.2f} render_ms={:.2f} plan={}",
                    record.frame, record.polygons, record.snrDb, record.renderMs, record.plan);

@@ -72,6 +72,7 @@ class Replay {
         }
       }
       const Pose& pose = trace_.poses[i];
+      const std::int64_t sampledNs = clock_.nowNs();
       const std::int64_t sentNs = sendPose(pose, i);
       absorb(link_.poll(std::chrono::milliseconds(0)));
       if (options_.lockstep && extras_.poseSent) {
@@ -92,6 +93,7 @@ class Replay {
       }
       const std::int64_t frameDoneNs = clock_.nowNs();
       FrameRecord record = recordOf(i, pose, *produced, frameDoneNs);
+      record.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
 
       if (options_.measure) {
         Result<FrameQuality> quality = producer_.measure(i, pose);
@@ -183,7 +185,7 @@ class Replay {
       if (newest != submitted_.end()) {
         targetAccuracy_ = newest->targetAccuracy;
         if (newest->frame < poseSentNs_.size() && poseSentNs_[newest->frame] >= 0) {
-          record.poseToFrameMs = (frameDoneNs - poseSentNs_[newest->frame]) / kNsPerMs;
+          record.updateLatencyMs = (frameDoneNs - poseSentNs_[newest->frame]) / kNsPerMs;
         }
         submitted_.erase(submitted_.begin(), newest + 1);
       }

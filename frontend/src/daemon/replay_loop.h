@@ -16,7 +16,10 @@
 // - Pacing: rate > 0: frame i starts at start + i / rate; rate == 0: at start
 //   + (t_i - t_0) of the trace; rate < 0: unpaced (frames back to back). Late
 //   frames start at once (the schedule is not re-anchored).
-// - pose_to_frame_ms: on a frame where at least one update became visible,
+// - pose_to_frame_ms: every frame: clock time when the frame was read back
+//   minus clock time when its pose was sampled (taken from the trace at its
+//   slot, just before it is sent). In lockstep it includes the wait.
+// - update_latency_ms: on a frame where at least one update became visible,
 //   clock time when the frame was read back minus clock time when the pose
 //   that the newest visible update answered (SceneUpdate.frame) was sent;
 //   NaN on other frames or when that pose was not sent by this process.

@@ -43,7 +43,7 @@ double nearestRank(const std::vector<double>& sorted, double q) {
 
 std::string frameCsvHeader() {
   return "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
-         "pose_to_frame_ms,plan,draw_calls,uploaded_bytes\n";
+         "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes\n";
 }
 
 std::string formatFrameCsvRow(const FrameRecord& r) {
@@ -58,6 +58,7 @@ std::string formatFrameCsvRow(const FrameRecord& r) {
   row += ',' + formatNumber(r.psnrDb, "%.4f");
   row += ',' + formatNumber(r.renderMs, "%.4f");
   row += ',' + formatNumber(r.poseToFrameMs, "%.4f");
+  row += ',' + formatNumber(r.updateLatencyMs, "%.4f");
   row += ',' + std::to_string(r.plan);
   row += ',' + std::to_string(r.drawCalls);
   row += ',' + std::to_string(r.uploadedBytes);
@@ -82,11 +83,12 @@ Percentiles percentiles(std::vector<double> values) {
 ReplaySummary summarizeFrames(const std::vector<FrameRecord>& records) {
   ReplaySummary s;
   s.frames = records.size();
-  std::vector<double> render, latency, snr, psnr;
+  std::vector<double> render, latency, updateLatency, snr, psnr;
   double polygonSum = 0.0;
   for (const FrameRecord& r : records) {
     render.push_back(r.renderMs);
     latency.push_back(r.poseToFrameMs);
+    updateLatency.push_back(r.updateLatencyMs);
     if (!std::isnan(r.snrDb)) snr.push_back(r.snrDb);
     if (!std::isnan(r.psnrDb)) psnr.push_back(r.psnrDb);
     polygonSum += static_cast<double>(r.polygons);
@@ -95,6 +97,7 @@ ReplaySummary summarizeFrames(const std::vector<FrameRecord>& records) {
   }
   s.renderMs = percentiles(render);
   s.poseToFrameMs = percentiles(latency);
+  s.updateLatencyMs = percentiles(updateLatency);
   s.snrFrames = snr.size();
   if (!snr.empty()) {
     std::sort(snr.begin(), snr.end());
@@ -114,6 +117,7 @@ std::string summaryJson(const ReplaySummary& s) {
       {"frames", s.frames},
       {"render_ms", jsonPercentiles(s.renderMs)},
       {"pose_to_frame_ms", jsonPercentiles(s.poseToFrameMs)},
+      {"update_latency_ms", jsonPercentiles(s.updateLatencyMs)},
       {"snr_db",
        {{"count", s.snrFrames},
         {"median", jsonNumber(s.snrMedianDb)},

@@ -6,6 +6,11 @@
 //   milliseconds of wall-clock time; link_bytes = bytes received from the
 //   backbone since the previous frame; target_accuracy = the plan's target
 //   (1/rad, as the backbone defines it); snr_db/psnr_db as frame_metrics.h.
+// - pose_to_frame_ms: the pose was sampled -> the frame drawn for it, with the
+//   newest state held then, was read back (the thin client's own latency, the
+//   paper's 8 ms). update_latency_ms: the pose was sent -> the backbone's
+//   update answering it became visible (the round trip through the backbone,
+//   and the simplifier when it waited for one); only on frames that show one.
 // - Missing values are NaN: written as an empty CSV field and JSON null.
 //   Infinite SNR/PSNR (identical frames) is written "inf" / "-inf" in both.
 // - Percentiles are nearest-rank over the finite values: the p-th of n
@@ -40,13 +45,14 @@ struct FrameRecord {
   double psnrDb = kMissing;
   double renderMs = kMissing;
   double poseToFrameMs = kMissing;
+  double updateLatencyMs = kMissing;
   std::uint64_t plan = 0;  // last applied SceneUpdate plan
   std::size_t drawCalls = 0;
   std::size_t uploadedBytes = 0;  // representation bytes uploaded to the GPU this frame
 };
 
 // "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,
-//  pose_to_frame_ms,plan,draw_calls,uploaded_bytes\n"
+//  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);
@@ -62,6 +68,7 @@ struct ReplaySummary {
   std::size_t frames = 0;
   Percentiles renderMs;
   Percentiles poseToFrameMs;
+  Percentiles updateLatencyMs;
   std::size_t snrFrames = 0;  // frames with a measured SNR (infinite included)
   double snrMedianDb = FrameRecord::kMissing;
   double snrMinDb = FrameRecord::kMissing;
