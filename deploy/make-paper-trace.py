@@ -8,10 +8,12 @@ frame 65 on. Positions and look-at targets are Catmull-Rom splines through the k
 frame interval is chosen so the viewer never moves faster than MAX_SPEED (the observer speed
 bound the backbone plans with), so the prediction is honest.
 
-Usage: deploy/make-paper-trace.py [OUT]
+Usage: deploy/make-paper-trace.py [--frames N] [OUT]
+  OUT defaults to deploy/data/paper-flight.trace; --frames samples the same path more finely
+  (e.g. 1000 frames for latency runs long enough for a stable p99).
 """
+import argparse
 import math
-import sys
 
 FRAMES = 100
 MAX_SPEED = 0.095  # m/s, under the demo's 0.1 m/s bound
@@ -47,22 +49,30 @@ def spline(index, frame):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else "deploy/data/paper-flight.trace"
-    eyes = [spline(1, f) for f in range(FRAMES)]
-    targets = [spline(2, f) for f in range(FRAMES)]
-    step = max(math.dist(eyes[i], eyes[i + 1]) for i in range(FRAMES - 1))
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("out", nargs="?", default="deploy/data/paper-flight.trace")
+    parser.add_argument("--frames", type=int, default=FRAMES, help="poses along the path (>= 2)")
+    args = parser.parse_args()
+    if args.frames < 2:
+        parser.error("--frames must be at least 2")
+    out, frames = args.out, args.frames
+    # Key frames are numbered on the 100-frame path; more frames sample it more finely.
+    scale = (FRAMES - 1) / (frames - 1)
+    eyes = [spline(1, i * scale) for i in range(frames)]
+    targets = [spline(2, i * scale) for i in range(frames)]
+    step = max(math.dist(eyes[i], eyes[i + 1]) for i in range(frames - 1))
     dt = math.ceil(step / MAX_SPEED * 100) / 100  # seconds per frame, rounded up to 10 ms
     with open(out, "w") as f:
         f.write("# thinlod-trace 1\n")
         f.write("# Flight path of the paper's experiment (Pasman & Jansen 2002, section 4.2) through\n")
         f.write("# deploy/data/paper-room.wrl; made by deploy/make-paper-trace.py.\n")
-        f.write(f"# {FRAMES} frames, {dt:.2f} s apart: the viewer never exceeds {MAX_SPEED} m/s.\n")
+        f.write(f"# {frames} frames, {dt:.2f} s apart: the viewer never exceeds {MAX_SPEED} m/s.\n")
         f.write("# time_s  px py pz  lookat tx ty tz  fov_deg\n")
-        for i in range(FRAMES):
+        for i in range(frames):
             e, t = eyes[i], targets[i]
             f.write(f"{i * dt:.2f} {e[0]:.4f} {e[1]:.4f} {e[2]:.4f} lookat "
                     f"{t[0]:.4f} {t[1]:.4f} {t[2]:.4f} {FOV_DEG:g}\n")
-    print(f"wrote {out}: {FRAMES} frames, dt {dt:.2f} s, max step {step:.4f} m")
+    print(f"wrote {out}: {frames} frames, dt {dt:.2f} s, max step {step:.4f} m")
 
 
 if __name__ == "__main__":
