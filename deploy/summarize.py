@@ -104,9 +104,14 @@ def gnuplot(script):
     subprocess.run(["gnuplot"], input=script.encode(), check=True)
 
 
-def plot_run(run_dir, name):
+def plot_run(run_dir, name, rows):
     csv_path = os.path.join(run_dir, "frames.csv")
     png = os.path.join(run_dir, "snr_accuracy_triangles.png")
+    # A constant target (a fixed-accuracy run) would give gnuplot an empty y2 range.
+    targets = [t for t in (number(r["target_accuracy"]) for r in rows) if math.isfinite(t)]
+    y2range = ""
+    if targets and min(targets) == max(targets):
+        y2range = f"set y2range [{0.9 * targets[0]:g}:{1.1 * targets[0] + 1e-9:g}]"
     # In the style of the paper's Figures 12 and 13: SNR with the target accuracy above,
     # triangles at the frontend below.
     gnuplot(f"""
@@ -121,6 +126,7 @@ set ylabel 'SNR (dB)'
 set y2label 'target accuracy (rad^-1)'
 set y2tics
 set ytics nomirror
+{y2range}
 plot '{csv_path}' using 'frame':'snr_db' with linespoints pt 7 ps 0.4 title 'SNR (dB)', \\
      '' using 'frame':'target_accuracy' axes x1y2 with lines dt 2 title 'target accuracy'
 unset y2label
@@ -199,11 +205,11 @@ def main():
         return 1
     summaries = []
     for r in runs:
-        summary, _ = summarize_run(os.path.join(out_dir, r))
+        summary, rows = summarize_run(os.path.join(out_dir, r))
         summaries.append(summary)
         # A run without SNR (a latency run, --no-reference) gets only the latency plot.
         if summary["frames_with_finite_snr"]:
-            plot_run(os.path.join(out_dir, r), r)
+            plot_run(os.path.join(out_dir, r), r, rows)
         plot_latency(os.path.join(out_dir, r), r)
         if summary.get("budget_link_bytes_per_s"):
             plot_link(os.path.join(out_dir, r), r, summary["budget_link_bytes_per_s"])
