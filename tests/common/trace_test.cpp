@@ -102,7 +102,8 @@ TEST(Trace, UnknownVersion) {
                           ErrorCode::kVersionMismatch));
 }
 
-TEST(Trace, NoPoses) { EXPECT_TRUE(failsOnLine(withHeader("# only a comment\n"), 3, "no poses")); }
+// The error names the file's last line (a final newline does not start a line).
+TEST(Trace, NoPoses) { EXPECT_TRUE(failsOnLine(withHeader("# only a comment\n"), 2, "no poses")); }
 
 TEST(Trace, WrongFieldCount) {
   EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 0 60\n1 0 0 0 lookat 1 1 60\n"), 3,
@@ -262,6 +263,72 @@ TEST(Trace, SamplePoseInterpolatesAndClamps) {
   EXPECT_NEAR(glm::degrees(glm::angle(mid.orientation)), 45.0f, 1e-3f);
   EXPECT_TRUE(samplePose(trace, -10.0) == trace.poses.front());
   EXPECT_TRUE(samplePose(trace, 10.0) == trace.poses.back());
+}
+
+
+// ---------------------------------------------------------------- stream parser
+
+TEST(TraceStream, AnySplitOfTheBytesGivesTheSamePosesAsParseTrace) {
+  const std::string text = withHeader(
+      "0 0 0 0 quat 1 0 0 0 60\n# comment\n\n0.5 1 2 3 lookat 1 2 2 45\n1.25 -1 0 0 quat 0 0 1 0 "
+      "90\n2 0 1 0 lookat 0 1 -5 30");  // no final newline
+  const auto whole = parseTrace(text);
+  ASSERT_TRUE(whole.ok()) << whole.status().toString();
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    TraceStreamParser parser;
+    TraceStreamParser::Output out;
+    std::size_t position = 0;
+    while (position < text.size()) {
+      const std::size_t piece = std::uniform_int_distribution<std::size_t>(0, 9)(rng);
+      parser.feed(std::string_view(text).substr(position, piece), out);
+      position += piece;
+    }
+    parser.finish(out);
+    ASSERT_TRUE(out.errors.empty()) << out.errors.front().toString();
+    ASSERT_EQ(out.poses.size(), whole->poses.size());
+    for (std::size_t i = 0; i < out.poses.size(); ++i) EXPECT_EQ(out.poses[i], whole->poses[i]);
+    EXPECT_EQ(parser.lines(), 7u);
+  }
+}
+
+TEST(TraceStream, ABadPoseLineIsReportedAndSkippedAndLaterLinesStillCount) {
+  TraceStreamParser parser;
+  TraceStreamParser::Output out;
+  parser.feed(withHeader("0 0 0 0 quat 1 0 0 0 60\n"
+                         "1 0 0 nan quat 1 0 0 0 60\n"   // line 3: not finite
+                         "0 0 0 0 quat 1 0 0 0 60\n"     // line 4: time does not advance
+                         "2 0 0 0 quat 1 0 0 0 60\n"),
+              out);
+  ASSERT_EQ(out.errors.size(), 2u);
+  EXPECT_NE(out.errors[0].message().find("line 3:"), std::string::npos);
+  EXPECT_NE(out.errors[1].message().find("line 4: time 0 is not after"), std::string::npos);
+  ASSERT_EQ(out.poses.size(), 2u);
+  EXPECT_EQ(out.poses[1].time, 2.0);
+  EXPECT_FALSE(parser.failed());
+}
+
+TEST(TraceStream, ABadHeaderRejectsTheWholeStream) {
+  TraceStreamParser parser;
+  TraceStreamParser::Output out;
+  parser.feed("# thinlod-trace 9\n0 0 0 0 quat 1 0 0 0 60\n", out);
+  ASSERT_EQ(out.errors.size(), 1u);
+  EXPECT_EQ(out.errors[0].code(), ErrorCode::kVersionMismatch);
+  EXPECT_TRUE(parser.failed());
+  EXPECT_TRUE(out.poses.empty());
+}
+
+TEST(TraceStream, AnOverlongLineIsAnErrorAndIsNotBuffered) {
+  TraceStreamParser parser;
+  TraceStreamParser::Output out;
+  parser.feed(withHeader(""), out);
+  const std::string chunk(1000, ' ');
+  for (int i = 0; i < 100; ++i) parser.feed(chunk, out);  // 100 KB without a newline
+  parser.feed("\n3 0 0 0 quat 1 0 0 0 60\n", out);
+  ASSERT_EQ(out.errors.size(), 1u);
+  EXPECT_NE(out.errors[0].message().find("line 2: line longer than"), std::string::npos);
+  ASSERT_EQ(out.poses.size(), 1u);
+  EXPECT_EQ(out.poses[0].time, 3.0);
 }
 
 }  // namespace

@@ -193,43 +193,88 @@ glm::quat lookAtOrientation(const glm::vec3& position, const glm::vec3& target) 
   return glm::quatLookAtRH(direction, up);
 }
 
-Result<Trace> parseTrace(std::string_view text) {
-  Trace trace;
-  std::size_t lineNumber = 0;
+void TraceStreamParser::feed(std::string_view bytes, Output& out) {
   std::size_t position = 0;
-  bool sawHeader = false;
-  while (position <= text.size()) {
-    const std::size_t newline = text.find('\n', position);
-    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
-    const std::string_view rawLine = text.substr(position, end - position);
+  while (position < bytes.size()) {
+    const std::size_t newline = bytes.find('\n', position);
+    const std::size_t end = newline == std::string_view::npos ? bytes.size() : newline;
+    const std::string_view piece = bytes.substr(position, end - position);
     position = end + 1;
-    ++lineNumber;
-    if (!sawHeader) {
-      Result<int> header = parseHeader(rawLine);
-      if (!header.ok()) return header.status();
-      sawHeader = true;
-      continue;
+    if (!overlong_) {
+      if (partial_.size() + piece.size() > kMaxTraceLineBytes) {
+        overlong_ = true;
+        partial_.clear();
+      } else {
+        partial_.append(piece);
+      }
     }
-    std::string_view content = rawLine;
-    const std::size_t hash = content.find('#');
-    if (hash != std::string_view::npos) content = content.substr(0, hash);
-    content = trim(content);
-    if (content.empty()) continue;
-    Result<Pose> pose = parsePoseLine(lineNumber, splitFields(content));
-    if (!pose.ok()) return pose.status();
-    if (!trace.poses.empty() && !(pose->time > trace.poses.back().time)) {
-      char buffer[96];
-      std::snprintf(buffer, sizeof(buffer), "time %.17g is not after the previous pose's %.17g",
-                    pose->time, trace.poses.back().time);
-      return lineError(lineNumber, buffer);
-    }
-    trace.poses.push_back(*pose);
-    if (newline == std::string_view::npos) break;
+    if (newline == std::string_view::npos) return;  // the line continues in the next feed
+    completeLine(out);
   }
-  if (trace.poses.empty()) {
+}
+
+void TraceStreamParser::finish(Output& out) {
+  if (!partial_.empty() || overlong_) completeLine(out);
+}
+
+void TraceStreamParser::completeLine(Output& out) {
+  ++lines_;
+  const bool overlong = overlong_;
+  overlong_ = false;
+  std::string line;
+  line.swap(partial_);
+  if (failed_) return;
+  if (overlong) {
+    out.errors.push_back(lineError(lines_, "line longer than " +
+                                               std::to_string(kMaxTraceLineBytes) + " bytes"));
+    if (!sawHeader_) failed_ = true;
+    return;
+  }
+  if (!sawHeader_) {
+    Result<int> header = parseHeader(line);
+    if (!header.ok()) {
+      out.errors.push_back(header.status());
+      failed_ = true;
+      return;
+    }
+    sawHeader_ = true;
+    return;
+  }
+  std::string_view content = line;
+  const std::size_t hash = content.find('#');
+  if (hash != std::string_view::npos) content = content.substr(0, hash);
+  content = trim(content);
+  if (content.empty()) return;
+  Result<Pose> pose = parsePoseLine(lines_, splitFields(content));
+  if (!pose.ok()) {
+    out.errors.push_back(pose.status());
+    return;
+  }
+  if (lastTime_ && !(pose->time > *lastTime_)) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof(buffer), "time %.17g is not after the previous pose's %.17g",
+                  pose->time, *lastTime_);
+    out.errors.push_back(lineError(lines_, buffer));
+    return;
+  }
+  lastTime_ = pose->time;
+  out.poses.push_back(*pose);
+}
+
+Result<Trace> parseTrace(std::string_view text) {
+  // The stream parser, fed everything at once; the first error wins.
+  TraceStreamParser parser;
+  TraceStreamParser::Output out;
+  parser.feed(text, out);
+  parser.finish(out);
+  if (!out.errors.empty()) return out.errors.front();
+  if (parser.lines() == 0) return lineError(1, "missing header '# thinlod-trace 1'");
+  if (out.poses.empty()) {
     return Status(ErrorCode::kParseError,
-                  "line " + std::to_string(lineNumber) + ": trace has no poses");
+                  "line " + std::to_string(parser.lines()) + ": trace has no poses");
   }
+  Trace trace;
+  trace.poses = std::move(out.poses);
   return trace;
 }
 

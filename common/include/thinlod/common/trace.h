@@ -14,6 +14,11 @@
 // - loadTraceFile()/saveTraceFile() are the thin file wrappers; their
 //   errors are prefixed with the path (kNotFound, kIoError,
 //   kResourceExhausted above kMaxTraceFileBytes, or the parse error).
+// - TraceStreamParser reads the same format arriving in pieces (a live pose
+//   source): each completed line is checked as parseTrace() would; a bad
+//   pose line is reported and skipped and later lines still count; a bad
+//   header (or an over-long first line) rejects the rest of the stream.
+//   Lines over kMaxTraceLineBytes are errors and are not buffered.
 // - samplePose() interpolates (position and fov linearly, orientation by
 //   slerp) and clamps outside the trace's time span.
 // - No globals; everything is thread-safe on distinct objects.
@@ -23,6 +28,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,6 +39,7 @@ namespace thinlod {
 
 inline constexpr int kTraceVersion = 1;
 inline constexpr std::size_t kMaxTraceFileBytes = std::size_t{256} << 20;
+inline constexpr std::size_t kMaxTraceLineBytes = 4096;
 
 struct Pose {
   double time = 0.0;                              // seconds
@@ -59,6 +66,29 @@ glm::mat4 viewMatrix(const Pose& pose);
 glm::quat lookAtOrientation(const glm::vec3& position, const glm::vec3& target);
 
 Result<Trace> parseTrace(std::string_view text);
+
+class TraceStreamParser {
+ public:
+  struct Output {
+    std::vector<Pose> poses;    // in order, times strictly increasing
+    std::vector<Status> errors;  // kParseError / kVersionMismatch, "line N: ..."
+  };
+  // Appends `bytes` and parses every line they complete into `out`.
+  void feed(std::string_view bytes, Output& out);
+  // End of input: parses a last line without a newline.
+  void finish(Output& out);
+  std::size_t lines() const { return lines_; }  // completed lines so far
+  bool failed() const { return failed_; }       // the header was bad: nothing more is read
+
+ private:
+  void completeLine(Output& out);
+  std::string partial_;
+  bool overlong_ = false;
+  bool sawHeader_ = false;
+  bool failed_ = false;
+  std::size_t lines_ = 0;
+  std::optional<double> lastTime_;
+};
 std::string writeTrace(const Trace& trace);
 
 // Precondition: !trace.poses.empty().
