@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -393,6 +394,52 @@ TEST(FrontendProcess, SigtermEndsTheReplayEarlyAndStillWritesTheOutputs) {
   const nlohmann::json json = nlohmann::json::parse(readFile(summary));
   EXPECT_EQ(json["interrupted"], true);
   EXPECT_EQ(json["frames"], rows.size());
+  fs::remove_all(dir);
+}
+
+TEST(FrontendProcess, FollowsALivePoseStreamFromAFifoSkippingABadLine) {
+  const std::string dir = makeTempDir();
+  const std::string fifo = dir + "/poses";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string csv = dir + "/frames.csv";
+  const std::string summary = dir + "/summary.json";
+  // Rate 0: one frame per arriving pose.
+  FrontendProcess process({"--backbone.address", "tcp://127.0.0.1:1", "--pose-stream", fifo,
+                           "--no-reference", "--connect-timeout-ms", "0", "--csv", csv,
+                           "--summary-json", summary, "--width", "160", "--height", "120"},
+                          dir + "/frontend.log");
+  const int writer = ::open(fifo.c_str(), O_WRONLY);  // blocks until the frontend opened it
+  ASSERT_GE(writer, 0);
+  auto send = [&](const std::string& text) {
+    ASSERT_EQ(::write(writer, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+    std::this_thread::sleep_for(150ms);  // each pose its own frame
+  };
+  send("# thinlod-trace 1\n");
+  send("0.0 2 1.5 4.8 lookat 2 0.4 1.6 60\n");
+  send("0.1 2 1.5 4.7 lookat 2 0.4 1.6 60\n");
+  send("0.2 2 1.5 nan lookat 2 0.4 1.6 60\n");  // line 4: rejected, skipped
+  send("0.3 2 1.5 4.6 look");                     // a pose in two writes
+  send("at 2 0.4 1.6 60\n");
+  ::close(writer);  // end of stream: the frontend finishes
+  const int exitCode = process.waitExit([] { std::this_thread::sleep_for(10ms); });
+  const std::string log = readFile(dir + "/frontend.log");
+  ASSERT_EQ(exitCode, 0) << log;
+  EXPECT_NE(log.find("event=pose_rejected action=skipped error=\"ParseError: line 4:"),
+            std::string::npos)
+      << log;
+  std::vector<std::string> header;
+  const auto rows = readCsv(csv, &header);
+  ASSERT_EQ(rows.size(), 3u) << readFile(csv);
+  const double times[] = {0.0, 0.1, 0.3};
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_NEAR(numberOf(rows[i].at("time_s")), times[i], 1e-9);
+    EXPECT_TRUE(std::isfinite(numberOf(rows[i].at("pose_to_frame_ms"))));
+  }
+  const nlohmann::json json = nlohmann::json::parse(readFile(summary));
+  EXPECT_EQ(json["pose_stream"], fifo);
+  EXPECT_EQ(json["pose_stream_received"], 3);
+  EXPECT_EQ(json["pose_stream_lines_rejected"], 1);
+  EXPECT_EQ(json["poses_skipped"], 0);
   fs::remove_all(dir);
 }
 

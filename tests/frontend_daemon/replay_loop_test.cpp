@@ -150,6 +150,41 @@ Trace traceAt(const std::vector<double>& times) {
   return trace;
 }
 
+// A live stream on the fake clock: pose k arrives at arrivalsMs[k].
+class ScriptedStream final : public PoseSource {
+ public:
+  ScriptedStream(FakeClock& clock, std::vector<std::int64_t> arrivalsMs)
+      : clock_(clock), start_(clock.now), arrivalsMs_(std::move(arrivalsMs)) {}
+  void refresh() override {
+    while (delivered_ < arrivalsMs_.size() &&
+           clock_.now - start_ >= arrivalsMs_[delivered_] * kMs) {
+      if (newest_) ++skipped_;
+      Pose pose;
+      pose.time = static_cast<double>(arrivalsMs_[delivered_]) / 1000.0;
+      pose.position = glm::vec3(static_cast<float>(delivered_), 1.0f, 5.0f);
+      newest_ = pose;
+      ++delivered_;
+    }
+  }
+  bool ready() const override { return newest_.has_value(); }
+  Pose take() override {
+    Pose pose = *newest_;
+    newest_.reset();
+    return pose;
+  }
+  bool ended() const override { return !newest_ && delivered_ == arrivalsMs_.size(); }
+  std::optional<std::int64_t> dueOffsetNs() const override { return std::nullopt; }
+  std::size_t skipped() const override { return skipped_; }
+
+ private:
+  FakeClock& clock_;
+  std::int64_t start_;
+  std::vector<std::int64_t> arrivalsMs_;
+  std::size_t delivered_ = 0;
+  std::optional<Pose> newest_;
+  std::size_t skipped_ = 0;
+};
+
 // Update answering pose `frame`: object `id` becomes a sphere with 8*4-ish triangles.
 protocol::SceneUpdate sphereUpdate(std::uint64_t plan, std::uint64_t frame, std::uint64_t id,
                                    double target) {
@@ -411,6 +446,70 @@ TEST_F(ReplayLoopTest, RenderFailureEndsTheReplayWithItsStatus) {
   ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
   EXPECT_EQ(result.status.code(), ErrorCode::kInternal);
   EXPECT_EQ(result.records.size(), 1u);
+}
+
+TEST_F(ReplayLoopTest, LiveStreamAtRateZeroDrawsEachPoseWhenItArrives) {
+  options.rate = 0.0;
+  options.measure = false;
+  options.pollSlice = std::chrono::milliseconds(1);
+  const std::int64_t start = clock.now;
+  ScriptedStream stream(clock, {30, 40, 100});
+  ReplayResult result =
+      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  ASSERT_TRUE(result.status.ok()) << result.status.toString();
+  ASSERT_EQ(result.records.size(), 3u);
+  const std::vector<std::int64_t> expectedStartMs = {30, 40, 100};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(producer.renderStartNs[i] - start, expectedStartMs[i] * kMs) << i;
+    EXPECT_DOUBLE_EQ(result.records[i].poseToFrameMs, 5.0) << i;  // the render only
+    EXPECT_EQ(link.poses[i].sequence, i);
+    EXPECT_EQ(link.poses[i].position.x, static_cast<float>(i));
+  }
+  EXPECT_EQ(result.framesRedrawingAPose, 0u);
+  EXPECT_EQ(result.posesSkipped, 0u);
+}
+
+TEST_F(ReplayLoopTest, LiveStreamAtARateTakesTheNewestPoseOrDrawsTheLastOneAgain) {
+  options.rate = 100.0;  // a frame every 10 ms
+  options.measure = false;
+  options.pollSlice = std::chrono::milliseconds(1);
+  const std::int64_t start = clock.now;
+  // Nothing until 25 ms; then two poses within one frame; then one more at 52 ms.
+  ScriptedStream stream(clock, {25, 27, 52});
+  ReplayResult result =
+      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  ASSERT_TRUE(result.status.ok()) << result.status.toString();
+  // Frame 0 waits for the first pose and starts at 25 ms; frame 1 (slot 10 ms,
+  // late) takes pose 27 at 30 ms; frames 2-5 (35, 40, 45, 50 ms) find nothing
+  // new and draw pose 27 again; frame 6 (60 ms) takes pose 52; at frame 7 the
+  // stream has ended.
+  ASSERT_EQ(result.records.size(), 7u);
+  EXPECT_EQ(producer.renderStartNs[0] - start, 25 * kMs);
+  EXPECT_FALSE(std::isnan(result.records[0].poseToFrameMs));
+  std::size_t fresh = 0;
+  for (const FrameRecord& record : result.records) {
+    if (!std::isnan(record.poseToFrameMs)) ++fresh;
+  }
+  EXPECT_EQ(fresh, 3u);  // every pose drawn once
+  EXPECT_EQ(result.framesRedrawingAPose, result.records.size() - 3);
+  EXPECT_GE(result.framesRedrawingAPose, 1u);
+  EXPECT_EQ(link.poses.size(), 3u);  // poses are sent once, redraws send nothing
+  EXPECT_EQ(result.posesSkipped, 0u);
+  EXPECT_EQ(result.records.back().timeS, 0.052);
+}
+
+TEST_F(ReplayLoopTest, LiveStreamSkipsPosesOvertakenBeforeAFrameTakesThem) {
+  options.rate = 20.0;  // a frame every 50 ms
+  options.measure = false;
+  options.pollSlice = std::chrono::milliseconds(1);
+  ScriptedStream stream(clock, {0, 10, 20, 30, 60});
+  ReplayResult result =
+      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  ASSERT_TRUE(result.status.ok());
+  ASSERT_EQ(result.records.size(), 3u);  // 0 ms: pose 0; 50 ms: pose 30 (10, 20 skipped); 100 ms: 60
+  EXPECT_EQ(result.posesSkipped, 2u);
+  EXPECT_EQ(result.records[1].timeS, 0.030);
+  EXPECT_EQ(result.records[2].timeS, 0.060);
 }
 
 TEST_F(ReplayLoopTest, EmptyTraceIsAnError) {

@@ -33,6 +33,8 @@ class ChannelLink final : public BackboneLink {
   // are kept for the next poll(). True when connected.
   bool waitConnected(std::chrono::milliseconds timeout, std::chrono::milliseconds progressEvery,
                      const std::function<bool()>& stop);
+  // poll() also wakes when `fd` is readable (e.g. a live pose stream).
+  void wakeOn(int fd) { poller_.addFd(fd); }
 
  private:
   explicit ChannelLink(std::unique_ptr<protocol::Channel> channel, int wakeFd);

@@ -18,12 +18,16 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
                     "unless --no-reference");
   runtime.addOption("models-dir", &o->modelsDir, "directory searched for the scene's mesh files");
   runtime.addOption("trace", &o->tracePath, "flight path to replay (docs/trace-format.md)");
+  runtime.addOption("pose-stream", &o->poseStreamPath,
+                    "live poses instead of --trace: trace lines read as they arrive from this "
+                    "file or FIFO ('-' = stdin); each frame takes the newest pose");
   runtime.addOption("width", &o->width, "frame width, pixels");
   runtime.addOption("height", &o->height, "frame height, pixels");
   runtime.addOption("backend", &o->backend, "offscreen GL: auto|egl|osmesa");
   runtime.addOption("rate", &o->rate,
-                    "replay speed, frames per second; 0 = the trace's own timing; negative = "
-                    "unpaced (each frame as soon as the previous one is done)");
+                    "replay speed, frames per second; 0 = the trace's own timing (a pose stream: "
+                    "a frame per arriving pose); negative = unpaced (each frame as soon as the "
+                    "previous one is done)");
   runtime.addOption("lockstep", &o->lockstep,
                     "wait for the backbone's SceneUpdate of each frame before rendering it");
   runtime.addOption("lockstep-timeout-ms", &o->lockstepTimeoutMs,
@@ -37,7 +41,8 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("dump-every", &o->dumpEvery, "dump every Nth frame (with --frames-dir)");
   runtime.addOption("no-reference", &o->noReference,
                     "skip the full-quality reference and SNR (pure latency runs)");
-  runtime.addOption("frames", &o->frames, "stop after N frames; 0 = the whole trace");
+  runtime.addOption("frames", &o->frames,
+                    "stop after N frames; 0 = the whole trace (or until the pose stream ends)");
   runtime.addOption("label", &o->label, "run name written into the summary");
   runtime.addOption("connect-timeout-ms", &o->connectTimeoutMs,
                     "how long to wait for the backbone handshake before replaying anyway, ms");
@@ -52,7 +57,9 @@ Result<render::Backend> parseBackend(const std::string& name) {
 }
 
 Status validateOptions(const DaemonOptions& o) {
-  if (o.tracePath.empty()) return invalid("trace", "a flight path is required");
+  if (o.tracePath.empty() == o.poseStreamPath.empty()) {
+    return invalid("trace", "give exactly one of --trace (a flight path) and --pose-stream");
+  }
   if (o.scenePath.empty() && !o.noReference) {
     return invalid("scene",
                    "a scene file is required for the reference frames (or --no-reference)");

@@ -17,6 +17,7 @@ struct DaemonOptions {
   std::string scenePath;
   std::string modelsDir;
   std::string tracePath;
+  std::string poseStreamPath;  // "-" = stdin
   int width = 640;
   int height = 480;
   std::string backend = "auto";

@@ -1,11 +1,17 @@
-// thinlod-frontend: replays a flight path against the backbone, renders what
-// it holds every frame, measures each frame against the full-quality
-// reference and writes the per-frame CSV and a run summary (docs/frontend.md,
-// "Daemon"). Exits 0 at the end of the trace or on SIGINT/SIGTERM (outputs
-// written either way), 1 on a setup or rendering failure, 2 on bad options.
+// thinlod-frontend: replays a flight path (or follows a live pose stream)
+// against the backbone, renders what it holds every frame, measures each
+// frame against the full-quality reference and writes the per-frame CSV and a
+// run summary (docs/frontend.md, "Daemon"). Exits 0 at the end of the trace or
+// stream or on SIGINT/SIGTERM (outputs written either way), 1 on a setup or
+// rendering failure, 2 on bad options.
+#include <fcntl.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -16,6 +22,7 @@
 #include "daemon_options.h"
 #include "gl_frame_producer.h"
 #include "outputs.h"
+#include "pose_source.h"
 #include "replay_loop.h"
 #include "scene_setup.h"
 #include "thinlod/common/trace.h"
@@ -25,6 +32,23 @@ namespace thinlod::frontend::daemon {
 namespace {
 
 constexpr std::uint64_t kProgressEveryFrames = 10;
+
+// Closes the descriptor it holds.
+class UniqueFd {
+ public:
+  UniqueFd() = default;
+  UniqueFd(const UniqueFd&) = delete;
+  UniqueFd& operator=(const UniqueFd&) = delete;
+  ~UniqueFd() { reset(-1); }
+  void reset(int fd) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = fd;
+  }
+  int get() const { return fd_; }
+
+ private:
+  int fd_ = -1;
+};
 
 // Logs, the CSV and the PNG dumps, frame by frame.
 class DaemonObserver final : public ReplayObserver {
@@ -94,10 +118,38 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     spdlog::error("event=bad_options error=\"{}\"", valid.toString());
     return 2;
   }
-  Result<Trace> trace = loadTraceFile(options.tracePath);
-  if (!trace.ok()) {
-    spdlog::error("event=trace_failed error=\"{}\"", trace.status().toString());
-    return 1;
+  // Poses: a trace loaded whole, or a live stream read as it arrives.
+  Trace trace;
+  std::unique_ptr<PoseSource> source;
+  StreamPoseSource* stream = nullptr;
+  UniqueFd streamFd;
+  if (!options.tracePath.empty()) {
+    Result<Trace> loaded = loadTraceFile(options.tracePath);
+    if (!loaded.ok()) {
+      spdlog::error("event=trace_failed error=\"{}\"", loaded.status().toString());
+      return 1;
+    }
+    trace = std::move(loaded).value();
+    source = std::make_unique<TracePoseSource>(trace);
+  } else {
+    const bool standardInput = options.poseStreamPath == "-";
+    streamFd.reset(standardInput ? ::dup(STDIN_FILENO)
+                                 : ::open(options.poseStreamPath.c_str(), O_RDONLY | O_NONBLOCK));
+    if (streamFd.get() < 0) {
+      spdlog::error("event=pose_stream_failed path={} error=\"{}\"", options.poseStreamPath,
+                    std::strerror(errno));
+      return 1;
+    }
+    struct stat info {};
+    const bool fifo = ::fstat(streamFd.get(), &info) == 0 && S_ISFIFO(info.st_mode);
+    auto live = std::make_unique<StreamPoseSource>(
+        streamFd.get(),
+        [](const Status& error) {
+          spdlog::warn("event=pose_rejected action=skipped error=\"{}\"", error.toString());
+        },
+        /*waitForWriter=*/fifo && !standardInput);
+    stream = live.get();
+    source = std::move(live);
   }
 
   std::optional<LoadedScene> scene;
@@ -176,9 +228,12 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     spdlog::warn("event=backbone_unavailable address={} waited_ms={} action=replay_anyway",
                  options.backboneAddress, options.connectTimeoutMs);
   }
-  spdlog::info("event=ready address={} connected={} trace={} poses={} lockstep={} reference={}",
-               options.backboneAddress, connected, options.tracePath, trace->poses.size(),
-               options.lockstep, !options.noReference);
+  if (stream != nullptr) (*link)->wakeOn(streamFd.get());
+  spdlog::info(
+      "event=ready address={} connected={} trace={} poses={} pose_stream={} lockstep={} "
+      "reference={}",
+      options.backboneAddress, connected, options.tracePath, trace.poses.size(),
+      options.poseStreamPath, options.lockstep, !options.noReference);
 
   ReplayOptions replay;
   replay.lockstep = options.lockstep;
@@ -192,12 +247,17 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
 
   SteadyClock clock;
   DaemonObserver observer(csv.get(), **producer, options);
-  ReplayResult result = runReplay(*trace, replay, clock, **link, **producer, observer, stop);
+  ReplayResult result = runReplay(*source, replay, clock, **link, **producer, observer, stop);
 
   int exitCode = 0;
   RunInfo info;
   info.label = options.label;
   info.tracePath = options.tracePath;
+  info.poseStreamPath = options.poseStreamPath;
+  if (stream != nullptr) {
+    info.streamPosesReceived = stream->received();
+    info.streamLinesRejected = stream->rejectedLines();
+  }
   info.scenePath = options.scenePath;
   info.backend = (*producer)->describe();
   info.width = options.width;

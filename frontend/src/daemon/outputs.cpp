@@ -98,6 +98,11 @@ std::string runSummaryJson(const ReplayResult& result, const RunInfo& info) {
   }
   json["label"] = info.label;
   json["trace"] = info.tracePath;
+  json["pose_stream"] = info.poseStreamPath;
+  json["pose_stream_received"] = info.streamPosesReceived;
+  json["pose_stream_lines_rejected"] = info.streamLinesRejected;
+  json["poses_skipped"] = result.posesSkipped;
+  json["frames_redrawing_a_pose"] = result.framesRedrawingAPose;
   json["scene"] = info.scenePath;
   json["backend"] = info.backend;
   json["width"] = info.width;

@@ -37,7 +37,10 @@ class CsvOutput {
 // What the summary adds to the library's ReplaySummary.
 struct RunInfo {
   std::string label;
-  std::string tracePath;
+  std::string tracePath;       // empty with a pose stream
+  std::string poseStreamPath;  // empty with a trace
+  std::size_t streamPosesReceived = 0;
+  std::size_t streamLinesRejected = 0;
   std::string scenePath;
   std::string backend;  // as created, e.g. "egl, llvmpipe (...)"
   int width = 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <utility>
 
 namespace thinlod::frontend::daemon {
@@ -19,11 +20,6 @@ struct SubmittedUpdate {
   std::uint64_t frame = 0;  // the pose it answered
   double targetAccuracy = 0.0;
 };
-
-std::int64_t scheduleOffsetNs(const Trace& trace, std::size_t frame, double rate) {
-  if (rate > 0.0) return std::llround(static_cast<double>(frame) * kNsPerS / rate);
-  return std::llround((trace.poses[frame].time - trace.poses.front().time) * kNsPerS);
-}
 
 protocol::ViewerPose wirePose(const Pose& pose, std::uint64_t sequence,
                               const ReplayOptions& options) {
@@ -40,40 +36,58 @@ protocol::ViewerPose wirePose(const Pose& pose, std::uint64_t sequence,
 
 class Replay {
  public:
-  Replay(const Trace& trace, const ReplayOptions& options, Clock& clock, BackboneLink& link,
+  Replay(PoseSource& source, const ReplayOptions& options, Clock& clock, BackboneLink& link,
          FrameProducer& producer, ReplayObserver& observer,
          const std::function<bool()>& stopRequested)
-      : trace_(trace),
+      : source_(source),
         options_(options),
         clock_(clock),
         link_(link),
         producer_(producer),
         observer_(observer),
-        stop_(stopRequested),
-        poseSentNs_(trace.poses.size(), -1),
-        answered_(trace.poses.size(), false) {}
+        stop_(stopRequested) {}
 
   ReplayResult run() {
-    std::size_t frames = trace_.poses.size();
-    if (options_.maxFrames > 0) frames = std::min(frames, options_.maxFrames);
     const std::int64_t startNs = clock_.nowNs();
     std::uint64_t bytesBefore = link_.bytesReceived();
-    for (std::size_t i = 0; i < frames; ++i) {
+    std::optional<Pose> last;
+    for (std::size_t i = 0; options_.maxFrames == 0 || i < options_.maxFrames; ++i) {
       if (stop_()) {
         result_.interrupted = true;
         break;
       }
       extras_ = FrameExtras{};
-      if (options_.rate >= 0.0) {
-        waitUntil(startNs + scheduleOffsetNs(trace_, i, options_.rate), [] { return false; });
-        if (stop_()) {
-          result_.interrupted = true;
-          break;
-        }
+      source_.refresh();
+      if (source_.ended()) break;  // every pose drawn: no slot to wait for
+      // The frame's slot: a fixed rate, or the source's own timing at rate 0.
+      if (options_.rate > 0.0) {
+        waitUntil(startNs + std::llround(static_cast<double>(i) * kNsPerS / options_.rate),
+                  [] { return false; });
+      } else if (options_.rate == 0.0) {
+        if (const auto due = source_.dueOffsetNs()) waitUntil(startNs + *due, [] { return false; });
       }
-      const Pose& pose = trace_.poses[i];
+      // Its pose: a new one if the source has it (waiting for the first one,
+      // and for every one at rate 0); at a rate, the last one drawn again.
+      source_.refresh();
+      if ((!last || options_.rate == 0.0) && !source_.ready() && !source_.ended()) {
+        waitUntil(std::numeric_limits<std::int64_t>::max(), [&] {
+          source_.refresh();
+          return source_.ready() || source_.ended();
+        });
+      }
+      if (stop_()) {
+        result_.interrupted = true;
+        break;
+      }
+      const bool fresh = source_.ready();
+      if (!fresh && (source_.ended() || !last || options_.rate == 0.0)) break;
+      const Pose pose = fresh ? source_.take() : *last;
+      last = pose;
+      if (!fresh) ++result_.framesRedrawingAPose;
+      poseSentNs_.push_back(-1);
+      answered_.push_back(false);
       const std::int64_t sampledNs = clock_.nowNs();
-      const std::int64_t sentNs = sendPose(pose, i);
+      const std::int64_t sentNs = fresh ? sendPose(pose, i) : sampledNs;
       absorb(link_.poll(std::chrono::milliseconds(0)));
       if (options_.lockstep && extras_.poseSent) {
         waitUntil(sentNs + options_.lockstepTimeout.count() * 1'000'000LL,
@@ -93,7 +107,7 @@ class Replay {
       }
       const std::int64_t frameDoneNs = clock_.nowNs();
       FrameRecord record = recordOf(i, pose, *produced, frameDoneNs);
-      record.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
+      if (fresh) record.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
 
       if (options_.measure) {
         Result<FrameQuality> quality = producer_.measure(i, pose);
@@ -113,6 +127,7 @@ class Replay {
       result_.extras.push_back(extras_);
       observer_.onFrame(record, extras_);
     }
+    result_.posesSkipped = source_.skipped();
     return std::move(result_);
   }
 
@@ -210,7 +225,7 @@ class Replay {
     if (!sent.ok()) observer_.onSendFailed("FrameStats", record.frame, sent);
   }
 
-  const Trace& trace_;
+  PoseSource& source_;
   const ReplayOptions& options_;
   Clock& clock_;
   BackboneLink& link_;
@@ -233,6 +248,12 @@ std::int64_t SteadyClock::nowNs() {
       .count();
 }
 
+ReplayResult runReplay(PoseSource& source, const ReplayOptions& options, Clock& clock,
+                       BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
+                       const std::function<bool()>& stopRequested) {
+  return Replay(source, options, clock, link, producer, observer, stopRequested).run();
+}
+
 ReplayResult runReplay(const Trace& trace, const ReplayOptions& options, Clock& clock,
                        BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
                        const std::function<bool()>& stopRequested) {
@@ -241,7 +262,8 @@ ReplayResult runReplay(const Trace& trace, const ReplayOptions& options, Clock& 
     result.status = Status(ErrorCode::kInvalidArgument, "trace has no poses");
     return result;
   }
-  return Replay(trace, options, clock, link, producer, observer, stopRequested).run();
+  TracePoseSource source(trace);
+  return runReplay(source, options, clock, link, producer, observer, stopRequested);
 }
 
 }  // namespace thinlod::frontend::daemon

@@ -2,9 +2,11 @@
 // wall clock so it can be tested with fakes (docs/frontend.md, "Daemon").
 //
 // Contract:
-// - runReplay() drives one frame per trace pose i (up to maxFrames): wait for
-//   the frame's slot (pacing), send ViewerPose{sequence = i, timestampNs =
-//   pose time in ns}, take what the link has (0 ms) or, in lockstep, wait up
+// - runReplay() drives frames i = 0, 1, ... (up to maxFrames) from a
+//   PoseSource (pose_source.h; a Trace is wrapped in a TracePoseSource): wait
+//   for the frame's slot (pacing), take the frame's pose, send
+//   ViewerPose{sequence = i, timestampNs = pose time in ns}, take what the
+//   link has (0 ms) or, in lockstep, wait up
 //   to lockstepTimeout for the SceneUpdate with frame == i; convert and submit
 //   every update in arrival order (a bad update is rejected whole); render
 //   the frame; then measure it against the reference; emit a FrameRecord and
@@ -14,11 +16,19 @@
 //   Nothing blocks on the network except the bounded lockstep wait, which
 //   ends early when the link is not connected.
 // - Pacing: rate > 0: frame i starts at start + i / rate; rate == 0: at start
-//   + (t_i - t_0) of the trace; rate < 0: unpaced (frames back to back). Late
-//   frames start at once (the schedule is not re-anchored).
-// - pose_to_frame_ms: every frame: clock time when the frame was read back
-//   minus clock time when its pose was sampled (taken from the trace at its
-//   slot, just before it is sent). In lockstep it includes the wait.
+//   + (t_i - t_0) of a trace, or when the next pose of a stream arrives;
+//   rate < 0: unpaced (frames back to back). Late frames start at once (the
+//   schedule is not re-anchored).
+// - Poses: each frame takes a new pose when the source has one; before the
+//   first pose, and at rate 0 before every one, the loop waits for it (input
+//   keeps flowing). At a rate (or unpaced) with nothing new from a stream,
+//   the frame draws the last pose again: no pose is sent, no lockstep wait,
+//   pose_to_frame_ms is NaN, and framesRedrawingAPose counts it. The replay
+//   ends when the source has ended and its last pose was drawn.
+// - pose_to_frame_ms: every frame with a new pose: clock time when the frame
+//   was read back minus clock time when its pose was sampled (taken from the
+//   source at its slot, just before it is sent). In lockstep it includes the
+//   wait.
 // - update_latency_ms: on a frame where at least one update became visible,
 //   clock time when the frame was read back minus clock time when the pose
 //   that the newest visible update answered (SceneUpdate.frame) was sent;
@@ -40,6 +50,7 @@
 #include "thinlod/common/trace.h"
 #include "thinlod/frontend/frame_record.h"
 #include "thinlod/frontend/frontend_scene.h"
+#include "pose_source.h"
 #include "thinlod/protocol/messages.h"
 #include "wire_conversion.h"
 
@@ -136,10 +147,16 @@ struct ReplayResult {
   std::size_t updatesRejected = 0;
   std::size_t lockstepTimeouts = 0;
   std::size_t posesNotSent = 0;  // link down at the time
+  std::size_t posesSkipped = 0;  // a stream's poses overtaken by newer ones before a frame
+  std::size_t framesRedrawingAPose = 0;
   bool interrupted = false;      // stopRequested() ended it early
   Status status;                 // why it ended early with an error
 };
 
+ReplayResult runReplay(PoseSource& source, const ReplayOptions& options, Clock& clock,
+                       BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
+                       const std::function<bool()>& stopRequested);
+// A trace without poses is kInvalidArgument in ReplayResult::status.
 ReplayResult runReplay(const Trace& trace, const ReplayOptions& options, Clock& clock,
                        BackboneLink& link, FrameProducer& producer, ReplayObserver& observer,
                        const std::function<bool()>& stopRequested);
