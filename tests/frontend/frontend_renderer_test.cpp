@@ -87,6 +87,25 @@ TEST_P(FrontendRendererTest, EmptySceneIsTheClearColour) {
   EXPECT_EQ(report.drawCalls, 0u);
 }
 
+TEST_P(FrontendRendererTest, WarmUpLeavesNothingBehindAndRejectsBadLighting) {
+  makeRenderer();
+  render::Lighting tooMany;
+  tooMany.lights.resize(render::kMaxLights + 1);
+  EXPECT_EQ(renderer_->warmUp(tooMany).code(), ErrorCode::kInvalidArgument);
+  ASSERT_TRUE(renderer_->warmUp(flatLighting()).ok());
+  // The warm-up triangle is gone from the next frame, and nothing is held.
+  RgbaImage image;
+  const FrameReport report = frame(image);
+  EXPECT_TRUE(pixelNear(image, kSize / 2, kSize / 2, kBackground, kBackground, kBackground, 0));
+  EXPECT_EQ(report.drawCalls, 0u);
+  EXPECT_EQ(report.triangles, 0u);
+  EXPECT_EQ(renderer_->scene().objects().size(), 0u);
+  // Without a current context it refuses.
+  context_->releaseCurrent();
+  EXPECT_EQ(renderer_->warmUp(flatLighting()).code(), ErrorCode::kUnavailable);
+  ASSERT_TRUE(context_->makeCurrent().ok());
+}
+
 TEST_P(FrontendRendererTest, ColouredMeshIsDrawnLit) {
   makeRenderer();
   submit(1, {addOp(1, RepresentationKind::kMesh, quadMesh(-1, -1, 0, 1, 0), nullptr,

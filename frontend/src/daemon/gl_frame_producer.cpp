@@ -35,6 +35,8 @@ Result<std::unique_ptr<GlFrameProducer>> GlFrameProducer::create(
       FrontendRenderer::create(*producer->context_, rendererOptions);
   if (!renderer.ok()) return renderer.status();
   producer->renderer_ = std::move(renderer).value();
+  // Shader compiles now, before the first frame is timed.
+  THINLOD_RETURN_IF_ERROR(producer->renderer_->warmUp(lighting));
 
   ReferenceRendererOptions referenceOptions;
   referenceOptions.width = options.width;

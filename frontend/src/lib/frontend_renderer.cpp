@@ -296,6 +296,37 @@ Result<std::unique_ptr<FrontendRenderer>> FrontendRenderer::create(
   return std::unique_ptr<FrontendRenderer>(new FrontendRenderer(std::move(impl)));
 }
 
+Status FrontendRenderer::warmUp(const render::Lighting& lighting) {
+  Impl& impl = *impl_;
+  if (!impl.context->isCurrent()) {
+    return Status(ErrorCode::kUnavailable,
+                  "FrontendRenderer::warmUp: the GL context is not current on this thread");
+  }
+  // One triangle near the centre of an identity camera's view, white layer,
+  // drawn as both kinds of batch (merged meshes carry per-vertex layers).
+  IndexedMesh triangle;
+  triangle.positions = {{-0.1f, -0.1f, 0.0f}, {0.1f, -0.1f, 0.0f}, {0.0f, 0.1f, 0.0f}};
+  triangle.normals.assign(3, glm::vec3(0.0f, 0.0f, 1.0f));
+  triangle.uvs.assign(3, glm::vec2(0.5f));
+  triangle.colors.assign(3, {255, 255, 255, 255});
+  triangle.indices = {0, 1, 2};
+  auto mesh = impl.renderer->uploadMesh(triangle, std::vector<std::uint16_t>(3, kWhiteLayer));
+  if (!mesh.ok()) return mesh.status();
+  std::vector<render::DrawItem> items;
+  for (const bool lit : {false, true}) {
+    render::DrawItem item;
+    item.mesh = *mesh;
+    item.material = impl.materialFor({0, lit});
+    items.push_back(item);
+  }
+  render::Camera identity;
+  Status status = impl.renderer->beginFrame(*impl.target, impl.options.clearColor);
+  if (status.ok()) status = impl.renderer->draw(items, identity, lighting);
+  if (status.ok()) status = impl.renderer->finish();
+  impl.renderer->deleteMesh(*mesh);
+  return status;
+}
+
 Status FrontendRenderer::submit(SceneBatch batch) { return impl_->scene.enqueue(std::move(batch)); }
 
 Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,

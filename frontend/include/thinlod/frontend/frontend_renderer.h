@@ -23,6 +23,11 @@
 //   whose upload fails is dropped whole (FrameReport::droppedBatches,
 //   lastUploadError) and rendering continues; GL failures while drawing are
 //   kInternal / kResourceExhausted.
+// - warmUp(lighting) draws one small triangle with each kind of batch under
+//   `lighting` (the frame is cleared by the next renderFrame), so shader
+//   compilation, including the driver's first-draw compile, happens before
+//   the first frame that must meet a deadline. Optional; renderFrame works
+//   without it and prepares the programs itself.
 #pragma once
 
 #include <cstddef>
@@ -88,6 +93,7 @@ class FrontendRenderer {
   FrontendRenderer(const FrontendRenderer&) = delete;
   FrontendRenderer& operator=(const FrontendRenderer&) = delete;
 
+  Status warmUp(const render::Lighting& lighting);
   Status submit(SceneBatch batch);
   // `frame` is resized to width x height (no reallocation when already so).
   Result<FrameReport> renderFrame(const render::Camera& camera, const render::Lighting& lighting,
