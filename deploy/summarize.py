@@ -104,6 +104,15 @@ def gnuplot(script):
     subprocess.run(["gnuplot"], input=script.encode(), check=True)
 
 
+def plot_png(png, width, height, commands):
+    """Runs gnuplot `commands` on a CSV with a header, drawing into `png`."""
+    gnuplot(f"""
+set datafile separator ','
+set terminal pngcairo size {width},{height} noenhanced
+set output '{png}'
+""" + commands)
+
+
 def plot_run(run_dir, name, rows):
     csv_path = os.path.join(run_dir, "frames.csv")
     png = os.path.join(run_dir, "snr_accuracy_triangles.png")
@@ -114,10 +123,7 @@ def plot_run(run_dir, name, rows):
         y2range = f"set y2range [{0.9 * targets[0]:g}:{1.1 * targets[0] + 1e-9:g}]"
     # In the style of the paper's Figures 12 and 13: SNR with the target accuracy above,
     # triangles at the frontend below.
-    gnuplot(f"""
-set datafile separator ','
-set terminal pngcairo size 900,650 noenhanced
-set output '{png}'
+    plot_png(png, 900, 650, f"""
 set multiplot layout 2,1 title '{name}'
 set key outside bottom center horizontal
 set grid
@@ -141,10 +147,7 @@ unset multiplot
 def plot_latency(run_dir, name):
     csv_path = os.path.join(run_dir, "frames.csv")
     png = os.path.join(run_dir, "latency.png")
-    gnuplot(f"""
-set datafile separator ','
-set terminal pngcairo size 900,400 noenhanced
-set output '{png}'
+    plot_png(png, 900, 400, f"""
 set title '{name}: latency per frame'
 set xlabel 'frame'
 set ylabel 'ms'
@@ -161,10 +164,7 @@ def plot_comparison(out_dir, runs):
     png = os.path.join(out_dir, "snr_comparison.png")
     parts = [f"'{os.path.join(out_dir, r, 'frames.csv')}' using 'frame':'snr_db' with lines title '{r}'"
              for r in runs]
-    gnuplot(f"""
-set datafile separator ','
-set terminal pngcairo size 900,500 noenhanced
-set output '{png}'
+    plot_png(png, 900, 500, f"""
 set title 'SNR per frame, all runs'
 set xlabel 'frame'
 set ylabel 'SNR (dB)'
@@ -177,10 +177,7 @@ plot {', '.join(parts)}
 def plot_link(run_dir, name, rate):
     csv_path = os.path.join(run_dir, "frames.csv")
     png = os.path.join(run_dir, "link_load.png")
-    gnuplot(f"""
-set datafile separator ','
-set terminal pngcairo size 900,400 noenhanced
-set output '{png}'
+    plot_png(png, 900, 400, f"""
 set title '{name}: link bytes per frame (budget {rate:.0f} bytes/s)'
 set xlabel 'time (s)'
 set ylabel 'bytes'
