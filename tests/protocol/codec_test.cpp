@@ -4,10 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ostream>
 #include <limits>
 
 #include "seed_messages.h"
 #include "thinlod_wire_generated.h"
+
+namespace thinlod::protocol::seeds {
+// A parameter prints as its name: gtest (and so ctest's test list) would
+// otherwise show the struct's raw bytes.
+void PrintTo(const NamedMessage& seed, std::ostream* os) { *os << seed.name; }
+}  // namespace thinlod::protocol::seeds
 
 namespace thinlod::protocol {
 namespace {
