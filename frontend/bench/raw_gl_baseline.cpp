@@ -62,14 +62,14 @@ Result<GLuint> compile(GLenum type, const char* source) {
 
 Result<std::unique_ptr<RawGlBaseline>> RawGlBaseline::create(
     int width, int height, const IndexedMesh& mesh, const std::vector<std::uint16_t>& vertexLayers,
-    const std::vector<const render::RgbaImage*>& layerImages) {
+    const std::vector<const RgbaImage*>& layerImages) {
   if (width <= 0 || height <= 0 || mesh.uvs.size() != mesh.positions.size() ||
       mesh.colors.size() != mesh.positions.size() || vertexLayers.size() != mesh.positions.size() ||
       layerImages.empty()) {
     return Status(ErrorCode::kInvalidArgument, "raw GL baseline: inconsistent merged mesh");
   }
   const int layerWidth = layerImages[0]->width, layerHeight = layerImages[0]->height;
-  for (const render::RgbaImage* image : layerImages) {
+  for (const RgbaImage* image : layerImages) {
     if (image->width != layerWidth || image->height != layerHeight) {
       return Status(ErrorCode::kInvalidArgument, "raw GL baseline: layer sizes differ");
     }

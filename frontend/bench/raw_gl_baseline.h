@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::bench {
@@ -32,7 +32,7 @@ class RawGlBaseline {
   static Result<std::unique_ptr<RawGlBaseline>> create(
       int width, int height, const IndexedMesh& mergedMesh,
       const std::vector<std::uint16_t>& vertexLayers,
-      const std::vector<const render::RgbaImage*>& layerImages);
+      const std::vector<const RgbaImage*>& layerImages);
   ~RawGlBaseline();
   RawGlBaseline(const RawGlBaseline&) = delete;
   RawGlBaseline& operator=(const RawGlBaseline&) = delete;

@@ -34,7 +34,7 @@ Bytes meshFrame() {
 }
 
 Bytes textureFrame(TextureCodec codec) {
-  TextureRGBA8 t{24, 16, Bytes(24 * 16 * 4)};
+  RgbaImage t(24, 16);
   for (std::size_t i = 0; i < t.pixels.size(); ++i) {
     t.pixels[i] = static_cast<std::uint8_t>(i % 4 == 3 ? 255 : (i * 7) % 251);
   }
@@ -61,9 +61,10 @@ bool decodeChecked(const Bytes& frame, bool isMesh) {
     }
     return mesh.ok();
   }
-  Result<TextureRGBA8> texture = decodeTexture(frame.data(), frame.size());
+  Result<RgbaImage> texture = decodeTexture(frame.data(), frame.size());
   if (texture.ok()) {
-    EXPECT_EQ(texture->pixels.size(), std::size_t{texture->width} * texture->height * 4);
+    EXPECT_FALSE(texture->empty());
+    EXPECT_TRUE(texture->consistent());
   }
   return texture.ok();
 }
@@ -140,7 +141,7 @@ TEST(DecoderSafety, TruncatedPngPayloadIsRejectedBeforeTheImageLibrary) {
   Bytes frame = textureFrame(TextureCodec::kPng);
   frame.resize(frame.size() - 5);  // cuts into the IEND chunk
   resealFrame(frame);
-  Result<TextureRGBA8> decoded = decodeTexture(frame.data(), frame.size());
+  Result<RgbaImage> decoded = decodeTexture(frame.data(), frame.size());
   EXPECT_EQ(decoded.status().code(), ErrorCode::kParseError);
   EXPECT_NE(decoded.status().message().find("truncated"), std::string::npos)
       << decoded.status().message();
@@ -179,6 +180,17 @@ TEST(DecoderSafety, HeaderCountsMustMatchTheDecodedMesh) {
   Bytes frame = meshFrame();
   frame[12] ^= 1;  // triangle count: still within limits, now wrong
   EXPECT_EQ(decodeMesh(frame.data(), frame.size()).status().code(), ErrorCode::kParseError);
+}
+
+TEST(DecoderSafety, TextureSidesBeyondIntAreRejectedWhateverTheLimit) {
+  Bytes frame = textureFrame(TextureCodec::kZstd);
+  for (int i = 8; i < 16; ++i) frame[i] = 0xff;  // width and height 2^32 - 1
+  DecodeLimits limits;
+  limits.maxTextureDimension = 0xffffffffu;  // admits any u32 side
+  Result<RgbaImage> decoded = decodeTexture(frame.data(), frame.size(), limits);
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(decoded.status().message().find("outside [1, 2147483647]"), std::string::npos)
+      << decoded.status().message();
 }
 
 TEST(DecoderSafety, NullInputIsAnError) {

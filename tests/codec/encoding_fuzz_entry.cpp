@@ -15,9 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limits.maxTextureDimension = 1024;
   thinlod::Result<thinlod::IndexedMesh> mesh = decodeMesh(data, size, limits);
   if (mesh.ok() && !mesh->validate("fuzz").ok()) __builtin_trap();
-  thinlod::Result<TextureRGBA8> texture = decodeTexture(data, size, limits);
-  if (texture.ok() && texture->pixels.size() != std::size_t{texture->width} * texture->height * 4) {
-    __builtin_trap();
-  }
+  thinlod::Result<thinlod::RgbaImage> texture = decodeTexture(data, size, limits);
+  if (texture.ok() && (texture->empty() || !texture->consistent())) __builtin_trap();
   return 0;
 }

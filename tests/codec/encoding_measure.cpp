@@ -32,14 +32,14 @@ double medianMillis(const std::function<void()>& work) {
   return times[times.size() / 2];
 }
 
-TextureRGBA8 impostorLike(std::uint32_t size) {
+RgbaImage impostorLike(int size) {
   // A shaded blob covering ~30% of the image on transparent black.
-  TextureRGBA8 t{size, size, std::vector<std::uint8_t>(std::size_t{size} * size * 4, 0)};
-  for (std::uint32_t y = 0; y < size; ++y) {
-    for (std::uint32_t x = 0; x < size; ++x) {
+  RgbaImage t(size, size);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
       const double u = (x + 0.5) / size - 0.5, v = (y + 0.5) / size - 0.55;
       if (u * u / 0.09 + v * v / 0.12 >= 1.0) continue;
-      std::uint8_t* p = &t.pixels[4 * (std::size_t{y} * size + x)];
+      std::uint8_t* p = t.at(x, y);
       const double shade = 0.35 + 0.6 * std::max(0.0, 0.6 - u + 0.4 * v);
       p[0] = static_cast<std::uint8_t>(std::min(255.0, 230 * shade + ((x * 7 + y * 13) % 5)));
       p[1] = static_cast<std::uint8_t>(std::min(255.0, 190 * shade));
@@ -81,16 +81,16 @@ int main(int argc, char** argv) {
     }
   }
   // Transparent background (alpha 0 outside the object), as rendered.
-  const TextureRGBA8 transparent = impostorLike(256);
+  const RgbaImage transparent = impostorLike(256);
   // The same on an opaque grey background, so JPEG applies.
-  TextureRGBA8 grey = transparent;
+  RgbaImage grey = transparent;
   for (std::size_t i = 0; i < grey.pixels.size(); i += 4) {
     if (grey.pixels[i + 3] == 0) grey.pixels[i] = grey.pixels[i + 1] = grey.pixels[i + 2] = 96;
     grey.pixels[i + 3] = 255;
   }
   struct Case {
     const char* name;
-    const TextureRGBA8* texture;
+    const RgbaImage* texture;
     TextureCodec codec;
     int level;  // zstd level / PNG zlib level / JPEG quality
   };

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "thinlod/common/codec/encoding.h"
 
@@ -9,13 +10,13 @@ namespace thinlod::codec {
 namespace {
 
 // A smooth, impostor-like image: a shaded disc on transparent black.
-TextureRGBA8 impostorLike(std::uint32_t size, bool opaque) {
-  TextureRGBA8 t{size, size, std::vector<std::uint8_t>(std::size_t{size} * size * 4)};
-  for (std::uint32_t y = 0; y < size; ++y) {
-    for (std::uint32_t x = 0; x < size; ++x) {
+RgbaImage impostorLike(int size, bool opaque) {
+  RgbaImage t(size, size);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
       const double u = (x + 0.5) / size - 0.5, v = (y + 0.5) / size - 0.5;
       const bool inside = u * u + v * v < 0.16;
-      std::uint8_t* p = &t.pixels[4 * (std::size_t{y} * size + x)];
+      std::uint8_t* p = t.at(x, y);
       const double shade = inside ? 0.5 + 0.5 * std::cos(6 * u) * std::cos(5 * v) : 0.1;
       p[0] = static_cast<std::uint8_t>(255 * shade);
       p[1] = static_cast<std::uint8_t>(200 * shade);
@@ -26,14 +27,14 @@ TextureRGBA8 impostorLike(std::uint32_t size, bool opaque) {
   return t;
 }
 
-TextureRGBA8 noise(std::uint32_t w, std::uint32_t h, std::uint32_t seed) {
+RgbaImage noise(int w, int h, std::uint32_t seed) {
   std::mt19937 rng(seed);
-  TextureRGBA8 t{w, h, std::vector<std::uint8_t>(std::size_t{w} * h * 4)};
+  RgbaImage t(w, h);
   for (std::uint8_t& b : t.pixels) b = static_cast<std::uint8_t>(rng());
   return t;
 }
 
-double psnr(const TextureRGBA8& a, const TextureRGBA8& b) {
+double psnr(const RgbaImage& a, const RgbaImage& b) {
   double sum = 0.0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
     const double d = double(a.pixels[i]) - b.pixels[i];
@@ -43,18 +44,18 @@ double psnr(const TextureRGBA8& a, const TextureRGBA8& b) {
   return mse > 0 ? 10 * std::log10(255.0 * 255.0 / mse) : INFINITY;
 }
 
-TextureRGBA8 roundTrip(const TextureRGBA8& t, TextureCodec codec) {
+RgbaImage roundTrip(const RgbaImage& t, TextureCodec codec) {
   Result<std::vector<std::uint8_t>> frame = encodeTextureWith(t, codec);
   EXPECT_TRUE(frame.ok()) << frame.status().toString();
   if (!frame.ok()) return {};
-  Result<TextureRGBA8> decoded = decodeTexture(frame->data(), frame->size());
+  Result<RgbaImage> decoded = decodeTexture(frame->data(), frame->size());
   EXPECT_TRUE(decoded.ok()) << decoded.status().toString();
-  return decoded.ok() ? *decoded : TextureRGBA8{};
+  return decoded.ok() ? *decoded : RgbaImage{};
 }
 
 TEST(TextureEncoding, ZstdRoundTripIsExact) {
-  const TextureRGBA8 t = noise(37, 21, 3);  // odd sizes, every alpha value
-  const TextureRGBA8 back = roundTrip(t, TextureCodec::kZstd);
+  const RgbaImage t = noise(37, 21, 3);  // odd sizes, every alpha value
+  const RgbaImage back = roundTrip(t, TextureCodec::kZstd);
   EXPECT_EQ(back.width, t.width);
   EXPECT_EQ(back.height, t.height);
   EXPECT_EQ(back.pixels, t.pixels);
@@ -63,15 +64,15 @@ TEST(TextureEncoding, ZstdRoundTripIsExact) {
 TEST(TextureEncoding, PngRoundTripIsExactIncludingAlpha) {
   // Random alpha with colour under transparent pixels: premultiplication
   // anywhere in the pipeline would change these bytes.
-  const TextureRGBA8 t = noise(37, 21, 4);
-  const TextureRGBA8 back = roundTrip(t, TextureCodec::kPng);
+  const RgbaImage t = noise(37, 21, 4);
+  const RgbaImage back = roundTrip(t, TextureCodec::kPng);
   EXPECT_EQ(back.width, t.width);
   EXPECT_EQ(back.pixels, t.pixels);
 }
 
 TEST(TextureEncoding, JpegRoundTripIsWithinTolerance) {
-  const TextureRGBA8 t = impostorLike(256, true);
-  const TextureRGBA8 back = roundTrip(t, TextureCodec::kJpeg);
+  const RgbaImage t = impostorLike(256, true);
+  const RgbaImage back = roundTrip(t, TextureCodec::kJpeg);
   ASSERT_EQ(back.pixels.size(), t.pixels.size());
   EXPECT_GT(psnr(t, back), 35.0);
   for (std::size_t i = 3; i < back.pixels.size(); i += 4) ASSERT_EQ(back.pixels[i], 255);
@@ -94,13 +95,13 @@ TEST(TextureEncoding, FastestPolicyUsesZstd) {
 TEST(TextureEncoding, SmallestLosslessPicksTheSmallerLosslessCodec) {
   TextureEncodeOptions options;
   options.policy = TexturePolicy::kSmallestLossless;
-  const TextureRGBA8 t = impostorLike(128, false);
+  const RgbaImage t = impostorLike(128, false);
   Result<EncodedTexture> e = encodeTexture(t, options);
   ASSERT_TRUE(e.ok()) << e.status().toString();
   const std::size_t png = encodeTextureWith(t, TextureCodec::kPng)->size();
   const std::size_t zstd = encodeTextureWith(t, TextureCodec::kZstd)->size();
   EXPECT_EQ(e->bytes.size(), std::min(png, zstd));
-  Result<TextureRGBA8> back = decodeTexture(e->bytes.data(), e->bytes.size());
+  Result<RgbaImage> back = decodeTexture(e->bytes.data(), e->bytes.size());
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back->pixels, t.pixels);
 }
@@ -115,7 +116,7 @@ TEST(TextureEncoding, SmallestPolicyUsesJpegOnlyForOpaqueImages) {
 
 TEST(TextureEncoding, SmallestPolicyRejectsJpegBelowThePsnrFloor) {
   // Noise compresses badly and loses a lot in JPEG: PSNR falls under 60 dB.
-  TextureRGBA8 t = noise(64, 64, 5);
+  RgbaImage t = noise(64, 64, 5);
   for (std::size_t i = 3; i < t.pixels.size(); i += 4) t.pixels[i] = 255;
   TextureEncodeOptions options;
   options.jpegMinPsnr = 60.0;
@@ -125,19 +126,38 @@ TEST(TextureEncoding, SmallestPolicyRejectsJpegBelowThePsnrFloor) {
 }
 
 TEST(TextureEncoding, InvalidImagesAreRejected) {
-  TextureRGBA8 wrongSize{4, 4, std::vector<std::uint8_t>(10)};
+  RgbaImage wrongSize(4, 4);
+  wrongSize.pixels.resize(10);
   EXPECT_EQ(encodeTextureWith(wrongSize, TextureCodec::kZstd).status().code(),
             ErrorCode::kInvalidArgument);
-  EXPECT_EQ(encodeTexture(TextureRGBA8{}).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(encodeTexture(RgbaImage{}).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(TextureEncoding, NegativeSizesAreRejected) {
+  RgbaImage negative;
+  negative.width = -2;
+  negative.height = 4;
+  Result<std::vector<std::uint8_t>> frame = encodeTextureWith(negative, TextureCodec::kZstd);
+  EXPECT_EQ(frame.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(frame.status().message().find("negative size -2x4"), std::string::npos)
+      << frame.status().message();
+}
+
+TEST(TextureEncoding, SidesLongerThan65500AreRejected) {
+  const RgbaImage wide(65501, 1);
+  Result<std::vector<std::uint8_t>> frame = encodeTextureWith(wide, TextureCodec::kZstd);
+  EXPECT_EQ(frame.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(frame.status().message().find("65501x1"), std::string::npos)
+      << frame.status().message();
 }
 
 TEST(TextureEncoding, DimensionsBeyondTheLimitAreRejectedBeforeDecoding) {
-  const TextureRGBA8 t = noise(300, 10, 6);
+  const RgbaImage t = noise(300, 10, 6);
   Result<std::vector<std::uint8_t>> frame = encodeTextureWith(t, TextureCodec::kZstd);
   ASSERT_TRUE(frame.ok());
   DecodeLimits limits;
   limits.maxTextureDimension = 256;
-  Result<TextureRGBA8> decoded = decodeTexture(frame->data(), frame->size(), limits);
+  Result<RgbaImage> decoded = decodeTexture(frame->data(), frame->size(), limits);
   EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
 }
 

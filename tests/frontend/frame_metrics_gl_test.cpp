@@ -18,7 +18,6 @@
 namespace thinlod::frontend {
 namespace {
 
-using render::RgbaImage;
 using testing::addOp;
 using testing::sphereMesh;
 

@@ -15,8 +15,6 @@
 namespace thinlod::frontend {
 namespace {
 
-using render::RgbaImage;
-
 RgbaImage image(int w, int h, std::initializer_list<int> rgba) {
   RgbaImage out(w, h);
   std::size_t i = 0;

@@ -14,7 +14,6 @@ namespace thinlod::frontend {
 namespace {
 
 using render::Backend;
-using render::RgbaImage;
 using testing::addOp;
 using testing::backendParamName;
 using testing::flatLighting;

@@ -224,7 +224,7 @@ TEST(FrontendScene, RejectsNanPosition) {
 }
 
 TEST(FrontendScene, RejectsInconsistentTexture) {
-  auto texture = std::make_shared<render::RgbaImage>(4, 4);
+  auto texture = std::make_shared<RgbaImage>(4, 4);
   texture->pixels.resize(7);
   expectRejected(addOp(77, RepresentationKind::kSimpleImpostor, nullptr, texture), "inconsistent");
 }

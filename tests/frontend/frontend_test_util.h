@@ -14,7 +14,7 @@
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/frontend/frontend_scene.h"
 
 namespace thinlod::frontend::testing {
@@ -59,10 +59,9 @@ inline std::shared_ptr<const IndexedMesh> sphereMesh(float r, int slices, int st
   return m;
 }
 
-inline std::shared_ptr<const render::RgbaImage> solidImage(int w, int h, std::uint8_t r,
-                                                           std::uint8_t g, std::uint8_t b,
-                                                           std::uint8_t a = 255) {
-  auto image = std::make_shared<render::RgbaImage>(w, h);
+inline std::shared_ptr<const RgbaImage> solidImage(int w, int h, std::uint8_t r, std::uint8_t g,
+                                                   std::uint8_t b, std::uint8_t a = 255) {
+  auto image = std::make_shared<RgbaImage>(w, h);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       std::uint8_t* p = image->at(x, y);
@@ -90,8 +89,8 @@ inline render::Lighting flatLighting() {
   return lighting;
 }
 
-inline ::testing::AssertionResult pixelNear(const render::RgbaImage& image, int x, int y, int r,
-                                            int g, int b, int tolerance) {
+inline ::testing::AssertionResult pixelNear(const RgbaImage& image, int x, int y, int r, int g,
+                                            int b, int tolerance) {
   const std::uint8_t* p = image.at(x, y);
   const int expected[3] = {r, g, b};
   for (int c = 0; c < 3; ++c) {
@@ -106,7 +105,7 @@ inline ::testing::AssertionResult pixelNear(const render::RgbaImage& image, int 
 
 inline SceneOperation addOp(ObjectId id, RepresentationKind kind,
                             std::shared_ptr<const IndexedMesh> mesh,
-                            std::shared_ptr<const render::RgbaImage> texture,
+                            std::shared_ptr<const RgbaImage> texture,
                             const glm::mat4& transform = glm::mat4(1.0f),
                             const glm::vec4& color = glm::vec4(1.0f)) {
   SceneOperation op;

@@ -16,7 +16,6 @@ namespace thinlod::frontend {
 namespace {
 
 using render::Backend;
-using render::RgbaImage;
 using testing::addOp;
 using testing::backendParamName;
 using testing::orthoCamera;

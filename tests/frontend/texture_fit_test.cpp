@@ -17,7 +17,7 @@ TEST(TextureFit, ExactSizeIsUsedAsIs) {
 }
 
 TEST(TextureFit, SmallerTextureIsPaddedByReplicatingTheRightColumnAndTopRow) {
-  render::RgbaImage image(3, 2);  // texel (x, y) = (10x, 10y, 7, 255)
+  RgbaImage image(3, 2);  // texel (x, y) = (10x, 10y, 7, 255)
   for (int y = 0; y < 2; ++y) {
     for (int x = 0; x < 3; ++x) {
       std::uint8_t* p = image.at(x, y);
@@ -64,17 +64,17 @@ TEST(TextureFit, WideTextureShrinksOneAxisAndPadsTheOther) {
 
 TEST(TextureFit, ShrinkWeightsColourByAlpha) {
   // A transparent texel must not darken its opaque neighbour.
-  render::RgbaImage image(2, 1);
+  RgbaImage image(2, 1);
   const std::uint8_t texels[8] = {200, 100, 0, 255, 0, 0, 0, 0};
   std::copy(texels, texels + 8, image.pixels.begin());
-  const render::RgbaImage small = shrinkImage(image, 1, 1);
+  const RgbaImage small = shrinkImage(image, 1, 1);
   EXPECT_EQ(small.at(0, 0)[0], 200);
   EXPECT_EQ(small.at(0, 0)[1], 100);
   EXPECT_EQ(small.at(0, 0)[3], 128);
 }
 
 TEST(TextureFit, ShrinkOfFullyTransparentIsTransparentBlack) {
-  const render::RgbaImage small = shrinkImage(*solidImage(4, 4, 90, 90, 90, 0), 2, 2);
+  const RgbaImage small = shrinkImage(*solidImage(4, 4, 90, 90, 90, 0), 2, 2);
   EXPECT_EQ(small.at(1, 1)[0], 0);
   EXPECT_EQ(small.at(1, 1)[3], 0);
 }

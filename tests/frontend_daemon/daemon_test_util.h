@@ -11,6 +11,7 @@
 
 #include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/protocol/messages.h"
 
 namespace thinlod::frontend::daemon::testing {
@@ -56,14 +57,11 @@ inline std::vector<std::uint8_t> encodeOrDie(const IndexedMesh& mesh) {
   return bytes.ok() ? std::move(bytes).value() : std::vector<std::uint8_t>{};
 }
 
-inline codec::TextureRGBA8 gradientTexture(std::uint32_t w, std::uint32_t h) {
-  codec::TextureRGBA8 t;
-  t.width = w;
-  t.height = h;
-  t.pixels.resize(static_cast<std::size_t>(w) * h * 4);
-  for (std::uint32_t y = 0; y < h; ++y) {
-    for (std::uint32_t x = 0; x < w; ++x) {
-      std::uint8_t* p = &t.pixels[(static_cast<std::size_t>(y) * w + x) * 4];
+inline RgbaImage gradientTexture(int w, int h) {
+  RgbaImage t(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t* p = t.at(x, y);
       p[0] = static_cast<std::uint8_t>(x * 255 / (w > 1 ? w - 1 : 1));
       p[1] = static_cast<std::uint8_t>(y * 255 / (h > 1 ? h - 1 : 1));
       p[2] = 40;
@@ -73,12 +71,11 @@ inline codec::TextureRGBA8 gradientTexture(std::uint32_t w, std::uint32_t h) {
   return t;
 }
 
-inline protocol::Texture wireTexture(const codec::TextureRGBA8& texture,
-                                     protocol::TextureCodec codec) {
+inline protocol::Texture wireTexture(const RgbaImage& texture, protocol::TextureCodec codec) {
   protocol::Texture wire;
   wire.codec = codec;
-  wire.width = texture.width;
-  wire.height = texture.height;
+  wire.width = static_cast<std::uint32_t>(texture.width);
+  wire.height = static_cast<std::uint32_t>(texture.height);
   if (codec == protocol::TextureCodec::kRawRgba8) {
     wire.data = texture.pixels;
     return wire;
@@ -105,7 +102,7 @@ inline protocol::Representation meshRepresentation(const IndexedMesh& mesh,
 }
 
 inline protocol::Representation impostorRepresentation(protocol::TextureCodec codec,
-                                                       std::uint32_t size = 32) {
+                                                       int size = 32) {
   protocol::Representation rep;
   rep.kind = protocol::RepresentationKind::kMeshedImpostor;
   const IndexedMesh quad = quadMesh();

@@ -57,7 +57,7 @@ TEST(WireConversion, MeshedImpostorDecodesTextureAndStaysWhite) {
   MeshColors colours{{3, glm::vec4(0.1f, 0.2f, 0.3f, 1.0f)}};
   ConversionOptions options;
   options.meshColors = &colours;
-  const codec::TextureRGBA8 expected = gradientTexture(32, 32);
+  const RgbaImage expected = gradientTexture(32, 32);
   for (TextureCodec codec :
        {TextureCodec::kPng, TextureCodec::kZstdRgba8, TextureCodec::kRawRgba8}) {
     SCOPED_TRACE(static_cast<int>(codec));
@@ -78,7 +78,7 @@ TEST(WireConversion, MeshedImpostorDecodesTextureAndStaysWhite) {
 TEST(WireConversion, JpegImpostorDecodesWithinItsLoss) {
   auto rep = convertRepresentation(impostorRepresentation(TextureCodec::kJpeg), 1, {}, "op");
   ASSERT_TRUE(rep.ok()) << rep.status().toString();
-  const codec::TextureRGBA8 expected = gradientTexture(32, 32);
+  const RgbaImage expected = gradientTexture(32, 32);
   ASSERT_EQ(rep->texture->pixels.size(), expected.pixels.size());
   int worst = 0;
   for (std::size_t i = 0; i < expected.pixels.size(); ++i) {

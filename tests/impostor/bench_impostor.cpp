@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", baselineContextTarget.status().toString().c_str());
         return 1;
       }
-      render::RgbaImage scratch;
+      RgbaImage scratch;
       const Summary baseline = timeIt(repetitions, [&] {
         (void)(*baselineContextTarget)->clear(0, 0, 0, 0);
         (void)(*baselineContextTarget)->readColor(scratch);

@@ -44,7 +44,7 @@ class ImpostorTest : public ::testing::Test {
     return scene;
   }
 
-  static double alphaCoverage(const render::RgbaImage& image) {
+  static double alphaCoverage(const RgbaImage& image) {
     std::size_t covered = 0;
     for (std::size_t i = 3; i < image.pixels.size(); i += 4) covered += image.pixels[i] > 0;
     return static_cast<double>(covered) / (image.pixels.size() / 4);
@@ -58,7 +58,7 @@ class ImpostorTest : public ::testing::Test {
 TEST_F(ImpostorTest, SphereImpostorHasOpaqueObjectAndTransparentBackground) {
   auto impostor = impostors_->renderSimple(sphereScene(1.0f), glm::vec3(0, 0, 10));
   ASSERT_TRUE(impostor.ok()) << impostor.status().toString();
-  const render::RgbaImage& t = impostor->texture;
+  const RgbaImage& t = impostor->texture;
   ASSERT_EQ(t.width, 256);
   ASSERT_EQ(t.height, 256);
   EXPECT_GT(impostor->coverage, 0.5);
@@ -122,7 +122,7 @@ TEST_F(ImpostorTest, OffCentreObjectIsFramedAndKeepsTopUp) {
   scene.lighting.lights.clear();
   auto impostor = impostors_->renderSimple(scene, glm::vec3(12.0f, 1.4f, -1.0f));
   ASSERT_TRUE(impostor.ok()) << impostor.status().toString();
-  const render::RgbaImage& t = impostor->texture;
+  const RgbaImage& t = impostor->texture;
   // The pair fills the texture vertically: 2.2 m tall, 1 m wide.
   EXPECT_NEAR(impostor->quad.height / impostor->quad.width, 2.2, 0.05);
   EXPECT_NEAR(impostor->quad.center.y, 1.4f, 0.02f);
@@ -152,7 +152,7 @@ TEST_F(ImpostorTest, QuadSeenFromViewpointReproducesTheObject) {
   ASSERT_TRUE(renderer.beginFrame(**target, glm::vec4(0.0f)).ok());
   render::DrawItem object{*sphere, scene.parts[0].model, scene.parts[0].material};
   ASSERT_TRUE(renderer.draw(&object, 1, camera, scene.lighting).ok());
-  render::RgbaImage direct;
+  RgbaImage direct;
   ASSERT_TRUE((*target)->readColor(direct).ok());
 
   auto texture = renderer.uploadTexture(impostor->texture);
@@ -166,7 +166,7 @@ TEST_F(ImpostorTest, QuadSeenFromViewpointReproducesTheObject) {
   ASSERT_TRUE(renderer.beginFrame(**target, glm::vec4(0.0f)).ok());
   render::DrawItem billboard{*quad, glm::mat4(1.0f), material};
   ASSERT_TRUE(renderer.draw(&billboard, 1, camera, {}).ok());
-  render::RgbaImage viaImpostor;
+  RgbaImage viaImpostor;
   ASSERT_TRUE((*target)->readColor(viaImpostor).ok());
 
   // Compare: same coverage except along the rim, colours close inside.

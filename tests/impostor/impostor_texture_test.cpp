@@ -6,8 +6,8 @@
 namespace thinlod::simplifier {
 namespace {
 
-render::RgbaImage dot5x5() {  // one opaque red texel in the middle
-  render::RgbaImage image(5, 5);
+RgbaImage dot5x5() {  // one opaque red texel in the middle
+  RgbaImage image(5, 5);
   std::uint8_t* p = image.at(2, 2);
   p[0] = 200;
   p[3] = 255;
@@ -15,7 +15,7 @@ render::RgbaImage dot5x5() {  // one opaque red texel in the middle
 }
 
 TEST(ImpostorTexture, OneRingTakesNeighbourColourAndKeepsAlpha) {
-  render::RgbaImage image = dot5x5();
+  RgbaImage image = dot5x5();
   bleedColorIntoTransparent(image, 1);
   for (int y = 0; y < 5; ++y) {
     for (int x = 0; x < 5; ++x) {
@@ -30,7 +30,7 @@ TEST(ImpostorTexture, OneRingTakesNeighbourColourAndKeepsAlpha) {
 }
 
 TEST(ImpostorTexture, RingsGrowOnePixelPerPass) {
-  render::RgbaImage image = dot5x5();
+  RgbaImage image = dot5x5();
   bleedColorIntoTransparent(image, 2);
   for (int y = 0; y < 5; ++y) {
     for (int x = 0; x < 5; ++x) {
@@ -41,7 +41,7 @@ TEST(ImpostorTexture, RingsGrowOnePixelPerPass) {
 }
 
 TEST(ImpostorTexture, MixedNeighboursAverage) {
-  render::RgbaImage image(3, 1);
+  RgbaImage image(3, 1);
   image.pixels = {100, 0, 0, 255, 0, 0, 0, 0, 0, 50, 0, 255};
   bleedColorIntoTransparent(image, 1);
   EXPECT_EQ(image.at(1, 0)[0], 50);  // (100 + 0) / 2
@@ -50,11 +50,11 @@ TEST(ImpostorTexture, MixedNeighboursAverage) {
 }
 
 TEST(ImpostorTexture, ZeroPassesAndEmptyImagesAreNoOps) {
-  render::RgbaImage image = dot5x5();
-  const render::RgbaImage before = image;
+  RgbaImage image = dot5x5();
+  const RgbaImage before = image;
   bleedColorIntoTransparent(image, 0);
   EXPECT_EQ(image.pixels, before.pixels);
-  render::RgbaImage empty;
+  RgbaImage empty;
   bleedColorIntoTransparent(empty, 3);
   EXPECT_TRUE(empty.pixels.empty());
 }

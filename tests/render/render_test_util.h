@@ -15,7 +15,7 @@
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 
 namespace thinlod::render::testing {
 

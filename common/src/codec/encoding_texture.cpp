@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <new>
 #include <string>
 
@@ -15,6 +16,9 @@
 
 namespace thinlod::codec {
 namespace {
+
+// Longest side an encoder accepts (encoding.h).
+constexpr int kMaxEncodedSide = 65500;
 
 // A file name only selects OpenImageIO's format plugin; bytes go through
 // an in-memory IOProxy.
@@ -26,14 +30,22 @@ Status textureError(ErrorCode code, const std::string& message) {
   return Status(code, "texture: " + message);
 }
 
-Status checkTexture(const TextureRGBA8& texture) {
+Status checkTexture(const RgbaImage& texture) {
+  const std::string size = std::to_string(texture.width) + "x" + std::to_string(texture.height);
+  if (texture.width < 0 || texture.height < 0) {
+    return textureError(ErrorCode::kInvalidArgument, "negative size " + size);
+  }
   if (texture.width == 0 || texture.height == 0) {
-    return textureError(ErrorCode::kInvalidArgument, "empty image");
+    return textureError(ErrorCode::kInvalidArgument, "empty image (" + size + ")");
   }
-  if (texture.width > 65500 || texture.height > 65500) {
-    return textureError(ErrorCode::kInvalidArgument, "side longer than 65500 pixels");
+  if (texture.width > kMaxEncodedSide || texture.height > kMaxEncodedSide) {
+    return textureError(
+        ErrorCode::kInvalidArgument,
+        "size " + size + " has a side longer than " + std::to_string(kMaxEncodedSide) + " pixels");
   }
-  const std::uint64_t expected = std::uint64_t{texture.width} * texture.height * 4;
+  // Both sides are in [1, 65500]: the product cannot overflow 64 bits.
+  const std::uint64_t expected =
+      static_cast<std::uint64_t>(texture.width) * static_cast<std::uint64_t>(texture.height) * 4;
   if (texture.pixels.size() != expected) {
     return textureError(ErrorCode::kInvalidArgument,
                         "pixel buffer has " + std::to_string(texture.pixels.size()) +
@@ -42,14 +54,14 @@ Status checkTexture(const TextureRGBA8& texture) {
   return Status();
 }
 
-bool isOpaque(const TextureRGBA8& texture) {
+bool isOpaque(const RgbaImage& texture) {
   for (std::size_t i = 3; i < texture.pixels.size(); i += 4) {
     if (texture.pixels[i] != 255) return false;
   }
   return true;
 }
 
-Result<std::vector<std::uint8_t>> zstdPayload(const TextureRGBA8& texture, int level) {
+Result<std::vector<std::uint8_t>> zstdPayload(const RgbaImage& texture, int level) {
   std::vector<std::uint8_t> out(ZSTD_compressBound(texture.pixels.size()));
   const std::size_t written =
       ZSTD_compress(out.data(), out.size(), texture.pixels.data(), texture.pixels.size(), level);
@@ -60,14 +72,14 @@ Result<std::vector<std::uint8_t>> zstdPayload(const TextureRGBA8& texture, int l
   return out;
 }
 
-Result<std::vector<std::uint8_t>> imagePayload(const TextureRGBA8& texture, TextureCodec codec,
+Result<std::vector<std::uint8_t>> imagePayload(const RgbaImage& texture, TextureCodec codec,
                                                const TextureEncodeOptions& options) {
   const bool jpeg = codec == TextureCodec::kJpeg;
   const int channels = jpeg ? 3 : 4;
   std::vector<std::uint8_t> rgb;
   const std::uint8_t* pixels = texture.pixels.data();
   if (jpeg) {  // JPEG has no alpha channel: drop it (callers ensure it is 255)
-    rgb.resize(std::size_t{texture.width} * texture.height * 3);
+    rgb.resize(texture.pixels.size() / 4 * 3);
     for (std::size_t p = 0, n = rgb.size() / 3; p < n; ++p) {
       for (int c = 0; c < 3; ++c) rgb[3 * p + c] = texture.pixels[4 * p + c];
     }
@@ -75,8 +87,7 @@ Result<std::vector<std::uint8_t>> imagePayload(const TextureRGBA8& texture, Text
   }
   std::vector<unsigned char> bytes;
   OIIO::Filesystem::IOVecOutput proxy(bytes);
-  OIIO::ImageSpec spec(static_cast<int>(texture.width), static_cast<int>(texture.height), channels,
-                       OIIO::TypeDesc::UINT8);
+  OIIO::ImageSpec spec(texture.width, texture.height, channels, OIIO::TypeDesc::UINT8);
   if (jpeg) {
     spec.attribute("Compression", "jpeg:" + std::to_string(options.jpegQuality));
   } else {
@@ -99,7 +110,7 @@ Result<std::vector<std::uint8_t>> imagePayload(const TextureRGBA8& texture, Text
   return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
 }
 
-Result<std::vector<std::uint8_t>> payloadFor(const TextureRGBA8& texture, TextureCodec codec,
+Result<std::vector<std::uint8_t>> payloadFor(const RgbaImage& texture, TextureCodec codec,
                                              const TextureEncodeOptions& options) {
   switch (codec) {
     case TextureCodec::kZstd:
@@ -111,7 +122,7 @@ Result<std::vector<std::uint8_t>> payloadFor(const TextureRGBA8& texture, Textur
   return textureError(ErrorCode::kInvalidArgument, "unknown codec");
 }
 
-Status decodeZstd(const std::uint8_t* payload, std::size_t size, TextureRGBA8& out) {
+Status decodeZstd(const std::uint8_t* payload, std::size_t size, RgbaImage& out) {
   const std::size_t expected = out.pixels.size();
   const unsigned long long content = ZSTD_getFrameContentSize(payload, size);
   if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN ||
@@ -148,7 +159,7 @@ bool pngChunksComplete(const std::uint8_t* data, std::size_t size) {
 }
 
 Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
-                   TextureRGBA8& out) {
+                   RgbaImage& out) {
   if (codec == TextureCodec::kPng && !pngChunksComplete(payload, size)) {
     return textureError(ErrorCode::kParseError, "PNG payload is truncated or malformed");
   }
@@ -166,8 +177,8 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
   const OIIO::ImageSpec& spec = input->spec();
   const int wantChannels = codec == TextureCodec::kJpeg ? 3 : 4;
   // Checked against the frame header before any pixel is decoded.
-  if (spec.width != static_cast<int>(out.width) || spec.height != static_cast<int>(out.height) ||
-      spec.depth != 1 || spec.nchannels != wantChannels) {
+  if (spec.width != out.width || spec.height != out.height || spec.depth != 1 ||
+      spec.nchannels != wantChannels) {
     return textureError(ErrorCode::kParseError,
                         "image is " + std::to_string(spec.width) + "x" +
                             std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) +
@@ -189,7 +200,7 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
   return Status();
 }
 
-double psnrRgb(const TextureRGBA8& a, const TextureRGBA8& b) {
+double psnrRgb(const RgbaImage& a, const RgbaImage& b) {
   double squared = 0.0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
     if (i % 4 == 3) continue;
@@ -202,7 +213,7 @@ double psnrRgb(const TextureRGBA8& a, const TextureRGBA8& b) {
 
 }  // namespace
 
-Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture, TextureCodec codec,
+Result<std::vector<std::uint8_t>> encodeTextureWith(const RgbaImage& texture, TextureCodec codec,
                                                     const TextureEncodeOptions& options) {
   THINLOD_RETURN_IF_ERROR(checkTexture(texture));
   if (codec == TextureCodec::kJpeg && !isOpaque(texture)) {
@@ -214,8 +225,9 @@ Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture,
     detail::FrameHeader header;
     header.magic = detail::kTextureMagic;
     header.codec = static_cast<std::uint8_t>(codec);
-    header.countA = texture.width;
-    header.countB = texture.height;
+    // checkTexture: both sides are in [1, 65500].
+    header.countA = static_cast<std::uint32_t>(texture.width);
+    header.countB = static_cast<std::uint32_t>(texture.height);
     return detail::makeFrame(header, payload->data(), payload->size());
   } catch (const std::bad_alloc&) {
     return textureError(ErrorCode::kResourceExhausted, "out of memory");
@@ -224,7 +236,7 @@ Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture,
   }
 }
 
-Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
+Result<EncodedTexture> encodeTexture(const RgbaImage& texture,
                                      const TextureEncodeOptions& options) {
   std::vector<TextureCodec> candidates = {TextureCodec::kZstd};
   if (options.policy != TexturePolicy::kFastest) candidates.push_back(TextureCodec::kPng);
@@ -239,7 +251,7 @@ Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
     if (!frame.ok()) return frame.status();
     if (haveBest && frame->size() >= best.bytes.size()) continue;
     if (codec == TextureCodec::kJpeg) {
-      Result<TextureRGBA8> decoded = decodeTexture(frame->data(), frame->size());
+      Result<RgbaImage> decoded = decodeTexture(frame->data(), frame->size());
       if (!decoded.ok() || psnrRgb(texture, *decoded) < options.jpegMinPsnr) continue;
     }
     best.codec = codec;
@@ -249,8 +261,8 @@ Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
   return best;
 }
 
-Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
-                                   const DecodeLimits& limits) {
+Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
+                                const DecodeLimits& limits) {
   Result<detail::FrameHeader> parsed =
       detail::parseFrame(data, size, detail::kTextureMagic, limits, "decodeTexture");
   if (!parsed.ok()) return parsed.status();
@@ -262,18 +274,21 @@ Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
   if (header.attributes != 0) {
     return textureError(ErrorCode::kUnsupported, "unknown attribute bits");
   }
-  if (header.countA == 0 || header.countB == 0 || header.countA > limits.maxTextureDimension ||
-      header.countB > limits.maxTextureDimension) {
+  // RgbaImage sides are int: a limit above INT_MAX cannot admit more.
+  const std::uint32_t maxSide = std::min<std::uint32_t>(
+      limits.maxTextureDimension, static_cast<std::uint32_t>(std::numeric_limits<int>::max()));
+  if (header.countA == 0 || header.countB == 0 || header.countA > maxSide ||
+      header.countB > maxSide) {
     return textureError(ErrorCode::kResourceExhausted,
                         "dimensions " + std::to_string(header.countA) + "x" +
                             std::to_string(header.countB) + " outside [1, " +
-                            std::to_string(limits.maxTextureDimension) + "]");
+                            std::to_string(maxSide) + "]");
   }
   try {
-    TextureRGBA8 texture;
-    texture.width = header.countA;
-    texture.height = header.countB;
-    texture.pixels.resize(std::size_t{texture.width} * texture.height * 4);
+    RgbaImage texture;
+    texture.width = static_cast<int>(header.countA);
+    texture.height = static_cast<int>(header.countB);
+    texture.pixels.resize(std::size_t{header.countA} * header.countB * 4);
     const std::uint8_t* payload = data + kFrameHeaderBytes;
     const TextureCodec codec = static_cast<TextureCodec>(header.codec);
     if (codec == TextureCodec::kZstd) {

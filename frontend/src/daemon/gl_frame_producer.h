@@ -36,8 +36,8 @@ class GlFrameProducer final : public FrameProducer {
   Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose& pose) override;
   Result<FrameQuality> measure(std::uint64_t frame, const Pose& pose) override;
 
-  const render::RgbaImage& frame() const { return frame_; }
-  const render::RgbaImage& referenceFrame() const { return referenceFrame_; }
+  const RgbaImage& frame() const { return frame_; }
+  const RgbaImage& referenceFrame() const { return referenceFrame_; }
   // "egl, llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string describe() const;
 
@@ -51,8 +51,8 @@ class GlFrameProducer final : public FrameProducer {
   std::unique_ptr<render::OffscreenContext> context_;
   std::unique_ptr<FrontendRenderer> renderer_;
   std::unique_ptr<ReferenceRenderer> referenceRenderer_;
-  render::RgbaImage frame_;
-  render::RgbaImage referenceFrame_;
+  RgbaImage frame_;
+  RgbaImage referenceFrame_;
 };
 
 }  // namespace thinlod::frontend::daemon

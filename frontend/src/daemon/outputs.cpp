@@ -132,7 +132,7 @@ Status writeTextFile(const std::string& path, const std::string& text) {
   return written && closed ? Status() : ioError(path, "write failed");
 }
 
-Status writePng(const std::string& path, const render::RgbaImage& image) {
+Status writePng(const std::string& path, const RgbaImage& image) {
   if (image.empty() || !image.consistent()) return ioError(path, "empty or inconsistent image");
   std::unique_ptr<OIIO::ImageOutput> output = OIIO::ImageOutput::create(path);
   if (output == nullptr) return ioError(path, "no PNG writer: " + OIIO::geterror());

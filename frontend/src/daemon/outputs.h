@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "replay_loop.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 #include "thinlod/frontend/frame_record.h"
 
@@ -55,7 +55,7 @@ struct RunInfo {
 
 std::string runSummaryJson(const ReplayResult& result, const RunInfo& info);
 Status writeTextFile(const std::string& path, const std::string& text);
-Status writePng(const std::string& path, const render::RgbaImage& image);
+Status writePng(const std::string& path, const RgbaImage& image);
 // "<dir>/<prefix>_0042.png"
 std::string dumpPath(const std::string& dir, const std::string& prefix, std::uint64_t frame);
 

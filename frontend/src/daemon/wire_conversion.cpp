@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <glm/common.hpp>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -56,38 +57,41 @@ std::string sizeText(std::uint64_t width, std::uint64_t height) {
 }
 
 // kNone -> null; otherwise the decoded image or an error.
-Result<std::shared_ptr<const render::RgbaImage>> convertTexture(const protocol::Texture& wire,
-                                                                const ConversionOptions& options,
-                                                                const std::string& what) {
+Result<std::shared_ptr<const RgbaImage>> convertTexture(const protocol::Texture& wire,
+                                                        const ConversionOptions& options,
+                                                        const std::string& what) {
   if (wire.codec == protocol::TextureCodec::kNone) {
     if (!wire.data.empty() || wire.width != 0 || wire.height != 0) {
       return invalid(what, "codec None but " + sizeText(wire.width, wire.height) + " with " +
                                std::to_string(wire.data.size()) + " bytes");
     }
-    return std::shared_ptr<const render::RgbaImage>();
+    return std::shared_ptr<const RgbaImage>();
   }
-  const std::uint32_t maxSide = options.limits.maxTextureDimension;
+  // RgbaImage sides are int: a limit above INT_MAX cannot admit more.
+  const std::uint32_t maxSide =
+      std::min<std::uint32_t>(options.limits.maxTextureDimension,
+                              static_cast<std::uint32_t>(std::numeric_limits<int>::max()));
   if (wire.width == 0 || wire.height == 0 || wire.width > maxSide || wire.height > maxSide) {
     return invalid(what, "size " + sizeText(wire.width, wire.height) + " outside 1.." +
                              std::to_string(maxSide) + " per side");
   }
-  auto image = std::make_shared<render::RgbaImage>();
-  image->width = static_cast<int>(wire.width);
-  image->height = static_cast<int>(wire.height);
   const std::size_t expectedBytes = static_cast<std::size_t>(wire.width) * wire.height * 4;
   if (wire.codec == protocol::TextureCodec::kRawRgba8) {
     if (wire.data.size() != expectedBytes) {
       return invalid(what, "RawRgba8 data is " + std::to_string(wire.data.size()) +
                                " bytes, expected " + std::to_string(expectedBytes));
     }
+    auto image = std::make_shared<RgbaImage>();
+    image->width = static_cast<int>(wire.width);
+    image->height = static_cast<int>(wire.height);
     image->pixels = wire.data;
-    return std::shared_ptr<const render::RgbaImage>(std::move(image));
+    return std::shared_ptr<const RgbaImage>(std::move(image));
   }
   const std::uint8_t frameCodec = frameCodecOf(wire.codec);
   if (frameCodec == 0) {
     return invalid(what, "unknown texture codec " + std::to_string(static_cast<int>(wire.codec)));
   }
-  Result<codec::TextureRGBA8> decoded =
+  Result<RgbaImage> decoded =
       codec::decodeTexture(wire.data.data(), wire.data.size(), options.limits);
   if (!decoded.ok()) {
     return Status(decoded.status().code(), what + ": " + decoded.status().message());
@@ -98,7 +102,8 @@ Result<std::shared_ptr<const render::RgbaImage>> convertTexture(const protocol::
                              " does not match the wire codec " +
                              std::to_string(static_cast<int>(wire.codec)));
   }
-  if (decoded->width != wire.width || decoded->height != wire.height) {
+  if (static_cast<std::uint32_t>(decoded->width) != wire.width ||
+      static_cast<std::uint32_t>(decoded->height) != wire.height) {
     return invalid(what, "decoded size " + sizeText(decoded->width, decoded->height) +
                              " does not match the announced " + sizeText(wire.width, wire.height));
   }
@@ -106,8 +111,7 @@ Result<std::shared_ptr<const render::RgbaImage>> convertTexture(const protocol::
     return invalid(what, "decoded " + std::to_string(decoded->pixels.size()) + " bytes, expected " +
                              std::to_string(expectedBytes));
   }
-  image->pixels = std::move(decoded->pixels);
-  return std::shared_ptr<const render::RgbaImage>(std::move(image));
+  return std::shared_ptr<const RgbaImage>(std::make_shared<RgbaImage>(std::move(decoded).value()));
 }
 
 }  // namespace
@@ -148,7 +152,7 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
     rep.mesh = std::make_shared<const IndexedMesh>(std::move(mesh).value());
   }
 
-  Result<std::shared_ptr<const render::RgbaImage>> texture =
+  Result<std::shared_ptr<const RgbaImage>> texture =
       convertTexture(wire.texture, options, what + ": texture");
   if (!texture.ok()) return texture.status();
   rep.texture = std::move(texture).value();

@@ -64,8 +64,7 @@ Result<FrameComparison> compareFrames(const std::uint8_t* simplified, const std:
   return result;
 }
 
-Result<FrameComparison> compareFrames(const render::RgbaImage& simplified,
-                                      const render::RgbaImage& reference) {
+Result<FrameComparison> compareFrames(const RgbaImage& simplified, const RgbaImage& reference) {
   if (!simplified.consistent() || !reference.consistent()) {
     return Status(ErrorCode::kInvalidArgument,
                   "compareFrames: a frame's pixel buffer does not match its size");
@@ -80,13 +79,13 @@ Result<FrameComparison> compareFrames(const render::RgbaImage& simplified,
                        static_cast<std::size_t>(simplified.width) * simplified.height);
 }
 
-Result<double> frameSnr(const render::RgbaImage& simplified, const render::RgbaImage& reference) {
+Result<double> frameSnr(const RgbaImage& simplified, const RgbaImage& reference) {
   auto comparison = compareFrames(simplified, reference);
   if (!comparison.ok()) return comparison.status();
   return comparison->snrDb;
 }
 
-Result<double> framePsnr(const render::RgbaImage& simplified, const render::RgbaImage& reference) {
+Result<double> framePsnr(const RgbaImage& simplified, const RgbaImage& reference) {
   auto comparison = compareFrames(simplified, reference);
   if (!comparison.ok()) return comparison.status();
   return comparison->psnrDb;

@@ -96,7 +96,7 @@ struct FrontendRenderer::Impl {
       page.freeLayers.push_back(layer);
     }
     if (first) {
-      render::RgbaImage white(options.layerSize, options.layerSize);
+      RgbaImage white(options.layerSize, options.layerSize);
       std::fill(white.pixels.begin(), white.pixels.end(), std::uint8_t{255});
       Status status = renderer->setTextureLayer(page.texture, kWhiteLayer, white);
       if (!status.ok()) {
@@ -331,7 +331,7 @@ Status FrontendRenderer::submit(SceneBatch batch) { return impl_->scene.enqueue(
 
 Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
                                                   const render::Lighting& lighting,
-                                                  render::RgbaImage& frame) {
+                                                  RgbaImage& frame) {
   Impl& impl = *impl_;
   if (!impl.context->isCurrent()) {
     return Status(ErrorCode::kUnavailable,

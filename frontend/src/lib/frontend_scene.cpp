@@ -38,7 +38,7 @@ Status validateRepresentation(const Representation& rep, const std::string& what
                   what + ": " + representationKindName(rep.kind) + " needs a texture");
   }
   if (rep.texture != nullptr) {
-    const render::RgbaImage& t = *rep.texture;
+    const RgbaImage& t = *rep.texture;
     if (!t.consistent() || t.empty()) {
       return Status(ErrorCode::kInvalidArgument, what + ": texture " + std::to_string(t.width) +
                                                      "x" + std::to_string(t.height) + " with " +
@@ -77,7 +77,7 @@ const char* representationKindName(RepresentationKind kind) {
   return "unknown";
 }
 
-std::size_t uploadBytesOf(const IndexedMesh& mesh, const render::RgbaImage* texture) {
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture) {
   std::size_t bytes = mesh.vertexCount() * kGpuVertexBytes + mesh.indices.size() * kGpuIndexBytes;
   if (texture != nullptr) bytes += texture->pixels.size();
   return bytes;

@@ -26,8 +26,7 @@ struct ReferenceRenderer::Impl {
   std::unique_ptr<render::RenderTarget> target;
   std::unique_ptr<render::MeshRenderer> renderer;
   std::unordered_map<const IndexedMesh*, CacheEntry<IndexedMesh, render::MeshHandle>> meshes;
-  std::unordered_map<const render::RgbaImage*, CacheEntry<render::RgbaImage, render::TextureHandle>>
-      textures;
+  std::unordered_map<const RgbaImage*, CacheEntry<RgbaImage, render::TextureHandle>> textures;
   std::vector<render::DrawItem> items;
 
   ~Impl() {
@@ -65,15 +64,14 @@ struct ReferenceRenderer::Impl {
     return *handle;
   }
 
-  Result<render::TextureHandle> textureFor(const std::shared_ptr<const render::RgbaImage>& image) {
+  Result<render::TextureHandle> textureFor(const std::shared_ptr<const RgbaImage>& image) {
     auto it = textures.find(image.get());
     if (it != textures.end()) return it->second.handle;
     render::TextureOptions textureOptions;
     textureOptions.linearFilter = options.linearFilter;
     auto handle = renderer->uploadTexture(*image, textureOptions);
     if (!handle.ok()) return handle.status();
-    textures.emplace(image.get(),
-                     CacheEntry<render::RgbaImage, render::TextureHandle>{image, *handle});
+    textures.emplace(image.get(), CacheEntry<RgbaImage, render::TextureHandle>{image, *handle});
     return *handle;
   }
 };
@@ -100,7 +98,7 @@ Result<std::unique_ptr<ReferenceRenderer>> ReferenceRenderer::create(
 Result<ReferenceReport> ReferenceRenderer::render(const std::vector<ReferenceObject>& objects,
                                                   const render::Camera& camera,
                                                   const render::Lighting& lighting,
-                                                  render::RgbaImage& frame) {
+                                                  RgbaImage& frame) {
   Impl& impl = *impl_;
   if (!impl.context->isCurrent()) {
     return Status(ErrorCode::kUnavailable,

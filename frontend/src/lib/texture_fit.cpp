@@ -7,10 +7,10 @@
 
 namespace thinlod::frontend::detail {
 
-render::RgbaImage shrinkImage(const render::RgbaImage& source, int width, int height) {
+RgbaImage shrinkImage(const RgbaImage& source, int width, int height) {
   assert(width >= 1 && height >= 1 && width <= source.width && height <= source.height &&
          "shrinkImage: target must be non-empty and no larger than the source");
-  render::RgbaImage out(width, height);
+  RgbaImage out(width, height);
   for (int y = 0; y < height; ++y) {
     const int y0 = static_cast<int>(static_cast<long long>(y) * source.height / height);
     const int y1 =
@@ -41,15 +41,15 @@ render::RgbaImage shrinkImage(const render::RgbaImage& source, int width, int he
   return out;
 }
 
-FittedTexture fitTextureToLayer(const render::RgbaImage& source, int layerSize) {
+FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
   assert(layerSize >= 1 && source.consistent() && !source.empty());
   FittedTexture fitted;
   if (source.width == layerSize && source.height == layerSize) {
     fitted.useSource = true;
     return fitted;
   }
-  const render::RgbaImage* image = &source;
-  render::RgbaImage shrunk;
+  const RgbaImage* image = &source;
+  RgbaImage shrunk;
   if (source.width > layerSize || source.height > layerSize) {
     shrunk =
         shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
@@ -64,7 +64,7 @@ FittedTexture fitTextureToLayer(const render::RgbaImage& source, int layerSize) 
     fitted.image = std::move(shrunk);
     return fitted;
   }
-  render::RgbaImage padded(w + padRight, h + padTop);
+  RgbaImage padded(w + padRight, h + padTop);
   const std::size_t rowBytes = static_cast<std::size_t>(w) * 4;
   for (int y = 0; y < padded.height; ++y) {
     const int sourceRow = std::max(0, y - padTop);  // the extra top row repeats row 0

@@ -4,14 +4,14 @@
 
 #include <glm/vec2.hpp>
 
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 
 namespace thinlod::frontend::detail {
 
 struct FittedTexture {
   // What to write at the layer's uv-origin corner. Empty when `source` can be
   // written unchanged (it is exactly layerSize x layerSize).
-  render::RgbaImage image;
+  RgbaImage image;
   // uv * uvScale addresses the texture inside the layer.
   glm::vec2 uvScale{1.0f};
   bool useSource = false;
@@ -22,9 +22,9 @@ struct FittedTexture {
 // column on the right and one replicated row on top so bilinear filtering at
 // the edge never reads texels left in the layer by an earlier texture.
 // Precondition: source consistent and non-empty, layerSize >= 1.
-FittedTexture fitTextureToLayer(const render::RgbaImage& source, int layerSize);
+FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize);
 
 // Alpha-weighted box filter to width x height (each <= the source's edge).
-render::RgbaImage shrinkImage(const render::RgbaImage& source, int width, int height);
+RgbaImage shrinkImage(const RgbaImage& source, int width, int height);
 
 }  // namespace thinlod::frontend::detail

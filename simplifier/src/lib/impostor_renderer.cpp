@@ -29,7 +29,7 @@ bool finite(const glm::mat4& m) {
   return true;
 }
 
-double coverageOf(const render::RgbaImage& image) {
+double coverageOf(const RgbaImage& image) {
   std::size_t covered = 0;
   for (std::size_t i = 3; i < image.pixels.size(); i += 4) covered += image.pixels[i] != 0;
   const std::size_t total = image.pixels.size() / 4;
@@ -38,7 +38,7 @@ double coverageOf(const render::RgbaImage& image) {
 
 }  // namespace
 
-void bleedColorIntoTransparent(render::RgbaImage& image, int pixels) {
+void bleedColorIntoTransparent(RgbaImage& image, int pixels) {
   if (image.empty() || !image.consistent()) return;
   const int w = image.width;
   const int h = image.height;

@@ -34,27 +34,23 @@ std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
          (static_cast<std::uint32_t>(frame[15]) << 24);
 }
 
-bool opaque(const render::RgbaImage& image) {
+bool opaque(const RgbaImage& image) {
   for (std::size_t i = 3; i < image.pixels.size(); i += 4) {
     if (image.pixels[i] != 255) return false;
   }
   return true;
 }
 
-Result<protocol::Texture> encodeTexture(const render::RgbaImage& image,
-                                        protocol::TextureCodec requested) {
+// Takes the image by value: the raw codec moves its pixels onto the wire.
+Result<protocol::Texture> encodeTexture(RgbaImage image, protocol::TextureCodec requested) {
   protocol::Texture texture;
   texture.width = static_cast<std::uint32_t>(image.width);
   texture.height = static_cast<std::uint32_t>(image.height);
   if (requested == protocol::TextureCodec::kRawRgba8) {
     texture.codec = requested;
-    texture.data = image.pixels;
+    texture.data = std::move(image.pixels);
     return texture;
   }
-  codec::TextureRGBA8 pixels;
-  pixels.width = texture.width;
-  pixels.height = texture.height;
-  pixels.pixels = image.pixels;
   codec::TextureCodec used = codec::TextureCodec::kPng;
   texture.codec = protocol::TextureCodec::kPng;
   if (requested == protocol::TextureCodec::kZstdRgba8) {
@@ -64,7 +60,7 @@ Result<protocol::Texture> encodeTexture(const render::RgbaImage& image,
     used = codec::TextureCodec::kJpeg;
     texture.codec = requested;
   }
-  Result<std::vector<std::uint8_t>> bytes = codec::encodeTextureWith(pixels, used);
+  Result<std::vector<std::uint8_t>> bytes = codec::encodeTextureWith(image, used);
   if (!bytes.ok()) return bytes.status();
   texture.data = std::move(bytes).value();
   return texture;
@@ -258,7 +254,7 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   // --- Render. ---
   protocol::Representation representation;
   representation.kind = request.kind;
-  render::RgbaImage image;
+  RgbaImage image;
   IndexedMesh geometry;
   ImpostorFraming rendered;
   if (request.kind == protocol::RepresentationKind::kSimpleImpostor) {
@@ -295,7 +291,7 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   if (!meshBytes.ok()) return meshBytes.status();
   representation.mesh = std::move(meshBytes).value();
   representation.triangleCount = frameTriangles(representation.mesh);
-  Result<protocol::Texture> texture = encodeTexture(image, request.textureCodec);
+  Result<protocol::Texture> texture = encodeTexture(std::move(image), request.textureCodec);
   if (!texture.ok()) return texture.status();
   representation.texture = std::move(texture).value();
   representation.transform = glm::mat4(1.0f);

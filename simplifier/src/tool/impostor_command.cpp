@@ -95,7 +95,7 @@ void runImpostor(const ImpostorArgs& args) {
   options.textureSize = args.size;
   options.maxAngularError = args.maxAngularError;
 
-  render::RgbaImage texture;
+  RgbaImage texture;
   ConicRange validity;
   progressLine(command, std::string("rendering a ") + (args.meshed ? "meshed" : "simple") +
                             " impostor, " + std::to_string(args.size) + " texels");
@@ -126,14 +126,12 @@ void runImpostor(const ImpostorArgs& args) {
   result["validity"] = validityJson(validity);
 
   // The link cost of the texture in each codec (the backbone schedules with these).
-  codec::TextureRGBA8 rgba{static_cast<std::uint32_t>(texture.width),
-                           static_cast<std::uint32_t>(texture.height), texture.pixels};
   nlohmann::json sizes = nlohmann::json::object();
   std::vector<std::uint8_t> zstdFrame;
   for (auto [name, textureCodec] : {std::pair{"zstd", codec::TextureCodec::kZstd},
                                     std::pair{"png", codec::TextureCodec::kPng}}) {
     start = Clock::now();
-    Result<std::vector<std::uint8_t>> frame = codec::encodeTextureWith(rgba, textureCodec);
+    Result<std::vector<std::uint8_t>> frame = codec::encodeTextureWith(texture, textureCodec);
     if (!frame.ok()) fail(command, frame.status(), args.json, result);
     timings[std::string("encode_") + name] = millisecondsSince(start);
     sizes[name] = frame->size();

@@ -1,9 +1,13 @@
-// RgbaImage: a plain 8-bit RGBA raster exchanged between the renderer, the
-// impostor builder, the encoders and the frontend. No GL types here.
+// RgbaImage: the one plain 8-bit RGBA raster of thinlod, exchanged between
+// the renderer (readback), the impostor builder, the texture codecs
+// (codec/encoding.h encodes and decodes it), the wire conversion and the
+// frontend. Header-only, part of the core: no GL types, no dependencies.
 //
 // Contract:
 // - pixels.size() == width * height * 4; rows are stored top-down (row 0 is
 //   the top of the picture), 4 bytes per pixel in R, G, B, A order.
+//   consistent() checks this (and non-negative sizes); code taking an image
+//   from outside checks it before indexing.
 // - Colours are non-premultiplied; alpha 0 means "no surface here".
 // - Value type: copy/move freely, no thread affinity.
 #pragma once
@@ -12,7 +16,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace thinlod::render {
+namespace thinlod {
 
 struct RgbaImage {
   int width = 0;
@@ -36,4 +40,4 @@ struct RgbaImage {
   }
 };
 
-}  // namespace thinlod::render
+}  // namespace thinlod

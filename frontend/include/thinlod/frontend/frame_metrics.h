@@ -22,7 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::frontend {
@@ -35,14 +35,13 @@ struct FrameComparison {
   double psnrDb = 0.0;
 };
 
-Result<FrameComparison> compareFrames(const render::RgbaImage& simplified,
-                                      const render::RgbaImage& reference);
+Result<FrameComparison> compareFrames(const RgbaImage& simplified, const RgbaImage& reference);
 // Same over raw RGBA8 buffers of `pixelCount` pixels each.
 Result<FrameComparison> compareFrames(const std::uint8_t* simplified, const std::uint8_t* reference,
                                       std::size_t pixelCount);
 
-Result<double> frameSnr(const render::RgbaImage& simplified, const render::RgbaImage& reference);
-Result<double> framePsnr(const render::RgbaImage& simplified, const render::RgbaImage& reference);
+Result<double> frameSnr(const RgbaImage& simplified, const RgbaImage& reference);
+Result<double> framePsnr(const RgbaImage& simplified, const RgbaImage& reference);
 
 // The formulas above applied to given moments (mse, variance >= 0).
 double snrFromMoments(double variance, double mse);

@@ -40,7 +40,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 #include "thinlod/frontend/frontend_scene.h"
 
@@ -97,7 +97,7 @@ class FrontendRenderer {
   Status submit(SceneBatch batch);
   // `frame` is resized to width x height (no reallocation when already so).
   Result<FrameReport> renderFrame(const render::Camera& camera, const render::Lighting& lighting,
-                                  render::RgbaImage& frame);
+                                  RgbaImage& frame);
 
   const FrontendScene& scene() const;
   const FrontendRendererOptions& options() const;

@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::frontend {
@@ -54,7 +54,7 @@ struct Representation {
   std::shared_ptr<const IndexedMesh> mesh;
   // Required for impostors (their lighting is baked in: drawn unlit); optional
   // for meshes (drawn lit). Non-premultiplied RGBA, rows top-down.
-  std::shared_ptr<const render::RgbaImage> texture;
+  std::shared_ptr<const RgbaImage> texture;
   glm::mat4 transform{1.0f};  // object -> world
   glm::vec4 color{1.0f};      // multiplies texture and vertex colours, components in [0,1]
   std::uint32_t generation = 0;
@@ -103,7 +103,7 @@ struct SceneLimits {
 // GPU bytes MeshRenderer stores per vertex (interleaved) and per index.
 constexpr std::size_t kGpuVertexBytes = 40;
 constexpr std::size_t kGpuIndexBytes = 4;
-std::size_t uploadBytesOf(const IndexedMesh& mesh, const render::RgbaImage* texture);
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture);
 
 // Two counter-clockwise triangles spanning [-0.5, 0.5]^2 at z = 0, facing +z,
 // uv (0,0) at (-0.5,-0.5) and (1,1) at (0.5,0.5): the simple impostor default.

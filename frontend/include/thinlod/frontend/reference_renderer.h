@@ -26,7 +26,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::frontend {
@@ -34,8 +34,8 @@ namespace thinlod::frontend {
 struct ReferenceObject {
   std::shared_ptr<const IndexedMesh> mesh;
   render::Material material;
-  glm::mat4 transform{1.0f};                         // object -> world
-  std::shared_ptr<const render::RgbaImage> texture;  // optional
+  glm::mat4 transform{1.0f};                 // object -> world
+  std::shared_ptr<const RgbaImage> texture;  // optional
 };
 
 struct ReferenceRendererOptions {
@@ -62,7 +62,7 @@ class ReferenceRenderer {
 
   Result<ReferenceReport> render(const std::vector<ReferenceObject>& objects,
                                  const render::Camera& camera, const render::Lighting& lighting,
-                                 render::RgbaImage& frame);
+                                 RgbaImage& frame);
 
   int width() const;
   int height() const;

@@ -39,7 +39,7 @@
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::simplifier {
@@ -128,7 +128,7 @@ ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorM
                             double maxAngularError);
 
 struct SimpleImpostor {
-  render::RgbaImage texture;  // textureSize^2, transparent background
+  RgbaImage texture;  // textureSize^2, transparent background
   ImpostorQuad quad;
   ImpostorFraming framing;
   ConicRange validity;
@@ -144,7 +144,7 @@ struct DepthMeshStats {
 
 // Gives transparent texels near covered ones the mean colour of their covered
 // 8-neighbours, `pixels` rings deep; alpha is unchanged.
-void bleedColorIntoTransparent(render::RgbaImage& image, int pixels);
+void bleedColorIntoTransparent(RgbaImage& image, int pixels);
 
 // Builds the depth mesh from a top-down window-depth buffer (1 = background)
 // rendered with `framing.camera`. Vertices in object space with uvs into the
@@ -153,7 +153,7 @@ Result<IndexedMesh> buildDepthMesh(const std::vector<float>& depth, const Impost
                                    const MeshedImpostorOptions& options, DepthMeshStats* stats);
 
 struct MeshedImpostor {
-  render::RgbaImage texture;
+  RgbaImage texture;
   IndexedMesh mesh;  // object space, uvs into `texture`, normals facing the viewpoint side
   ImpostorFraming framing;
   ConicRange validity;

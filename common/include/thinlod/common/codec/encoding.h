@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::codec {
@@ -64,12 +65,10 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& mesh,
 Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
                                const DecodeLimits& limits = {});
 
-// --- Textures ---
-struct TextureRGBA8 {
-  std::uint32_t width = 0;
-  std::uint32_t height = 0;
-  std::vector<std::uint8_t> pixels;  // width * height * 4, rows top to bottom
-};
+// --- Textures: thinlod::RgbaImage (rgba_image.h) ---
+// Encoders reject (kInvalidArgument) a zero or negative side, a side longer
+// than 65500 pixels, or pixels.size() != width * height * 4. A decoded image
+// has 1..limits.maxTextureDimension pixels per side and is consistent().
 
 enum class TextureCodec : std::uint8_t { kZstd = 1, kPng = 2, kJpeg = 3 };
 
@@ -95,13 +94,13 @@ struct EncodedTexture {
   std::vector<std::uint8_t> bytes;  // the whole frame
 };
 
-Result<EncodedTexture> encodeTexture(const TextureRGBA8& texture,
+Result<EncodedTexture> encodeTexture(const RgbaImage& texture,
                                      const TextureEncodeOptions& options = {});
 // One codec, no policy (JPEG drops alpha: kInvalidArgument unless opaque).
-Result<std::vector<std::uint8_t>> encodeTextureWith(const TextureRGBA8& texture, TextureCodec codec,
+Result<std::vector<std::uint8_t>> encodeTextureWith(const RgbaImage& texture, TextureCodec codec,
                                                     const TextureEncodeOptions& options = {});
-Result<TextureRGBA8> decodeTexture(const std::uint8_t* data, std::size_t size,
-                                   const DecodeLimits& limits = {});
+Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
+                                const DecodeLimits& limits = {});
 
 // FNV-1a 64 over bytes: the frame's payload checksum (catches corruption on
 // the link, not forgery).

@@ -37,7 +37,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::render {

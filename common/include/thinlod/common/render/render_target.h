@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/render/rgba_image.h"
+#include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::render {
