@@ -562,7 +562,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
         impl_->ensureProgram(gl, variantOf(items[i].material, hasLayers, lighting)));
   }
   THINLOD_RETURN_IF_ERROR(impl_->target->bind());
-  const glm::mat4 viewProjection = camera.projection * camera.view;
+  const glm::mat4 viewProjection = kMirrorClipY * camera.projection * camera.view;
   const glm::vec3 eye = glm::vec3(glm::inverse(camera.view)[3]);
   float lightVectors[kMaxLights * 3] = {0};
   float lightColors[kMaxLights * 3] = {0};
@@ -599,7 +599,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
 
   gl.glEnable(GL_DEPTH_TEST);
   gl.glDepthFunc(GL_LEQUAL);
-  gl.glFrontFace(GL_CCW);
+  gl.glFrontFace(GL_CW);  // CCW triangles of the picture, mirrored by kMirrorClipY
   gl.glCullFace(GL_BACK);
   gl.glActiveTexture(GL_TEXTURE0);
   GLuint boundTexture = 0;

@@ -1,7 +1,6 @@
 #include "thinlod/common/render/render_target.h"
 
 #include <algorithm>
-#include <cstring>
 #include <string>
 
 #include "render/backends.h"
@@ -106,26 +105,14 @@ Status RenderTarget::clear(float r, float g, float b, float a) {
   return checkGlErrors(gl, "RenderTarget::clear");
 }
 
-Status RenderTarget::readPixelsFlipped(unsigned format, unsigned type, std::size_t bytesPerPixel,
-                                       void* dst) {
+Status RenderTarget::readPixels(unsigned format, unsigned type, void* dst) {
   THINLOD_RETURN_IF_ERROR(bind());
   const GlFunctions& gl = context_->gl();
   gl.glPixelStorei(GL_PACK_ALIGNMENT, 1);
   gl.glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  // Bottom-up rows of an upside-down picture: top-down rows of the picture.
   gl.glReadPixels(0, 0, width_, height_, format, type, dst);
-  THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "glReadPixels"));
-  // GL returns rows bottom-up; swap them in place to top-down order.
-  const std::size_t rowBytes = static_cast<std::size_t>(width_) * bytesPerPixel;
-  scratch_.resize(rowBytes);
-  auto* bytes = static_cast<std::uint8_t*>(dst);
-  for (int top = 0, bottom = height_ - 1; top < bottom; ++top, --bottom) {
-    std::uint8_t* a = bytes + static_cast<std::size_t>(top) * rowBytes;
-    std::uint8_t* b = bytes + static_cast<std::size_t>(bottom) * rowBytes;
-    std::memcpy(scratch_.data(), a, rowBytes);
-    std::memcpy(a, b, rowBytes);
-    std::memcpy(b, scratch_.data(), rowBytes);
-  }
-  return Status();
+  return checkGlErrors(gl, "glReadPixels");
 }
 
 Status RenderTarget::readColor(RgbaImage& out) {
@@ -142,7 +129,7 @@ Status RenderTarget::readColor(std::uint8_t* dst, std::size_t dstBytes) {
                                                    std::to_string(dstBytes) + " bytes, need " +
                                                    std::to_string(needed));
   }
-  return readPixelsFlipped(GL_RGBA, GL_UNSIGNED_BYTE, 4, dst);
+  return readPixels(GL_RGBA, GL_UNSIGNED_BYTE, dst);
 }
 
 Status RenderTarget::readDepth(std::vector<float>& out) {
@@ -157,7 +144,7 @@ Status RenderTarget::readDepth(float* dst, std::size_t dstCount) {
                                                    std::to_string(dstCount) + " floats, need " +
                                                    std::to_string(needed));
   }
-  return readPixelsFlipped(GL_DEPTH_COMPONENT, GL_FLOAT, sizeof(float), dst);
+  return readPixels(GL_DEPTH_COMPONENT, GL_FLOAT, dst);
 }
 
 }  // namespace thinlod::render
