@@ -54,13 +54,6 @@ Status checkTexture(const RgbaImage& texture) {
   return Status();
 }
 
-bool isOpaque(const RgbaImage& texture) {
-  for (std::size_t i = 3; i < texture.pixels.size(); i += 4) {
-    if (texture.pixels[i] != 255) return false;
-  }
-  return true;
-}
-
 Result<std::vector<std::uint8_t>> zstdPayload(const RgbaImage& texture, int level) {
   std::vector<std::uint8_t> out(ZSTD_compressBound(texture.pixels.size()));
   const std::size_t written =
@@ -216,7 +209,7 @@ double psnrRgb(const RgbaImage& a, const RgbaImage& b) {
 Result<std::vector<std::uint8_t>> encodeTextureWith(const RgbaImage& texture, TextureCodec codec,
                                                     const TextureEncodeOptions& options) {
   THINLOD_RETURN_IF_ERROR(checkTexture(texture));
-  if (codec == TextureCodec::kJpeg && !isOpaque(texture)) {
+  if (codec == TextureCodec::kJpeg && !texture.opaque()) {
     return textureError(ErrorCode::kInvalidArgument, "JPEG needs an opaque image (alpha 255)");
   }
   try {
@@ -241,7 +234,7 @@ Result<EncodedTexture> encodeTexture(const RgbaImage& texture,
   std::vector<TextureCodec> candidates = {TextureCodec::kZstd};
   if (options.policy != TexturePolicy::kFastest) candidates.push_back(TextureCodec::kPng);
   if (options.policy == TexturePolicy::kSmallest && checkTexture(texture).ok() &&
-      isOpaque(texture)) {
+      texture.opaque()) {
     candidates.push_back(TextureCodec::kJpeg);
   }
   EncodedTexture best;

@@ -34,13 +34,6 @@ std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
          (static_cast<std::uint32_t>(frame[15]) << 24);
 }
 
-bool opaque(const RgbaImage& image) {
-  for (std::size_t i = 3; i < image.pixels.size(); i += 4) {
-    if (image.pixels[i] != 255) return false;
-  }
-  return true;
-}
-
 // Takes the image by value: the raw codec moves its pixels onto the wire.
 Result<protocol::Texture> encodeTexture(RgbaImage image, protocol::TextureCodec requested) {
   protocol::Texture texture;
@@ -56,7 +49,7 @@ Result<protocol::Texture> encodeTexture(RgbaImage image, protocol::TextureCodec 
   if (requested == protocol::TextureCodec::kZstdRgba8) {
     used = codec::TextureCodec::kZstd;
     texture.codec = requested;
-  } else if (requested == protocol::TextureCodec::kJpeg && opaque(image)) {
+  } else if (requested == protocol::TextureCodec::kJpeg && image.opaque()) {
     used = codec::TextureCodec::kJpeg;
     texture.codec = requested;
   }

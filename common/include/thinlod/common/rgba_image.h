@@ -27,6 +27,13 @@ struct RgbaImage {
   RgbaImage(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 4, 0) {}
 
   bool empty() const { return width <= 0 || height <= 0; }
+  // Every alpha is 255 (true for an image without pixels).
+  bool opaque() const {
+    for (std::size_t i = 3; i < pixels.size(); i += 4) {
+      if (pixels[i] != 255) return false;
+    }
+    return true;
+  }
   bool consistent() const {
     return width >= 0 && height >= 0 &&
            pixels.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4;
