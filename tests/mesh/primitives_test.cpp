@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <random>
@@ -353,7 +354,9 @@ TEST(PrimitiveCurves, NeverPromiseMoreThanATessellationDelivers) {
   }
 }
 
-TEST(PrimitiveCurves, OverestimateIsBoundedByStepRatio) {
+// The fit is tight: never more than 10% above the cheapest tessellation that
+// reaches an accuracy (measured 1.06-1.08 with the default 24 segments).
+TEST(PrimitiveCurves, OverestimateIsAtMostTenPercent) {
   PrimitiveCurveOptions options;
   options.maxTriangles = 4096;
   for (const PrimitiveShape& s :
@@ -361,17 +364,26 @@ TEST(PrimitiveCurves, OverestimateIsBoundedByStepRatio) {
         PrimitiveShape::cone(0.5f, 1.0f)}) {
     Result<AccuracyCurve> curve = primitiveAccuracyCurve(s, options);
     ASSERT_TRUE(curve.ok()) << curve.status().toString();
+    EXPECT_LE(curve->segments().size(), static_cast<std::size_t>(options.maxSegments));
     const double lo = curve->minAccuracy();
     const double hi = curve->maxAccuracy();
+    double worst = 0.0;
     for (int k = 0; k <= 400; ++k) {
       const double a = lo * std::pow(hi / lo, k / 400.0);
       Result<TessellationParams> cheapest = tessellationForAccuracy(s, a, options.maxTriangles);
       ASSERT_TRUE(cheapest.ok()) << a;
-      EXPECT_LE(curve->resourcesFor(a),
-                options.stepRatio * tessellationTriangles(s, *cheapest) * (1 + 1e-9))
-          << primitiveKindName(s.kind) << " a=" << a;
+      worst = std::max(worst, curve->resourcesFor(a) / tessellationTriangles(s, *cheapest));
     }
+    std::printf("[ overestimate ] %s: worst %.4f\n", primitiveKindName(s.kind), worst);
+    EXPECT_LE(worst, 1.10) << primitiveKindName(s.kind);
   }
+}
+
+TEST(PrimitiveCurves, ZeroSegmentsIsRejected) {
+  PrimitiveCurveOptions options;
+  options.maxSegments = 0;
+  EXPECT_EQ(primitiveAccuracyCurve(PrimitiveShape::sphere(1.0f), options).status().code(),
+            ErrorCode::kInvalidArgument);
 }
 
 TEST(PrimitiveCurves, CoarsestTessellationStartsTheCurve) {

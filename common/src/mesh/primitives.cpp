@@ -16,7 +16,6 @@ constexpr double kPi = 3.14159265358979323846;
 // Bounds the work a single request can cause (untrusted scene input ends up
 // here through triangle budgets).
 constexpr int kMaxSegments = 1 << 20;
-constexpr double kHuge = std::numeric_limits<double>::infinity();
 
 using dvec3 = glm::dvec3;
 
@@ -242,114 +241,6 @@ IndexedMesh buildBox(const glm::vec3& size) {
     }
   }
   return mb.take();
-}
-
-// A conservative piecewise-linear curve through a ladder of exact
-// (accuracy, resources) points, tight in ratio: it never lies below the
-// staircase S(a) = min{ r_j : a_j >= a } (so it promises nothing a ladder
-// entry does not deliver) and stays within about stepRatio of it.
-//
-// Pareto frontier p_0..p_m (both coordinates strictly increasing). The first
-// segment is the point p_0 itself ([a_0, nextUp(a_0)) costs r_0). Then knots
-// are picked greedily so that resources grow by at most stepRatio within a
-// piece. A piece covering (a_s, a_e] must lie on or above the staircase
-// corners (a_{j-1}, r_j), s < j <= e; for a given slope its start value is
-// the lowest that clears every corner. The slope is flat or one of the
-// corners' upper-hull edges (tangents, tight where the staircase is concave
-// as primitive ladders are), whichever overestimates least in ratio.
-Result<AccuracyCurve> conservativeCurve(std::vector<AccuracySample> samples, double stepRatio) {
-  std::sort(samples.begin(), samples.end(), [](const AccuracySample& x, const AccuracySample& y) {
-    return x.accuracy != y.accuracy ? x.accuracy < y.accuracy : x.resources < y.resources;
-  });
-  std::vector<AccuracySample> frontier;
-  double cheapestAbove = kHuge;
-  for (std::size_t i = samples.size(); i-- > 0;) {
-    if (samples[i].resources < cheapestAbove) {
-      if (!frontier.empty() && frontier.back().accuracy == samples[i].accuracy) {
-        frontier.back() = samples[i];
-      } else {
-        frontier.push_back(samples[i]);
-      }
-      cheapestAbove = samples[i].resources;
-    }
-  }
-  std::reverse(frontier.begin(), frontier.end());
-  const std::size_t m = frontier.size();
-  if (m == 1) return AccuracyCurve::point(frontier[0].accuracy, frontier[0].resources);
-
-  // Corner j: the staircase reaches r_j just after a_{j-1}.
-  auto cornerA = [&](std::size_t j) { return frontier[j - 1].accuracy; };
-  auto cornerR = [&](std::size_t j) { return frontier[j].resources; };
-  // Rounding in later evaluation must not dip below a corner.
-  auto withMargin = [](double r) { return r + 1e-9 * std::max(1.0, r); };
-
-  std::vector<CurveSegment> segments;
-  segments.push_back(CurveSegment{frontier[0].accuracy, frontier[0].resources, 0.0});
-  std::vector<std::size_t> hull;
-  std::size_t start = 0;
-  while (start + 1 < m) {
-    std::size_t end = start + 1;
-    while (end + 1 < m &&
-           frontier[end + 1].resources <= stepRatio * frontier[start + 1].resources) {
-      ++end;
-    }
-    // Upper hull of the corners start+1..end (monotone chain).
-    hull.clear();
-    for (std::size_t j = start + 1; j <= end; ++j) {
-      while (hull.size() >= 2) {
-        const std::size_t o = hull[hull.size() - 2];
-        const std::size_t p = hull.back();
-        const double cross = (cornerA(p) - cornerA(o)) * (cornerR(j) - cornerR(o)) -
-                             (cornerR(p) - cornerR(o)) * (cornerA(j) - cornerA(o));
-        if (cross < 0.0) break;  // right turn: p stays on the upper hull
-        hull.pop_back();
-      }
-      hull.push_back(j);
-    }
-    // Candidate slopes: flat (worst case r_e / r_{s+1} <= stepRatio) and the
-    // hull edges (tangents); keep the one with the smallest worst ratio
-    // line(a_j) / r_j over the piece's steps.
-    const double a0 = std::nextafter(frontier[start].accuracy, kHuge);
-    auto startValue = [&](double slope) {
-      double v = cornerR(start + 1);
-      for (std::size_t j = start + 2; j <= end; ++j) {
-        v = std::max(v, cornerR(j) - slope * (cornerA(j) - a0));
-      }
-      return v;
-    };
-    auto worstRatio = [&](double slope, double v0) {
-      double worst = 0.0;
-      for (std::size_t j = start + 1; j <= end; ++j) {
-        worst = std::max(worst, (v0 + slope * (frontier[j].accuracy - a0)) / frontier[j].resources);
-      }
-      return worst;
-    };
-    double bestSlope = 0.0;
-    double bestV0 = startValue(0.0);
-    double bestWorst = worstRatio(0.0, bestV0);
-    const std::size_t kMaxCandidates = 64;
-    const std::size_t stride = std::max<std::size_t>(1, hull.size() / kMaxCandidates);
-    for (std::size_t h = 0; h + 1 < hull.size(); h += stride) {
-      const double slope =
-          (cornerR(hull[h + 1]) - cornerR(hull[h])) / (cornerA(hull[h + 1]) - cornerA(hull[h]));
-      if (!(slope > 0.0) || !std::isfinite(slope)) continue;
-      const double v0 = startValue(slope);
-      const double worst = worstRatio(slope, v0);
-      if (worst < bestWorst) {
-        bestWorst = worst;
-        bestSlope = slope;
-        bestV0 = v0;
-      }
-    }
-    double v0 = bestV0;
-    const double slope = bestSlope;
-    // No decrease at the knot: at least where the previous piece ended.
-    const CurveSegment& previous = segments.back();
-    v0 = std::max(withMargin(v0), previous.value + previous.slope * (a0 - previous.start));
-    segments.push_back(CurveSegment{a0, v0, slope});
-    start = end;
-  }
-  return AccuracyCurve::fromSegments(std::move(segments), frontier.back().accuracy);
 }
 
 bool positiveFinite(float v) { return std::isfinite(v) && v > 0.0f; }
@@ -598,8 +489,8 @@ Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
     return Status(ErrorCode::kResourceExhausted,
                   "primitive curve: maxTriangles above " + std::to_string(kMaxPrimitiveTriangles));
   }
-  if (!(options.stepRatio > 1.0) || !std::isfinite(options.stepRatio)) {
-    return Status(ErrorCode::kInvalidArgument, "primitive curve: stepRatio must be > 1");
+  if (options.maxSegments < 1) {
+    return Status(ErrorCode::kInvalidArgument, "primitive curve: maxSegments must be >= 1");
   }
   if (s.kind == PrimitiveKind::kBox) return AccuracyCurve::point(kExactRelativeAccuracy, 12.0);
   std::vector<AccuracySample> ladder;
@@ -623,7 +514,7 @@ Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
     }
   }
   if (ladder.empty()) add(chooseTessellation(s, 0));  // budget below the coarsest
-  return conservativeCurve(std::move(ladder), options.stepRatio);
+  return AccuracyCurve::fitConservative(std::move(ladder), options.maxSegments);
 }
 
 }  // namespace thinlod

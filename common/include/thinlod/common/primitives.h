@@ -17,8 +17,10 @@
 //   (a, triangles) points of every tessellation up to maxTriangles: it never
 //   promises more accuracy than a tessellation of that cost has, i.e.
 //   tessellate(shape, chooseTessellation(shape, r(a))) reaches accuracy >= a
-//   with at most r(a) triangles, and r(a) <= stepRatio * (the cheapest
-//   tessellation's triangles that reach a).
+//   with at most r(a) triangles. It is AccuracyCurve::fitConservative over
+//   that ladder, so it is as tight as maxSegments allows: at 24 segments r(a)
+//   is at most 1.08x the cheapest tessellation reaching a (sphere, cylinder,
+//   cone; tests/mesh/primitives_test.cpp).
 // - Invalid shapes (non-finite or non-positive sizes, no parts) are rejected
 //   by validatePrimitive(); other functions assert it.
 // - Pure functions, no I/O, thread-safe.
@@ -87,10 +89,9 @@ IndexedMesh tessellate(const PrimitiveShape& shape, const TessellationParams& pa
 
 struct PrimitiveCurveOptions {
   int maxTriangles = 16384;  // top of the ladder of tessellations
-  // Resources grow by at most this factor within one curve segment, which
-  // bounds the overestimate: r(a) <= stepRatio * cheapest tessellation that
-  // reaches a (25-31 segments up to 16k triangles at 1.25).
-  double stepRatio = 1.25;
+  // Segments of the fitted curve: more is tighter but costs the scheduler
+  // more knots to propagate (worst overestimate 1.04-1.06 at 31, 1.06-1.08 at 24).
+  int maxSegments = 24;
 };
 // Relative accuracy curve, resources in triangles. Box: a point curve at
 // (kExactRelativeAccuracy, 12).
