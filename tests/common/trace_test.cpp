@@ -105,6 +105,12 @@ TEST(Trace, UnknownVersion) {
 // The error names the file's last line (a final newline does not start a line).
 TEST(Trace, NoPoses) { EXPECT_TRUE(failsOnLine(withHeader("# only a comment\n"), 2, "no poses")); }
 
+TEST(Trace, TimesBeyondABillionSecondsAreRejected) {
+  EXPECT_TRUE(failsOnLine(withHeader("1e300 0 0 0 quat 1 0 0 0 60\n"), 2, "outside +-1e9 s"));
+  EXPECT_TRUE(failsOnLine(withHeader("-2e9 0 0 0 quat 1 0 0 0 60\n"), 2, "outside +-1e9 s"));
+  EXPECT_TRUE(parseTrace(withHeader("1e9 0 0 0 quat 1 0 0 0 60\n")).ok());
+}
+
 TEST(Trace, WrongFieldCount) {
   EXPECT_TRUE(failsOnLine(withHeader("0 0 0 0 quat 1 0 0 0 60\n1 0 0 0 lookat 1 1 60\n"), 3,
                           "expected 9 fields"));

@@ -114,6 +114,10 @@ Result<Pose> parsePoseLine(std::size_t line, const std::vector<std::string_view>
     if (!positionStatus.ok()) return positionStatus;
   }
   Pose pose;
+  // Times travel as int64 nanoseconds (ViewerPose.timestampNs): keep them representable.
+  if (!(std::fabs(head[0]) <= kMaxTraceTimeSeconds)) {
+    return lineError(line, "time " + std::string(fields[0]) + " s is outside +-1e9 s");
+  }
   pose.time = head[0];
   pose.position = glm::vec3(head[1], head[2], head[3]);
   const std::string_view keyword = fields[4];

@@ -2,7 +2,7 @@
 // backbone predicts from. Text format in docs/trace-format.md.
 //
 // Contract:
-// - Pose: time in seconds (strictly increasing within a trace), position in
+// - Pose: time in seconds (strictly increasing within a trace, |t| <= 1e9), position in
 //   metres (world frame), orientation camera-to-world (the camera looks down
 //   its -Z axis with +Y up, the OpenGL convention), vertical field of view in
 //   degrees in (0, 180). Everything finite.
@@ -40,6 +40,8 @@ namespace thinlod {
 inline constexpr int kTraceVersion = 1;
 inline constexpr std::size_t kMaxTraceFileBytes = std::size_t{256} << 20;
 inline constexpr std::size_t kMaxTraceLineBytes = 4096;
+// |time| bound: nanoseconds of it fit in int64 with room to spare.
+inline constexpr double kMaxTraceTimeSeconds = 1e9;
 
 struct Pose {
   double time = 0.0;                              // seconds
