@@ -12,6 +12,7 @@
 // - Value type: copy/move freely, no thread affinity.
 #pragma once
 
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,7 +25,9 @@ struct RgbaImage {
   std::vector<std::uint8_t> pixels;  // top-down rows, RGBA8
 
   RgbaImage() = default;
-  RgbaImage(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 4, 0) {}
+  // Precondition: w, h >= 0 (sizes from outside are checked before this).
+  RgbaImage(int w, int h)
+      : width(w), height(h), pixels(static_cast<std::size_t>(checkedSide(w)) * checkedSide(h) * 4, 0) {}
 
   bool empty() const { return width <= 0 || height <= 0; }
   // Every alpha is 255 (true for an image without pixels).
@@ -44,6 +47,12 @@ struct RgbaImage {
   }
   const std::uint8_t* at(int x, int y) const {
     return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+  }
+
+ private:
+  static int checkedSide(int side) {
+    assert(side >= 0 && "RgbaImage: negative size");
+    return side < 0 ? 0 : side;  // release builds: an empty image, not a huge allocation
   }
 };
 
