@@ -314,6 +314,45 @@ TEST(TraceStream, ABadPoseLineIsReportedAndSkippedAndLaterLinesStillCount) {
   EXPECT_FALSE(parser.failed());
 }
 
+TEST(TraceStream, StopAtFirstErrorKeepsOneErrorHoweverManyBadLines) {
+  TraceStreamParser::Options options;
+  options.stopAtFirstError = true;
+  TraceStreamParser parser(options);
+  TraceStreamParser::Output out;
+  std::string text = withHeader("0 0 0 0 quat 1 0 0 0 60\n");
+  for (int i = 0; i < 10000; ++i) text += "x\n";
+  parser.feed(text, out);
+  parser.finish(out);
+  ASSERT_EQ(out.errors.size(), 1u);
+  EXPECT_NE(out.errors[0].message().find("line 3:"), std::string::npos);
+  EXPECT_TRUE(parser.failed());
+  EXPECT_EQ(parser.lines(), 3u);  // nothing read after the error
+}
+
+TEST(TraceStream, ABogusFutureTimeIsRejectedAndASustainedJumpAccepted) {
+  TraceStreamParser::Options options;
+  options.maxTimeJumpSeconds = 10.0;
+  options.maxJumpRejections = 3;
+  TraceStreamParser parser(options);
+  TraceStreamParser::Output out;
+  std::string text = withHeader("1 0 0 0 quat 1 0 0 0 60\n"
+                                "1e9 0 0 0 quat 1 0 0 0 60\n"  // line 3: bogus jump
+                                "2 0 0 0 quat 1 0 0 0 60\n");  // still accepted
+  for (int i = 0; i < 4; ++i) {  // a real jump: 3 rejections, then accepted
+    text += std::to_string(1000 + i) + " 0 0 0 quat 1 0 0 0 60\n";
+  }
+  parser.feed(text, out);
+  ASSERT_EQ(out.errors.size(), 4u);
+  EXPECT_NE(out.errors[0].message().find("line 3: time 1000000000 jumps more than 10 s"),
+            std::string::npos)
+      << out.errors[0].message();
+  ASSERT_EQ(out.poses.size(), 3u);
+  EXPECT_EQ(out.poses[0].time, 1.0);
+  EXPECT_EQ(out.poses[1].time, 2.0);
+  EXPECT_EQ(out.poses[2].time, 1003.0);
+  EXPECT_FALSE(parser.failed());
+}
+
 TEST(TraceStream, ABadHeaderRejectsTheWholeStream) {
   TraceStreamParser parser;
   TraceStreamParser::Output out;

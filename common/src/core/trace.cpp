@@ -199,7 +199,7 @@ glm::quat lookAtOrientation(const glm::vec3& position, const glm::vec3& target) 
 
 void TraceStreamParser::feed(std::string_view bytes, Output& out) {
   std::size_t position = 0;
-  while (position < bytes.size()) {
+  while (position < bytes.size() && !failed_) {
     const std::size_t newline = bytes.find('\n', position);
     const std::size_t end = newline == std::string_view::npos ? bytes.size() : newline;
     const std::string_view piece = bytes.substr(position, end - position);
@@ -221,6 +221,11 @@ void TraceStreamParser::finish(Output& out) {
   if (!partial_.empty() || overlong_) completeLine(out);
 }
 
+void TraceStreamParser::reject(Status error, Output& out) {
+  out.errors.push_back(std::move(error));
+  if (options_.stopAtFirstError) failed_ = true;
+}
+
 void TraceStreamParser::completeLine(Output& out) {
   ++lines_;
   const bool overlong = overlong_;
@@ -229,8 +234,8 @@ void TraceStreamParser::completeLine(Output& out) {
   line.swap(partial_);
   if (failed_) return;
   if (overlong) {
-    out.errors.push_back(lineError(lines_, "line longer than " +
-                                               std::to_string(kMaxTraceLineBytes) + " bytes"));
+    reject(lineError(lines_, "line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes"),
+           out);
     if (!sawHeader_) failed_ = true;
     return;
   }
@@ -251,23 +256,35 @@ void TraceStreamParser::completeLine(Output& out) {
   if (content.empty()) return;
   Result<Pose> pose = parsePoseLine(lines_, splitFields(content));
   if (!pose.ok()) {
-    out.errors.push_back(pose.status());
+    reject(pose.status(), out);
     return;
   }
   if (lastTime_ && !(pose->time > *lastTime_)) {
     char buffer[96];
     std::snprintf(buffer, sizeof(buffer), "time %.17g is not after the previous pose's %.17g",
                   pose->time, *lastTime_);
-    out.errors.push_back(lineError(lines_, buffer));
+    reject(lineError(lines_, buffer), out);
     return;
   }
+  if (lastTime_ && pose->time - *lastTime_ > options_.maxTimeJumpSeconds &&
+      ++jumpRejections_ <= options_.maxJumpRejections) {
+    char buffer[128];
+    std::snprintf(buffer, sizeof(buffer),
+                  "time %.17g jumps more than %g s past the previous pose's %.17g", pose->time,
+                  options_.maxTimeJumpSeconds, *lastTime_);
+    reject(lineError(lines_, buffer), out);
+    return;
+  }
+  jumpRejections_ = 0;
   lastTime_ = pose->time;
   out.poses.push_back(*pose);
 }
 
 Result<Trace> parseTrace(std::string_view text) {
-  // The stream parser, fed everything at once; the first error wins.
-  TraceStreamParser parser;
+  // The stream parser, fed everything at once; the first error ends it.
+  TraceStreamParser::Options options;
+  options.stopAtFirstError = true;
+  TraceStreamParser parser(options);
   TraceStreamParser::Output out;
   parser.feed(text, out);
   parser.finish(out);

@@ -18,7 +18,8 @@
 //   source): each completed line is checked as parseTrace() would; a bad
 //   pose line is reported and skipped and later lines still count; a bad
 //   header (or an over-long first line) rejects the rest of the stream.
-//   Lines over kMaxTraceLineBytes are errors and are not buffered.
+//   Lines over kMaxTraceLineBytes are errors and are not buffered. Options
+//   (below) stop at the first error, and bound forward time jumps.
 // - samplePose() interpolates (position and fov linearly, orientation by
 //   slerp) and clamps outside the trace's time span.
 // - No globals; everything is thread-safe on distinct objects.
@@ -28,6 +29,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -71,6 +73,20 @@ Result<Trace> parseTrace(std::string_view text);
 
 class TraceStreamParser {
  public:
+  struct Options {
+    // Stop at the first error (a file: parseTrace), instead of reporting and
+    // skipping bad lines (a live stream).
+    bool stopAtFirstError = false;
+    // A pose more than this many seconds after the previous accepted one is
+    // rejected, so one bogus future time cannot make every later pose "not
+    // after" it; after maxJumpRejections such rejections in a row the jump
+    // is taken as real and accepted. Times never go backwards.
+    double maxTimeJumpSeconds = std::numeric_limits<double>::infinity();
+    int maxJumpRejections = 10;
+  };
+  TraceStreamParser() = default;
+  explicit TraceStreamParser(const Options& options) : options_(options) {}
+
   struct Output {
     std::vector<Pose> poses;    // in order, times strictly increasing
     std::vector<Status> errors;  // kParseError / kVersionMismatch, "line N: ..."
@@ -80,10 +96,14 @@ class TraceStreamParser {
   // End of input: parses a last line without a newline.
   void finish(Output& out);
   std::size_t lines() const { return lines_; }  // completed lines so far
-  bool failed() const { return failed_; }       // the header was bad: nothing more is read
+  // Nothing more is read: the header was bad (or, with stopAtFirstError, any line).
+  bool failed() const { return failed_; }
 
  private:
   void completeLine(Output& out);
+  void reject(Status error, Output& out);
+  Options options_;
+  int jumpRejections_ = 0;
   std::string partial_;
   bool overlong_ = false;
   bool sawHeader_ = false;
