@@ -29,6 +29,24 @@ TEST(DaemonOptions, TraceIsRequired) {
   expectRejected(options, "trace");
 }
 
+TEST(DaemonOptions, ExactlyOneOfTraceAndPoseStream) {
+  DaemonOptions options = validOptions();
+  options.poseStreamPath = "-";
+  expectRejected(options, "trace");  // both
+  options.tracePath.clear();
+  EXPECT_TRUE(validateOptions(options).ok());
+}
+
+TEST(DaemonOptions, APoseStreamCannotBeUnpaced) {
+  DaemonOptions options = validOptions();
+  options.tracePath.clear();
+  options.poseStreamPath = "poses.fifo";
+  options.rate = -1.0;
+  expectRejected(options, "rate");
+  options.rate = 30.0;
+  EXPECT_TRUE(validateOptions(options).ok());
+}
+
 TEST(DaemonOptions, SceneIsRequiredOnlyForTheReference) {
   DaemonOptions options = validOptions();
   options.scenePath.clear();

@@ -412,14 +412,26 @@ TEST(FrontendProcess, FollowsALivePoseStreamFromAFifoSkippingABadLine) {
   ASSERT_GE(writer, 0);
   auto send = [&](const std::string& text) {
     ASSERT_EQ(::write(writer, text.data(), text.size()), static_cast<ssize_t>(text.size()));
-    std::this_thread::sleep_for(150ms);  // each pose its own frame
   };
-  send("# thinlod-trace 1\n");
-  send("0.0 2 1.5 4.8 lookat 2 0.4 1.6 60\n");
+  // Each pose is written once the previous one has its CSV row, so no pose
+  // overtakes another however slow the machine is.
+  auto waitForRows = [&](std::size_t rows) {
+    std::vector<std::string> ignored;
+    const auto end = std::chrono::steady_clock::now() + kProcessDeadline;
+    while (std::chrono::steady_clock::now() < end && readCsv(csv, &ignored).size() < rows) {
+      std::this_thread::sleep_for(10ms);
+    }
+    ASSERT_EQ(readCsv(csv, &ignored).size(), rows) << readFile(dir + "/frontend.log");
+  };
+  send("# thinlod-trace 1\n0.0 2 1.5 4.8 lookat 2 0.4 1.6 60\n");
+  waitForRows(1);
   send("0.1 2 1.5 4.7 lookat 2 0.4 1.6 60\n");
+  waitForRows(2);
   send("0.2 2 1.5 nan lookat 2 0.4 1.6 60\n");  // line 4: rejected, skipped
   send("0.3 2 1.5 4.6 look");                     // a pose in two writes
+  std::this_thread::sleep_for(50ms);
   send("at 2 0.4 1.6 60\n");
+  waitForRows(3);
   ::close(writer);  // end of stream: the frontend finishes
   const int exitCode = process.waitExit([] { std::this_thread::sleep_for(10ms); });
   const std::string log = readFile(dir + "/frontend.log");

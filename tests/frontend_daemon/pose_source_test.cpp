@@ -3,6 +3,8 @@
 #include "pose_source.h"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <string>
@@ -31,6 +33,19 @@ class Pipe {
   int fds_[2] = {-1, -1};
 };
 
+// A source reading a dup of the pipe's read end, stamping arrivals with `clockNs`.
+std::unique_ptr<StreamPoseSource> sourceOn(const Pipe& pipe, std::vector<std::string>* errors,
+                                           const std::int64_t* clockNs = nullptr) {
+  StreamPoseSource::Options options;
+  options.nowNs = [clockNs] { return clockNs != nullptr ? *clockNs : std::int64_t{0}; };
+  if (errors != nullptr) {
+    options.onError = [errors](const Status& s) { errors->push_back(s.message()); };
+  }
+  auto source = StreamPoseSource::create(::dup(pipe.reader()), std::move(options));
+  EXPECT_TRUE(source.ok()) << source.status().toString();
+  return source.ok() ? std::move(source).value() : nullptr;
+}
+
 std::string poseLine(double t) {
   return std::to_string(t) + " 1 2 3 lookat 0 0 0 60\n";
 }
@@ -38,7 +53,9 @@ std::string poseLine(double t) {
 TEST(StreamPoseSource, PosesBecomeReadyOnlyWhenTheirLineIsComplete) {
   Pipe pipe;
   std::vector<std::string> errors;
-  StreamPoseSource source(pipe.reader(), [&](const Status& s) { errors.push_back(s.message()); });
+  auto owned = sourceOn(pipe, &errors);
+  ASSERT_NE(owned, nullptr);
+  StreamPoseSource& source = *owned;
   source.refresh();
   EXPECT_FALSE(source.ready());
   EXPECT_FALSE(source.ended());  // nothing yet, but the writer is still there
@@ -58,11 +75,17 @@ TEST(StreamPoseSource, PosesBecomeReadyOnlyWhenTheirLineIsComplete) {
 
 TEST(StreamPoseSource, TheNewestPoseWinsAndOlderOnesAreCountedAsSkipped) {
   Pipe pipe;
-  StreamPoseSource source(pipe.reader(), nullptr);
+  std::int64_t clockNs = 0;
+  auto owned = sourceOn(pipe, nullptr, &clockNs);
+  ASSERT_NE(owned, nullptr);
+  StreamPoseSource& source = *owned;
   pipe.write("# thinlod-trace 1\n" + poseLine(1) + poseLine(2) + poseLine(3));
+  clockNs = 500;
   source.refresh();
   ASSERT_TRUE(source.ready());
+  clockNs = 900;  // taken later: the stamp is the arrival, not the take
   EXPECT_EQ(source.take().time, 3.0);
+  EXPECT_EQ(source.lastArrivalNs(), std::optional<std::int64_t>(500));
   EXPECT_EQ(source.skipped(), 2u);
   EXPECT_EQ(source.received(), 3u);
 }
@@ -70,7 +93,9 @@ TEST(StreamPoseSource, TheNewestPoseWinsAndOlderOnesAreCountedAsSkipped) {
 TEST(StreamPoseSource, BadLinesAreReportedAndSkippedThenEndOfStreamEndsIt) {
   Pipe pipe;
   std::vector<std::string> errors;
-  StreamPoseSource source(pipe.reader(), [&](const Status& s) { errors.push_back(s.message()); });
+  auto owned = sourceOn(pipe, &errors);
+  ASSERT_NE(owned, nullptr);
+  StreamPoseSource& source = *owned;
   pipe.write("# thinlod-trace 1\n" + poseLine(1) + "2 1 2 inf lookat 0 0 0 60\n" + poseLine(0.5));
   source.refresh();
   ASSERT_EQ(errors.size(), 2u);
@@ -91,13 +116,99 @@ TEST(StreamPoseSource, BadLinesAreReportedAndSkippedThenEndOfStreamEndsIt) {
 TEST(StreamPoseSource, ABadHeaderEndsTheStream) {
   Pipe pipe;
   std::vector<std::string> errors;
-  StreamPoseSource source(pipe.reader(), [&](const Status& s) { errors.push_back(s.message()); });
+  auto owned = sourceOn(pipe, &errors);
+  ASSERT_NE(owned, nullptr);
+  StreamPoseSource& source = *owned;
   pipe.write("0 1 2 3 lookat 0 0 0 60\n" + poseLine(1));
   source.refresh();
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_NE(errors[0].find("line 1: missing header"), std::string::npos);
   EXPECT_FALSE(source.ready());
   EXPECT_TRUE(source.ended());
+}
+
+TEST(StreamPoseSource, AFloodIsReadInBoundedSlicesAndTheDescriptorIsDroppedAtTheEnd) {
+  Pipe pipe;
+  auto owned = sourceOn(pipe, nullptr);
+  ASSERT_NE(owned, nullptr);
+  StreamPoseSource& source = *owned;
+  std::string flood = "# thinlod-trace 1\n";
+  while (flood.size() < 60000) flood += "x\n";  // under the pipe's 64 KiB buffer
+  pipe.write(flood);
+  source.refresh();
+  const std::size_t afterOne = source.rejectedLines();
+  EXPECT_GT(afterOne, 0u);
+  EXPECT_LE(afterOne, StreamPoseSource::kMaxReadPerRefresh / 2);
+  for (int i = 0; i < 10; ++i) source.refresh();
+  EXPECT_EQ(source.rejectedLines(), (flood.size() - 18) / 2);
+  EXPECT_GE(source.wakeFd(), 0);
+  pipe.closeWriter();
+  source.refresh();
+  EXPECT_TRUE(source.ended());
+  EXPECT_EQ(source.wakeFd(), -1);  // nothing left to wait on: no spinning on the hang-up
+}
+
+TEST(StreamPoseSource, AFifoWaitsOutAWriterThatLeavesWithoutWriting) {
+  const std::string dir = ::testing::TempDir();
+  const std::string fifo = dir + "thinlod_pose_fifo_" + std::to_string(::getpid());
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  auto opened = StreamPoseSource::open(fifo, std::move(options));
+  ASSERT_TRUE(opened.ok()) << opened.status().toString();
+  StreamPoseSource& source = **opened;
+  source.refresh();
+  EXPECT_FALSE(source.ended());  // no writer yet
+  const int idle = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+  ASSERT_GE(idle, 0);
+  ::close(idle);  // a writer that leaves without writing
+  source.refresh();
+  EXPECT_FALSE(source.ended());
+  EXPECT_GE(source.wakeFd(), 0);
+  const int writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+  ASSERT_GE(writer, 0);
+  const std::string text = "# thinlod-trace 1\n" + poseLine(1);
+  ASSERT_EQ(::write(writer, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(writer);
+  source.refresh();
+  ASSERT_TRUE(source.ready());
+  EXPECT_EQ(source.take().time, 1.0);
+  source.refresh();
+  EXPECT_TRUE(source.ended());
+  ::unlink(fifo.c_str());
+}
+
+TEST(StreamPoseSource, StandardInputIsReopenedSoTheCallersStaysBlocking) {
+  // Stdin is a (blocking) pipe for this test, whatever the runner gave us.
+  Pipe pipe;
+  const int savedStdin = ::dup(STDIN_FILENO);
+  ASSERT_GE(::dup2(pipe.reader(), STDIN_FILENO), 0);
+  ASSERT_EQ(::fcntl(STDIN_FILENO, F_GETFL) & O_NONBLOCK, 0);
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  auto opened = StreamPoseSource::open("-", std::move(options));
+  const int flagsAfter = ::fcntl(STDIN_FILENO, F_GETFL);
+  if (savedStdin >= 0) {
+    ::dup2(savedStdin, STDIN_FILENO);
+    ::close(savedStdin);
+  } else {
+    ::close(STDIN_FILENO);
+  }
+  ASSERT_TRUE(opened.ok()) << opened.status().toString();
+  EXPECT_EQ(flagsAfter & O_NONBLOCK, 0);  // the shared description was not touched
+  pipe.write("# thinlod-trace 1\n" + poseLine(2));
+  (*opened)->refresh();
+  ASSERT_TRUE((*opened)->ready());  // and the source reads the same pipe
+  EXPECT_EQ((*opened)->take().time, 2.0);
+}
+
+TEST(StreamPoseSource, AMissingPathIsAnIoError) {
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  auto opened = StreamPoseSource::open("/nonexistent/poses", std::move(options));
+  EXPECT_EQ(opened.status().code(), ErrorCode::kIoError);
+  EXPECT_NE(opened.status().message().find("/nonexistent/poses"), std::string::npos);
 }
 
 TEST(TracePoseSource, GivesEveryPoseInOrderWithItsDueTime) {

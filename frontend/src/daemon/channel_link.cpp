@@ -46,8 +46,16 @@ Status ChannelLink::send(const protocol::Message& message) { return channel_->se
 
 std::uint64_t ChannelLink::bytesReceived() const { return channel_->stats().bytesIn; }
 
-void ChannelLink::drain(std::chrono::milliseconds timeout) {
-  if (timeout.count() > 0) poller_.wait(timeout);
+void ChannelLink::drain(std::chrono::milliseconds timeout, int wakeFd) {
+  if (timeout.count() > 0) {
+    if (wakeFd < 0) {
+      poller_.wait(timeout);
+    } else {
+      protocol::Poller withFd = poller_;  // a few pointers and descriptors
+      withFd.addFd(wakeFd);
+      withFd.wait(timeout);
+    }
+  }
   for (protocol::ChannelEvent& event : channel_->poll(std::chrono::milliseconds(0))) {
     switch (event.kind) {
       case protocol::ChannelEvent::Kind::kConnected:
@@ -72,8 +80,9 @@ void ChannelLink::drain(std::chrono::milliseconds timeout) {
   }
 }
 
-std::vector<protocol::SceneUpdate> ChannelLink::poll(std::chrono::milliseconds timeout) {
-  drain(timeout);
+std::vector<protocol::SceneUpdate> ChannelLink::poll(std::chrono::milliseconds timeout,
+                                                     int wakeFd) {
+  drain(timeout, wakeFd);
   return std::exchange(received_, {});
 }
 

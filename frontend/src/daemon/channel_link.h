@@ -25,7 +25,8 @@ class ChannelLink final : public BackboneLink {
 
   bool connected() const override;
   Status send(const protocol::Message& message) override;
-  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout) override;
+  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout,
+                                          int wakeFd = -1) override;
   std::uint64_t bytesReceived() const override;
 
   // Polls until the handshake is done, `timeout` passes or stop() is true,
@@ -33,12 +34,10 @@ class ChannelLink final : public BackboneLink {
   // are kept for the next poll(). True when connected.
   bool waitConnected(std::chrono::milliseconds timeout, std::chrono::milliseconds progressEvery,
                      const std::function<bool()>& stop);
-  // poll() also wakes when `fd` is readable (e.g. a live pose stream).
-  void wakeOn(int fd) { poller_.addFd(fd); }
 
  private:
   explicit ChannelLink(std::unique_ptr<protocol::Channel> channel, int wakeFd);
-  void drain(std::chrono::milliseconds timeout);
+  void drain(std::chrono::milliseconds timeout, int wakeFd = -1);
 
   std::unique_ptr<protocol::Channel> channel_;
   protocol::Poller poller_;

@@ -69,6 +69,10 @@ Status validateOptions(const DaemonOptions& o) {
   if (o.height < 1 || o.height > 16384) return invalid("height", "outside 1..16384");
   if (!parseBackend(o.backend).ok()) return parseBackend(o.backend).status();
   if (!std::isfinite(o.rate)) return invalid("rate", "not finite");
+  if (!o.poseStreamPath.empty() && o.rate < 0.0) {
+    return invalid("rate", "unpaced (negative) with --pose-stream would redraw the last pose "
+                           "back to back; use 0 (a frame per pose) or a positive rate");
+  }
   if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
   if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");
   if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");

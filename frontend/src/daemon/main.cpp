@@ -4,14 +4,10 @@
 // run summary (docs/frontend.md, "Daemon"). Exits 0 at the end of the trace or
 // stream or on SIGINT/SIGTERM (outputs written either way), 1 on a setup or
 // rendering failure, 2 on bad options.
-#include <fcntl.h>
 #include <spdlog/spdlog.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cerrno>
+#include <chrono>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -33,22 +29,36 @@ namespace {
 
 constexpr std::uint64_t kProgressEveryFrames = 10;
 
-// Closes the descriptor it holds.
-class UniqueFd {
+// A live pose stream may reject every line it sends: log the first few
+// rejections in full, then at most one count per second, so an untrusted
+// stream cannot flood the log from the render loop.
+class RejectionLog {
  public:
-  UniqueFd() = default;
-  UniqueFd(const UniqueFd&) = delete;
-  UniqueFd& operator=(const UniqueFd&) = delete;
-  ~UniqueFd() { reset(-1); }
-  void reset(int fd) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = fd;
+  void add(const Status& error) {
+    ++total_;
+    if (total_ <= kLoggedInFull) {
+      spdlog::warn("event=pose_rejected action=skipped error=\"{}\"", error.toString());
+      return;
+    }
+    ++unlogged_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - lastSummary_ < std::chrono::seconds(1)) return;
+    spdlog::warn("event=pose_rejected action=skipped count={} total={} last_error=\"{}\"",
+                 unlogged_, total_, error.toString());
+    unlogged_ = 0;
+    lastSummary_ = now;
   }
-  int get() const { return fd_; }
 
  private:
-  int fd_ = -1;
+  static constexpr std::size_t kLoggedInFull = 10;
+  std::size_t total_ = 0;
+  std::size_t unlogged_ = 0;
+  std::chrono::steady_clock::time_point lastSummary_{};
 };
+
+// A live stream's pose may move its time at most this far ahead at once
+// (several in a row are taken as a real jump; TraceStreamParser::Options).
+constexpr double kMaxPoseStreamJumpSeconds = 60.0;
 
 // Logs, the CSV and the PNG dumps, frame by frame.
 class DaemonObserver final : public ReplayObserver {
@@ -119,10 +129,11 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     return 2;
   }
   // Poses: a trace loaded whole, or a live stream read as it arrives.
+  SteadyClock clock;
   Trace trace;
   std::unique_ptr<PoseSource> source;
   StreamPoseSource* stream = nullptr;
-  UniqueFd streamFd;
+  RejectionLog rejections;
   if (!options.tracePath.empty()) {
     Result<Trace> loaded = loadTraceFile(options.tracePath);
     if (!loaded.ok()) {
@@ -132,24 +143,19 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     trace = std::move(loaded).value();
     source = std::make_unique<TracePoseSource>(trace);
   } else {
-    const bool standardInput = options.poseStreamPath == "-";
-    streamFd.reset(standardInput ? ::dup(STDIN_FILENO)
-                                 : ::open(options.poseStreamPath.c_str(), O_RDONLY | O_NONBLOCK));
-    if (streamFd.get() < 0) {
+    StreamPoseSource::Options streamOptions;
+    streamOptions.parser.maxTimeJumpSeconds = kMaxPoseStreamJumpSeconds;
+    streamOptions.nowNs = [&clock] { return clock.nowNs(); };
+    streamOptions.onError = [&rejections](const Status& error) { rejections.add(error); };
+    Result<std::unique_ptr<StreamPoseSource>> live =
+        StreamPoseSource::open(options.poseStreamPath, std::move(streamOptions));
+    if (!live.ok()) {
       spdlog::error("event=pose_stream_failed path={} error=\"{}\"", options.poseStreamPath,
-                    std::strerror(errno));
+                    live.status().toString());
       return 1;
     }
-    struct stat info {};
-    const bool fifo = ::fstat(streamFd.get(), &info) == 0 && S_ISFIFO(info.st_mode);
-    auto live = std::make_unique<StreamPoseSource>(
-        streamFd.get(),
-        [](const Status& error) {
-          spdlog::warn("event=pose_rejected action=skipped error=\"{}\"", error.toString());
-        },
-        /*waitForWriter=*/fifo && !standardInput);
-    stream = live.get();
-    source = std::move(live);
+    stream = live->get();
+    source = std::move(live).value();
   }
 
   std::optional<LoadedScene> scene;
@@ -228,7 +234,6 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     spdlog::warn("event=backbone_unavailable address={} waited_ms={} action=replay_anyway",
                  options.backboneAddress, options.connectTimeoutMs);
   }
-  if (stream != nullptr) (*link)->wakeOn(streamFd.get());
   spdlog::info(
       "event=ready address={} connected={} trace={} poses={} pose_stream={} lockstep={} "
       "reference={}",
@@ -245,7 +250,6 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   replay.viewportHeight = static_cast<std::uint32_t>(options.height);
   if (scene) replay.conversion.meshColors = &scene->meshColors;
 
-  SteadyClock clock;
   DaemonObserver observer(csv.get(), **producer, options);
   ReplayResult result = runReplay(*source, replay, clock, **link, **producer, observer, stop);
 

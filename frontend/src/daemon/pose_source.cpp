@@ -1,6 +1,7 @@
 #include "pose_source.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -10,60 +11,105 @@
 #include <utility>
 
 namespace thinlod::frontend::daemon {
+namespace {
+
+Status ioError(const std::string& what) {
+  return Status(ErrorCode::kIoError, "pose stream: " + what + ": " + std::strerror(errno));
+}
+
+}  // namespace
 
 std::optional<std::int64_t> TracePoseSource::dueOffsetNs() const {
   if (!ready()) return std::nullopt;
-  return std::llround((trace_.poses[next_].time - trace_.poses.front().time) * 1e9);
+  return secondsToNanoseconds(trace_.poses[next_].time - trace_.poses.front().time);
 }
 
-StreamPoseSource::StreamPoseSource(int fd, std::function<void(const Status&)> onError,
-                                   bool waitForWriter)
-    : fd_(fd), onError_(std::move(onError)), waitForWriter_(waitForWriter) {
-  const int flags = ::fcntl(fd_, F_GETFL);
-  if (flags >= 0) (void)::fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
+Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::create(int fd, Options options) {
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) {
+    Status error = ioError("making reads non-blocking");
+    ::close(fd);
+    return error;
+  }
+  return std::unique_ptr<StreamPoseSource>(new StreamPoseSource(fd, std::move(options)));
+}
+
+Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::open(const std::string& path,
+                                                                 Options options) {
+  // A fresh open file description of stdin: O_NONBLOCK on a dup() would
+  // change the description the caller (and its pipeline) shares.
+  const std::string file = path == "-" ? "/proc/self/fd/0" : path;
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return ioError("opening " + path);
+  struct stat info {};
+  if (path != "-" && ::fstat(fd, &info) == 0 && S_ISFIFO(info.st_mode)) options.fifoPath = path;
+  return create(fd, std::move(options));
+}
+
+StreamPoseSource::StreamPoseSource(int fd, Options options)
+    : fd_(fd), options_(std::move(options)), parser_(options_.parser) {}
+
+StreamPoseSource::~StreamPoseSource() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void StreamPoseSource::reopenFifo() {
+  const int fd = ::open(options_.fifoPath.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    if (options_.onError) options_.onError(ioError("reopening " + options_.fifoPath));
+    eof_ = true;
+    return;
+  }
+  ::close(fd_);
+  fd_ = fd;
 }
 
 void StreamPoseSource::refresh() {
   if (eof_ || parser_.failed()) return;
   char buffer[4096];
   TraceStreamParser::Output out;
-  // Bounded per call, so a flood of input cannot hold up a frame.
-  for (int reads = 0; reads < 64; ++reads) {
+  std::size_t readBytes = 0;
+  while (readBytes < kMaxReadPerRefresh) {
     const ssize_t n = ::read(fd_, buffer, sizeof(buffer));
     if (n > 0) {
       gotData_ = true;
+      readBytes += static_cast<std::size_t>(n);
       parser_.feed(std::string_view(buffer, static_cast<std::size_t>(n)), out);
       continue;
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
-    if (n == 0 && waitForWriter_ && !gotData_) break;  // no writer has come yet
-    if (n < 0) {
-      out.errors.push_back(
-          Status(ErrorCode::kIoError, std::string("pose stream: read: ") + std::strerror(errno)));
+    if (n == 0 && !gotData_ && !options_.fifoPath.empty()) {
+      // No writer yet, or one that left without writing: keep waiting for
+      // one; a fresh open clears the hang-up a departed writer leaves.
+      reopenFifo();
+      break;
     }
+    if (n < 0) out.errors.push_back(ioError("read"));
     parser_.finish(out);
     eof_ = true;
     break;
   }
-  absorb(out);
+  absorb(out, options_.nowNs());
 }
 
-void StreamPoseSource::absorb(TraceStreamParser::Output& out) {
+void StreamPoseSource::absorb(TraceStreamParser::Output& out, std::int64_t arrivalNs) {
   for (const Status& error : out.errors) {
     if (error.code() != ErrorCode::kIoError) ++rejectedLines_;
-    if (onError_) onError_(error);
+    if (options_.onError) options_.onError(error);
   }
   received_ += out.poses.size();
   for (Pose& pose : out.poses) {
     if (newest_) ++skipped_;
     newest_ = std::move(pose);
+    newestArrivalNs_ = arrivalNs;
   }
 }
 
 Pose StreamPoseSource::take() {
   Pose pose = *newest_;
   newest_.reset();
+  lastArrivalNs_ = newestArrivalNs_;
   return pose;
 }
 

@@ -25,7 +25,7 @@ protocol::ViewerPose wirePose(const Pose& pose, std::uint64_t sequence,
                               const ReplayOptions& options) {
   protocol::ViewerPose wire;
   wire.sequence = sequence;
-  wire.timestampNs = std::llround(pose.time * kNsPerS);
+  wire.timestampNs = secondsToNanoseconds(pose.time);
   wire.position = pose.position;
   wire.orientation = glm::normalize(pose.orientation);
   wire.fovY = pose.fovYRadians();
@@ -86,8 +86,9 @@ class Replay {
       if (!fresh) ++result_.framesRedrawingAPose;
       poseSentNs_.push_back(-1);
       answered_.push_back(false);
-      const std::int64_t sampledNs = clock_.nowNs();
-      const std::int64_t sentNs = fresh ? sendPose(pose, i) : sampledNs;
+      const std::int64_t sampledNs =
+          fresh ? source_.lastArrivalNs().value_or(clock_.nowNs()) : clock_.nowNs();
+      const std::int64_t sentNs = fresh ? sendPose(pose, i) : clock_.nowNs();
       absorb(link_.poll(std::chrono::milliseconds(0)));
       if (options_.lockstep && extras_.poseSent) {
         waitUntil(sentNs + options_.lockstepTimeout.count() * 1'000'000LL,
@@ -140,7 +141,9 @@ class Replay {
       if (now >= deadlineNs) return;
       const std::int64_t remainingMs = (deadlineNs - now + 999'999) / 1'000'000;
       absorb(link_.poll(std::chrono::milliseconds(
-          std::min<std::int64_t>(remainingMs, options_.pollSlice.count()))));
+                            std::min<std::int64_t>(remainingMs, options_.pollSlice.count())),
+                        source_.wakeFd()));
+      source_.refresh();  // also clears the descriptor's readability, or waits would spin
     }
   }
 
@@ -214,7 +217,7 @@ class Replay {
     protocol::FrameStats stats;
     stats.frame = record.frame;
     stats.plan = record.plan;
-    stats.timestampNs = std::llround(pose.time * kNsPerS);
+    stats.timestampNs = secondsToNanoseconds(pose.time);
     stats.polygons = static_cast<std::uint32_t>(
         std::min<std::size_t>(record.polygons, std::numeric_limits<std::uint32_t>::max()));
     stats.linkBytes = record.linkBytes;

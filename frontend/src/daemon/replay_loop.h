@@ -11,8 +11,10 @@
 //   every update in arrival order (a bad update is rejected whole); render
 //   the frame; then measure it against the reference; emit a FrameRecord and
 //   send FrameStats.
-// - Waiting is always link.poll(timeout) in slices of at most pollSlice, so
-//   input keeps flowing and a stop request ends the wait within one slice.
+// - Waiting is always link.poll(timeout, source.wakeFd()) in slices of at
+//   most pollSlice, then source.refresh(), so updates and poses keep flowing
+//   (a pose is stamped when it is read) and a stop request ends the wait
+//   within one slice.
 //   Nothing blocks on the network except the bounded lockstep wait, which
 //   ends early when the link is not connected.
 // - Pacing: rate > 0: frame i starts at start + i / rate; rate == 0: at start
@@ -26,9 +28,9 @@
 //   pose_to_frame_ms is NaN, and framesRedrawingAPose counts it. The replay
 //   ends when the source has ended and its last pose was drawn.
 // - pose_to_frame_ms: every frame with a new pose: clock time when the frame
-//   was read back minus clock time when its pose was sampled (taken from the
-//   source at its slot, just before it is sent). In lockstep it includes the
-//   wait.
+//   was read back minus clock time when its pose was sampled: a trace pose
+//   when the frame takes it at its slot, a stream pose when it was read
+//   (PoseSource::lastArrivalNs). In lockstep it includes the wait.
 // - update_latency_ms: on a frame where at least one update became visible,
 //   clock time when the frame was read back minus clock time when the pose
 //   that the newest visible update answered (SceneUpdate.frame) was sent;
@@ -73,9 +75,11 @@ class BackboneLink {
   virtual ~BackboneLink() = default;
   virtual bool connected() const = 0;
   virtual Status send(const protocol::Message& message) = 0;
-  // Waits up to `timeout` for input (less when something arrives or a stop
-  // is requested) and returns the SceneUpdates received, in order.
-  virtual std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout) = 0;
+  // Waits up to `timeout` for input (less when something arrives, `wakeFd`
+  // (if >= 0) becomes readable, or a stop is requested) and returns the
+  // SceneUpdates received, in order.
+  virtual std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout,
+                                                  int wakeFd = -1) = 0;
   virtual std::uint64_t bytesReceived() const = 0;  // encoded bytes, all messages, ever
 };
 

@@ -67,10 +67,7 @@ Result<std::shared_ptr<const RgbaImage>> convertTexture(const protocol::Texture&
     }
     return std::shared_ptr<const RgbaImage>();
   }
-  // RgbaImage sides are int: a limit above INT_MAX cannot admit more.
-  const std::uint32_t maxSide =
-      std::min<std::uint32_t>(options.limits.maxTextureDimension,
-                              static_cast<std::uint32_t>(std::numeric_limits<int>::max()));
+  const std::uint32_t maxSide = options.limits.maxDecodableSide();
   if (wire.width == 0 || wire.height == 0 || wire.width > maxSide || wire.height > maxSide) {
     return invalid(what, "size " + sizeText(wire.width, wire.height) + " outside 1.." +
                              std::to_string(maxSide) + " per side");
