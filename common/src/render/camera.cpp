@@ -1,10 +1,41 @@
 #include "thinlod/common/render/camera.h"
 
+#include <cmath>
+#include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
 
 namespace thinlod::render {
+namespace {
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+}  // namespace
+
+Status validateLighting(const Lighting& lighting, const std::string& what) {
+  if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
+    return Status(ErrorCode::kInvalidArgument, what + ": " +
+                                                   std::to_string(lighting.lights.size()) +
+                                                   " lights, at most " + std::to_string(kMaxLights));
+  }
+  if (!finite(lighting.ambient)) {
+    return Status(ErrorCode::kInvalidArgument, what + ": ambient light is not finite");
+  }
+  for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
+    const Light& light = lighting.lights[i];
+    if (!finite(light.vector) || !finite(light.color) || !std::isfinite(light.attenuation) ||
+        light.attenuation < 0.0f ||
+        (light.type == Light::Type::kDirectional && glm::length(light.vector) == 0.0f)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    what + ": light " + std::to_string(i) +
+                        " has a non-finite or zero vector, colour or attenuation");
+    }
+  }
+  return Status();
+}
 
 glm::vec3 unprojectPixel(const Camera& camera, float px, float py, float depth, int width,
                          int height) {

@@ -509,24 +509,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   if (!finite(camera.view) || !finite(camera.projection)) {
     return Status(ErrorCode::kInvalidArgument, "draw: camera matrices are not finite");
   }
-  if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
-    return Status(ErrorCode::kInvalidArgument, "draw: " + std::to_string(lighting.lights.size()) +
-                                                   " lights, at most " +
-                                                   std::to_string(kMaxLights));
-  }
-  if (!finite(lighting.ambient)) {
-    return Status(ErrorCode::kInvalidArgument, "draw: ambient light is not finite");
-  }
-  for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
-    const Light& light = lighting.lights[i];
-    if (!finite(light.vector) || !finite(light.color) || !std::isfinite(light.attenuation) ||
-        light.attenuation < 0.0f ||
-        (light.type == Light::Type::kDirectional && glm::length(light.vector) == 0.0f)) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "draw: light " + std::to_string(i) +
-                        " has a non-finite or zero vector, colour or attenuation");
-    }
-  }
+  THINLOD_RETURN_IF_ERROR(validateLighting(lighting, "draw"));
   // Validate every item before drawing any, so a bad list draws nothing.
   for (std::size_t i = 0; i < count; ++i) {
     const DrawItem& item = items[i];
@@ -658,6 +641,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   gl.glBindVertexArray(0);
   gl.glDisable(GL_BLEND);
   gl.glDepthMask(GL_TRUE);
+  gl.glFrontFace(GL_CCW);  // GL's default, for any other code in this context
   gl.glUseProgram(0);
   return checkGlErrors(gl, "MeshRenderer::draw");
 }
@@ -665,11 +649,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
 Status MeshRenderer::prepare(const Material& material, bool meshHasLayers,
                              const Lighting& lighting) {
   if (!context_->isCurrent()) return notCurrent("MeshRenderer::prepare");
-  if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "prepare: " + std::to_string(lighting.lights.size()) + " lights, at most " +
-                      std::to_string(kMaxLights));
-  }
+  THINLOD_RETURN_IF_ERROR(validateLighting(lighting, "prepare"));
   return impl_->ensureProgram(context_->gl(), variantOf(material, meshHasLayers, lighting));
 }
 

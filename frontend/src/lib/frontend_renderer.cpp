@@ -340,11 +340,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   if (!detail::finiteMatrix(camera.view) || !detail::finiteMatrix(camera.projection)) {
     return Status(ErrorCode::kInvalidArgument, "renderFrame: camera matrices are not finite");
   }
-  if (lighting.lights.size() > static_cast<std::size_t>(render::kMaxLights)) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "renderFrame: " + std::to_string(lighting.lights.size()) + " lights, at most " +
-                      std::to_string(render::kMaxLights));
-  }
+  THINLOD_RETURN_IF_ERROR(render::validateLighting(lighting, "renderFrame"));
   FrameReport report;
   const Clock::time_point frameStart = Clock::now();
 

@@ -11,11 +11,15 @@
 //   the light TRAVELS (e.g. (0,-1,0) = light from above); point lights store a
 //   position and fall off with 1/(1 + k d^2) where k = `attenuation`.
 // - Colours are linear RGB in [0, inf); intensity is folded into the colour.
+//   validateLighting() is the one check every renderer applies.
 #pragma once
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <string>
 #include <vector>
+
+#include "thinlod/common/status.h"
 
 namespace thinlod::render {
 
@@ -38,6 +42,11 @@ struct Lighting {
   glm::vec3 ambient{0.2f};
   std::vector<Light> lights;  // at most kMaxLights; more is kInvalidArgument at draw time
 };
+
+// kInvalidArgument (message starting with `what`) for more than kMaxLights
+// lights, a non-finite ambient, or a light with a non-finite or zero vector,
+// colour or negative attenuation; ok otherwise.
+Status validateLighting(const Lighting& lighting, const std::string& what);
 
 // World position of pixel (px, py) (y from the top) at window depth `depth`.
 glm::vec3 unprojectPixel(const Camera& camera, float px, float py, float depth, int width,

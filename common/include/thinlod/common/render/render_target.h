@@ -12,8 +12,8 @@
 //   640x480 frontend frame on llvmpipe). Front faces are then clockwise.
 // - readColor(): RGBA8, non-premultiplied as rendered, row 0 = top of the image.
 // - readDepth(): window-space depth in [0, 1] as float (1 = far plane / cleared
-//   background), row 0 = top. Convert to eye/world space with the projection
-//   used to draw (see unprojectDepth in mesh_renderer.h).
+//   background), row 0 = top. Convert to world space with unprojectPixel
+//   (camera.h) and the camera used to draw.
 // - The caller-buffer overloads avoid allocation: dst must hold width*height*4
 //   bytes (colour) or width*height floats (depth), else kInvalidArgument.
 // - Thread rules: as OffscreenContext (context current on the calling thread
