@@ -267,9 +267,7 @@ Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
   if (header.attributes != 0) {
     return textureError(ErrorCode::kUnsupported, "unknown attribute bits");
   }
-  // RgbaImage sides are int: a limit above INT_MAX cannot admit more.
-  const std::uint32_t maxSide = std::min<std::uint32_t>(
-      limits.maxTextureDimension, static_cast<std::uint32_t>(std::numeric_limits<int>::max()));
+  const std::uint32_t maxSide = limits.maxDecodableSide();
   if (header.countA == 0 || header.countB == 0 || header.countA > maxSide ||
       header.countB > maxSide) {
     return textureError(ErrorCode::kResourceExhausted,

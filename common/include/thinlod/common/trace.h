@@ -25,7 +25,9 @@
 // - No globals; everything is thread-safe on distinct objects.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
@@ -44,6 +46,10 @@ inline constexpr std::size_t kMaxTraceFileBytes = std::size_t{256} << 20;
 inline constexpr std::size_t kMaxTraceLineBytes = 4096;
 // |time| bound: nanoseconds of it fit in int64 with room to spare.
 inline constexpr double kMaxTraceTimeSeconds = 1e9;
+
+// Trace time (or a difference of two) as the protocol's int64 nanoseconds,
+// rounded. Precondition: |seconds| <= 2 * kMaxTraceTimeSeconds.
+inline std::int64_t secondsToNanoseconds(double seconds) { return std::llround(seconds * 1e9); }
 
 struct Pose {
   double time = 0.0;                              // seconds

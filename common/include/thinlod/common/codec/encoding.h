@@ -26,8 +26,10 @@
 // - Pure functions, no globals; safe to call concurrently.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
@@ -44,6 +46,13 @@ struct DecodeLimits {
   std::size_t maxVertices = 1u << 24;
   std::size_t maxTriangles = 1u << 24;
   std::uint32_t maxTextureDimension = 8192;  // per side
+
+  // The largest texture side a decoder may accept: maxTextureDimension, but
+  // never above INT_MAX (RgbaImage sides are int).
+  std::uint32_t maxDecodableSide() const {
+    return std::min<std::uint32_t>(maxTextureDimension,
+                                   static_cast<std::uint32_t>(std::numeric_limits<int>::max()));
+  }
 };
 
 // --- Meshes ---
