@@ -335,6 +335,22 @@ TEST(BackboneCorePose, RemovalsOfTheFirstPlanSurviveTheReplan) {
   EXPECT_EQ(core->frontendTriangles(), 0.0);
 }
 
+// One far-future stamp must not hold the backbone's clock (prediction, link
+// shaper) there: a pose moves it forward by at most 60 s; backwards stamps keep it.
+TEST(BackboneCorePose, APoseMovesTheClockForwardByAtMostAMinute) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  const std::vector<double> stamps = {0.0, 1e6, 2.0, 130.0, 50.0};
+  const std::vector<double> expected = {0.0, 60.0, 60.0, 120.0, 120.0};
+  for (std::size_t i = 0; i < stamps.size(); ++i) {
+    ASSERT_TRUE(core->beginPose(poseAt(i, stamps[i], kEntrance, kCow)).ok());
+    submitAll(*core);
+    const PoseOutcome outcome = core->finishPose();
+    EXPECT_DOUBLE_EQ(outcome.row.timeSeconds, expected[i]) << "pose " << i;
+  }
+}
+
 TEST(BackboneCorePose, PlanningFailureStillAnswersWithAnEmptyUpdate) {
   auto core = makeCore(polygonBudget(200));
   ASSERT_NE(core, nullptr);

@@ -12,6 +12,9 @@
 namespace thinlod::backbone_daemon {
 namespace {
 
+// How far one pose may move the backbone's clock (see beginPose).
+constexpr std::int64_t kMaxPoseTimeStepNs = 60'000'000'000LL;
+
 using backbone::RepresentationKind;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -616,7 +619,20 @@ Status BackboneCore::beginPose(const protocol::ViewerPose& pose) {
   schedulingMicrosecondsThisPose_ = 0.0;
   retiredThisPose_.clear();
 
-  const double time = std::max(lastTime_, double(pose.timestampNs) * 1e-9);
+  // A pose moves the backbone's clock forward by at most kMaxPoseTimeStepNs:
+  // one bogus far-future stamp would otherwise hold prediction and the link
+  // shaper there. Backwards stamps keep the clock where it is.
+  std::int64_t poseNs = pose.timestampNs;
+  if (lastPoseNs_) {
+    const std::int64_t limit =
+        *lastPoseNs_ > std::numeric_limits<std::int64_t>::max() - kMaxPoseTimeStepNs
+            ? std::numeric_limits<std::int64_t>::max()
+            : *lastPoseNs_ + kMaxPoseTimeStepNs;
+    poseNs = std::clamp(poseNs, *lastPoseNs_, limit);
+  }
+  lastPoseNs_ = poseNs;
+  poseTimeNs_ = poseNs;
+  const double time = std::max(lastTime_, double(poseNs) * 1e-9);
   lastTime_ = time;
   viewer_ = backbone::ViewerState();
   viewer_.frame = pose.sequence;
@@ -777,7 +793,7 @@ PoseOutcome BackboneCore::finishPose() {
   });
 
   // The link shaper runs on pose time.
-  const std::int64_t nowNs = std::max(lastShaperNs_, pose_.timestampNs);
+  const std::int64_t nowNs = std::max(lastShaperNs_, poseTimeNs_);
   lastShaperNs_ = nowNs;
   const protocol::LinkShaper::Clock::time_point now{std::chrono::nanoseconds(nowNs)};
   if (options_.budget.maxLinkBytesPerSecond && !shaper_) {
@@ -842,6 +858,7 @@ void BackboneCore::resetFrontend() {
   promised_.clear();
   shaper_.reset();
   lastTime_ = -1e300;
+  lastPoseNs_.reset();
   lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   inPose_ = false;
   plan_.reset();

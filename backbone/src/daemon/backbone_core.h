@@ -225,6 +225,8 @@ class BackboneCore {
 
   // Frontend session.
   double lastTime_ = -1e300;
+  std::optional<std::int64_t> lastPoseNs_;  // the clamped pose time (see beginPose)
+  std::int64_t poseTimeNs_ = 0;
   std::int64_t lastShaperNs_ = 0;
   std::optional<protocol::LinkShaper> shaper_;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
