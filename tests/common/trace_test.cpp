@@ -332,7 +332,7 @@ TEST(TraceStream, StopAtFirstErrorKeepsOneErrorHoweverManyBadLines) {
 TEST(TraceStream, ABogusFutureTimeIsRejectedAndASustainedJumpAccepted) {
   TraceStreamParser::Options options;
   options.maxTimeJumpSeconds = 10.0;
-  options.maxJumpRejections = 3;
+  options.timeBaseRestartAfter = 3;
   TraceStreamParser parser(options);
   TraceStreamParser::Output out;
   std::string text = withHeader("1 0 0 0 quat 1 0 0 0 60\n"
@@ -351,6 +351,29 @@ TEST(TraceStream, ABogusFutureTimeIsRejectedAndASustainedJumpAccepted) {
   EXPECT_EQ(out.poses[1].time, 2.0);
   EXPECT_EQ(out.poses[2].time, 1003.0);
   EXPECT_FALSE(parser.failed());
+}
+
+TEST(TraceStream, ABogusFirstTimeOrARestartedClockStartsANewTimeBase) {
+  TraceStreamParser::Options options;
+  options.maxTimeJumpSeconds = 60.0;
+  options.timeBaseRestartAfter = 2;
+  TraceStreamParser parser(options);
+  TraceStreamParser::Output out;
+  // A bogus first pose far ahead, then a tracker counting from 1 s.
+  std::string text = withHeader("1e8 0 0 0 quat 1 0 0 0 60\n");
+  for (int t = 1; t <= 5; ++t) text += std::to_string(t) + " 0 0 0 quat 1 0 0 0 60\n";
+  parser.feed(text, out);
+  ASSERT_EQ(out.errors.size(), 2u);  // 1 and 2 rejected, 3 restarts the time base
+  ASSERT_EQ(out.poses.size(), 4u);
+  EXPECT_EQ(out.poses[0].time, 1e8);
+  EXPECT_EQ(out.poses[1].time, 3.0);
+  EXPECT_EQ(out.poses[3].time, 5.0);
+  // Without restarts (a file) the order stays strict.
+  TraceStreamParser strict;
+  TraceStreamParser::Output strictOut;
+  strict.feed(text, strictOut);
+  EXPECT_EQ(strictOut.poses.size(), 1u);
+  EXPECT_EQ(strictOut.errors.size(), 5u);
 }
 
 TEST(TraceStream, ABadHeaderRejectsTheWholeStream) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <fcntl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -209,6 +210,59 @@ TEST(StreamPoseSource, AMissingPathIsAnIoError) {
   auto opened = StreamPoseSource::open("/nonexistent/poses", std::move(options));
   EXPECT_EQ(opened.status().code(), ErrorCode::kIoError);
   EXPECT_NE(opened.status().message().find("/nonexistent/poses"), std::string::npos);
+}
+
+TEST(StreamPoseSource, ARestartedTimeBaseStillHandsOutIncreasingTimes) {
+  Pipe pipe;
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  options.parser.timeBaseRestartAfter = 2;
+  auto source = StreamPoseSource::create(::dup(pipe.reader()), std::move(options));
+  ASSERT_TRUE(source.ok());
+  std::vector<double> times;
+  for (const double t : {100.0, 1.0, 2.0, 3.0, 4.0}) {
+    pipe.write((t == 100.0 ? std::string("# thinlod-trace 1\n") : std::string()) + poseLine(t));
+    (*source)->refresh();
+    if ((*source)->ready()) times.push_back((*source)->take().time);
+  }
+  // 1 and 2 are rejected, 3 restarts the time base and is shifted after 100.
+  ASSERT_EQ(times.size(), 3u);
+  EXPECT_EQ(times[0], 100.0);
+  EXPECT_DOUBLE_EQ(times[1], 100.001);
+  EXPECT_DOUBLE_EQ(times[2], 101.001);
+  EXPECT_EQ((*source)->rejectedLines(), 2u);
+}
+
+TEST(StreamPoseSource, StandardInputMayBeASocket) {
+  int sockets[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, sockets), 0);
+  const int savedStdin = ::dup(STDIN_FILENO);
+  ASSERT_GE(::dup2(sockets[0], STDIN_FILENO), 0);
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  auto opened = StreamPoseSource::open("-", std::move(options));
+  const int flagsAfter = ::fcntl(STDIN_FILENO, F_GETFL);
+  if (savedStdin >= 0) {
+    ::dup2(savedStdin, STDIN_FILENO);
+    ::close(savedStdin);
+  }
+  ::close(sockets[0]);
+  ASSERT_TRUE(opened.ok()) << opened.status().toString();
+  EXPECT_EQ(flagsAfter & O_NONBLOCK, 0);
+  (*opened)->refresh();  // nothing yet: must not block
+  EXPECT_FALSE((*opened)->ready());
+  const std::string text = "# thinlod-trace 1\n" + poseLine(7);
+  ASSERT_EQ(::write(sockets[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  (*opened)->refresh();
+  ASSERT_TRUE((*opened)->ready());
+  EXPECT_EQ((*opened)->take().time, 7.0);
+  ::close(sockets[1]);
+}
+
+TEST(StreamPoseSource, AClockIsRequired) {
+  Pipe pipe;
+  auto source = StreamPoseSource::create(::dup(pipe.reader()), StreamPoseSource::Options{});
+  EXPECT_EQ(source.status().code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(TracePoseSource, GivesEveryPoseInOrderWithItsDueTime) {

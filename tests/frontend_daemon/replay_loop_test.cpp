@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "daemon_test_util.h"
@@ -49,7 +50,8 @@ class FakeLink final : public BackboneLink {
     }
     return Status();
   }
-  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout, int) override {
+  std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout, int wakeFd) override {
+    wakeFds.insert(wakeFd);
     const std::int64_t deadline = clock_.now + timeout.count() * kMs;
     std::int64_t wake = deadline;
     for (const auto& [at, update] : inFlight) wake = std::min(wake, std::max(at, clock_.now));
@@ -77,6 +79,7 @@ class FakeLink final : public BackboneLink {
   std::vector<protocol::FrameStats> frameStats;
   std::vector<std::pair<std::int64_t, protocol::SceneUpdate>> inFlight;
   std::uint64_t bytes = 0;
+  std::set<int> wakeFds;  // every wakeFd poll() was given
 
  private:
   FakeClock& clock_;
@@ -150,7 +153,8 @@ Trace traceAt(const std::vector<double>& times) {
   return trace;
 }
 
-// A live stream on the fake clock: pose k arrives at arrivalsMs[k].
+// A live stream on the fake clock: pose k becomes readable at arrivalsMs[k]
+// and, like a real stream, is stamped when refresh() reads it.
 class ScriptedStream final : public PoseSource {
  public:
   ScriptedStream(FakeClock& clock, std::vector<std::int64_t> arrivalsMs)
@@ -163,7 +167,7 @@ class ScriptedStream final : public PoseSource {
       pose.time = static_cast<double>(arrivalsMs_[delivered_]) / 1000.0;
       pose.position = glm::vec3(static_cast<float>(delivered_), 1.0f, 5.0f);
       newest_ = pose;
-      newestArrivalNs_ = start_ + arrivalsMs_[delivered_] * kMs;
+      newestArrivalNs_ = clock_.now;
       ++delivered_;
     }
   }
@@ -176,6 +180,8 @@ class ScriptedStream final : public PoseSource {
   }
   bool ended() const override { return !newest_ && delivered_ == arrivalsMs_.size(); }
   std::optional<std::int64_t> lastArrivalNs() const override { return lastArrivalNs_; }
+  int wakeFd() const override { return ended() ? -1 : kStreamFd; }
+  static constexpr int kStreamFd = 42;
   std::optional<std::int64_t> dueOffsetNs() const override { return std::nullopt; }
   std::size_t skipped() const override { return skipped_; }
 
@@ -317,6 +323,12 @@ TEST_F(ReplayLoopTest, LiveModeAppliesALateAnswerWhenItArrivesWithItsTrueLatency
   for (const FrameRecord& record : result.records) EXPECT_DOUBLE_EQ(record.poseToFrameMs, 5.0);
   EXPECT_EQ(result.records[2].linkBytes, link.bytes);
   EXPECT_EQ(result.records[3].linkBytes, 0u);
+}
+
+TEST_F(ReplayLoopTest, ATraceGivesWaitsNoDescriptorToWakeOn) {
+  options.rate = 10.0;
+  run(traceAt({0.0, 0.1, 0.2}));
+  EXPECT_EQ(link.wakeFds, (std::set<int>{-1}));
 }
 
 TEST_F(ReplayLoopTest, DefaultPacingFollowsTheTraceTimes) {
@@ -495,10 +507,15 @@ TEST_F(ReplayLoopTest, LiveStreamAtARateTakesTheNewestPoseOrDrawsTheLastOneAgain
     EXPECT_EQ(producer.renderStartNs[i] - start, startMs[i] * kMs) << i;
     EXPECT_EQ(result.records[i].timeS, timeS[i]) << i;
   }
-  // Latency counts from the pose's arrival: 25 -> 30, 27 -> 35, 52 -> 65 ms.
+  // Latency counts from when the pose was read: 25 -> 30; pose 27 arrived
+  // while frame 0 rendered and was read at 30 -> 35; pose 52 arrived while
+  // frame 5 rendered (50-55) and was read at 55 by the refresh after the
+  // first poll of the wait for the 60 ms slot -> 65 ms (without that refresh
+  // it would be read at 60 and the frame would claim 5 ms).
   EXPECT_DOUBLE_EQ(result.records[0].poseToFrameMs, 5.0);
-  EXPECT_DOUBLE_EQ(result.records[1].poseToFrameMs, 8.0);
-  EXPECT_DOUBLE_EQ(result.records[6].poseToFrameMs, 13.0);
+  EXPECT_DOUBLE_EQ(result.records[1].poseToFrameMs, 5.0);
+  EXPECT_DOUBLE_EQ(result.records[6].poseToFrameMs, 10.0);
+  EXPECT_TRUE(link.wakeFds.count(ScriptedStream::kStreamFd));  // waits woke on the stream
   for (std::size_t i = 2; i < 6; ++i) EXPECT_TRUE(std::isnan(result.records[i].poseToFrameMs)) << i;
   EXPECT_EQ(result.framesRedrawingAPose, 4u);
   EXPECT_EQ(link.poses.size(), 3u);  // poses are sent once, redraws send nothing

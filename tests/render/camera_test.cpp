@@ -1,10 +1,13 @@
-// projectToPixel / unprojectPixel: pixel convention and round trips (no GL).
+// projectToPixel / unprojectPixel: pixel convention and round trips; validateLighting (no GL).
 #include "thinlod/common/render/camera.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <random>
+#include <string>
 
 namespace thinlod::render {
 namespace {
@@ -44,6 +47,45 @@ TEST(Camera, UnprojectInvertsProjectOnRandomPoints) {
     const glm::vec3 back = unprojectPixel(camera, window.x, window.y, window.z, 640, 480);
     EXPECT_NEAR(glm::length(back - world), 0.0f, 2e-3f) << i;
   }
+}
+
+TEST(ValidateLighting, AcceptsTheDefaultsAndNamesEachProblem) {
+  EXPECT_TRUE(validateLighting(Lighting(), "draw").ok());
+  Lighting lighting;
+  lighting.lights.resize(kMaxLights);
+  EXPECT_TRUE(validateLighting(lighting, "draw").ok());
+  lighting.lights.resize(kMaxLights + 1);
+  EXPECT_NE(validateLighting(lighting, "draw").message().find("draw: 5 lights, at most 4"),
+            std::string::npos);
+  const float nan = std::nanf("");
+  auto rejected = [](const Lighting& l) {
+    const Status status = validateLighting(l, "renderFrame");
+    return status.code() == ErrorCode::kInvalidArgument &&
+           status.message().rfind("renderFrame: ", 0) == 0;
+  };
+  Lighting bad;
+  bad.ambient = glm::vec3(nan, 0.0f, 0.0f);
+  EXPECT_TRUE(rejected(bad));
+  bad.ambient = glm::vec3(-0.1f, 0.0f, 0.0f);
+  EXPECT_TRUE(rejected(bad));
+  bad = Lighting();
+  Light light;
+  light.vector = glm::vec3(0.0f);  // a directional light needs a direction
+  bad.lights = {light};
+  EXPECT_TRUE(rejected(bad));
+  light.type = Light::Type::kPoint;  // a point light at the origin is fine
+  bad.lights = {light};
+  EXPECT_FALSE(rejected(bad));
+  light.attenuation = -1.0f;
+  bad.lights = {light};
+  EXPECT_TRUE(rejected(bad));
+  light.attenuation = 0.0f;
+  light.color = glm::vec3(1.0f, -1.0f, 0.0f);
+  bad.lights = {light};
+  EXPECT_TRUE(rejected(bad));
+  light.color = glm::vec3(std::numeric_limits<float>::infinity());
+  bad.lights = {light};
+  EXPECT_TRUE(rejected(bad));
 }
 
 }  // namespace

@@ -259,23 +259,26 @@ void TraceStreamParser::completeLine(Output& out) {
     reject(pose.status(), out);
     return;
   }
-  if (lastTime_ && !(pose->time > *lastTime_)) {
+  const bool restart =
+      options_.timeBaseRestartAfter > 0 && timeRejections_ >= options_.timeBaseRestartAfter;
+  if (lastTime_ && !restart && !(pose->time > *lastTime_)) {
     char buffer[96];
     std::snprintf(buffer, sizeof(buffer), "time %.17g is not after the previous pose's %.17g",
                   pose->time, *lastTime_);
+    ++timeRejections_;
     reject(lineError(lines_, buffer), out);
     return;
   }
-  if (lastTime_ && pose->time - *lastTime_ > options_.maxTimeJumpSeconds &&
-      ++jumpRejections_ <= options_.maxJumpRejections) {
+  if (lastTime_ && !restart && pose->time - *lastTime_ > options_.maxTimeJumpSeconds) {
     char buffer[128];
     std::snprintf(buffer, sizeof(buffer),
                   "time %.17g jumps more than %g s past the previous pose's %.17g", pose->time,
                   options_.maxTimeJumpSeconds, *lastTime_);
+    ++timeRejections_;
     reject(lineError(lines_, buffer), out);
     return;
   }
-  jumpRejections_ = 0;
+  timeRejections_ = 0;
   lastTime_ = pose->time;
   out.poses.push_back(*pose);
 }

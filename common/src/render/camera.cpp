@@ -13,6 +13,8 @@ bool finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+bool colour(const glm::vec3& c) { return finite(c) && c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f; }
+
 }  // namespace
 
 Status validateLighting(const Lighting& lighting, const std::string& what) {
@@ -21,17 +23,19 @@ Status validateLighting(const Lighting& lighting, const std::string& what) {
                                                    std::to_string(lighting.lights.size()) +
                                                    " lights, at most " + std::to_string(kMaxLights));
   }
-  if (!finite(lighting.ambient)) {
-    return Status(ErrorCode::kInvalidArgument, what + ": ambient light is not finite");
+  if (!colour(lighting.ambient)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": ambient light is not a finite, non-negative colour");
   }
   for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
     const Light& light = lighting.lights[i];
-    if (!finite(light.vector) || !finite(light.color) || !std::isfinite(light.attenuation) ||
+    if (!finite(light.vector) || !colour(light.color) || !std::isfinite(light.attenuation) ||
         light.attenuation < 0.0f ||
         (light.type == Light::Type::kDirectional && glm::length(light.vector) == 0.0f)) {
       return Status(ErrorCode::kInvalidArgument,
                     what + ": light " + std::to_string(i) +
-                        " has a non-finite or zero vector, colour or attenuation");
+                        " has a non-finite or zero vector, a negative or non-finite colour, or "
+                        "a negative or non-finite attenuation");
     }
   }
   return Status();

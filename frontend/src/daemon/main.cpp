@@ -35,6 +35,11 @@ constexpr std::uint64_t kProgressEveryFrames = 10;
 class RejectionLog {
  public:
   void add(const Status& error) {
+    if (error.code() == ErrorCode::kIoError) {  // the stream itself failed: always say so
+      spdlog::error("event=pose_stream_failed error=\"{}\" rejected_lines={}", error.toString(),
+                    total_);
+      return;
+    }
     ++total_;
     if (total_ <= kLoggedInFull) {
       spdlog::warn("event=pose_rejected action=skipped error=\"{}\"", error.toString());
@@ -56,9 +61,11 @@ class RejectionLog {
   std::chrono::steady_clock::time_point lastSummary_{};
 };
 
-// A live stream's pose may move its time at most this far ahead at once
-// (several in a row are taken as a real jump; TraceStreamParser::Options).
+// A live stream's pose may move its time at most this far ahead at once;
+// after this many poses in a row rejected for their time the stream starts a
+// new time base (TraceStreamParser::Options).
 constexpr double kMaxPoseStreamJumpSeconds = 60.0;
+constexpr int kPoseStreamRestartAfter = 10;
 
 // Logs, the CSV and the PNG dumps, frame by frame.
 class DaemonObserver final : public ReplayObserver {
@@ -145,6 +152,7 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   } else {
     StreamPoseSource::Options streamOptions;
     streamOptions.parser.maxTimeJumpSeconds = kMaxPoseStreamJumpSeconds;
+    streamOptions.parser.timeBaseRestartAfter = kPoseStreamRestartAfter;
     streamOptions.nowNs = [&clock] { return clock.nowNs(); };
     streamOptions.onError = [&rejections](const Status& error) { rejections.add(error); };
     Result<std::unique_ptr<StreamPoseSource>> live =

@@ -1,6 +1,7 @@
 #include "pose_source.h"
 
 #include <fcntl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -24,30 +25,55 @@ std::optional<std::int64_t> TracePoseSource::dueOffsetNs() const {
   return secondsToNanoseconds(trace_.poses[next_].time - trace_.poses.front().time);
 }
 
-Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::create(int fd, Options options) {
-  const int flags = ::fcntl(fd, F_GETFL);
-  if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) {
-    Status error = ioError("making reads non-blocking");
+Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::adopt(int fd, Options options,
+                                                                  ReadMode mode) {
+  if (!options.nowNs) {
     ::close(fd);
-    return error;
+    return Status(ErrorCode::kInvalidArgument, "pose stream: Options::nowNs is required");
   }
-  return std::unique_ptr<StreamPoseSource>(new StreamPoseSource(fd, std::move(options)));
+  if (mode == ReadMode::kNonBlocking) {
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) {
+      Status error = ioError("making reads non-blocking");
+      ::close(fd);
+      return error;
+    }
+  }
+  return std::unique_ptr<StreamPoseSource>(new StreamPoseSource(fd, std::move(options), mode));
+}
+
+Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::create(int fd, Options options) {
+  return adopt(fd, std::move(options), ReadMode::kNonBlocking);
 }
 
 Result<std::unique_ptr<StreamPoseSource>> StreamPoseSource::open(const std::string& path,
                                                                  Options options) {
-  // A fresh open file description of stdin: O_NONBLOCK on a dup() would
-  // change the description the caller (and its pipeline) shares.
+  struct stat info {};
+  if (path == "-") {
+    if (::fstat(STDIN_FILENO, &info) != 0) return ioError("stdin");
+    // O_NONBLOCK on a dup() would change the description the caller (and its
+    // pipeline) shares; sockets and regular files need no flag at all.
+    if (S_ISSOCK(info.st_mode) || S_ISREG(info.st_mode)) {
+      const int fd = ::fcntl(STDIN_FILENO, F_DUPFD_CLOEXEC, 0);
+      if (fd < 0) return ioError("duplicating stdin");
+      return adopt(fd, std::move(options),
+                   S_ISSOCK(info.st_mode) ? ReadMode::kSocket : ReadMode::kRegularFile);
+    }
+  }
   const std::string file = path == "-" ? "/proc/self/fd/0" : path;
   const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return ioError("opening " + path);
-  struct stat info {};
   if (path != "-" && ::fstat(fd, &info) == 0 && S_ISFIFO(info.st_mode)) options.fifoPath = path;
-  return create(fd, std::move(options));
+  return adopt(fd, std::move(options), ReadMode::kNonBlocking);
 }
 
-StreamPoseSource::StreamPoseSource(int fd, Options options)
-    : fd_(fd), options_(std::move(options)), parser_(options_.parser) {}
+StreamPoseSource::StreamPoseSource(int fd, Options options, ReadMode mode)
+    : fd_(fd), options_(std::move(options)), mode_(mode), parser_(options_.parser) {}
+
+long StreamPoseSource::readSome(char* buffer, std::size_t size) {
+  if (mode_ == ReadMode::kSocket) return ::recv(fd_, buffer, size, MSG_DONTWAIT);
+  return ::read(fd_, buffer, size);
+}
 
 StreamPoseSource::~StreamPoseSource() {
   if (fd_ >= 0) ::close(fd_);
@@ -70,7 +96,7 @@ void StreamPoseSource::refresh() {
   TraceStreamParser::Output out;
   std::size_t readBytes = 0;
   while (readBytes < kMaxReadPerRefresh) {
-    const ssize_t n = ::read(fd_, buffer, sizeof(buffer));
+    const long n = readSome(buffer, sizeof(buffer));
     if (n > 0) {
       gotData_ = true;
       readBytes += static_cast<std::size_t>(n);
@@ -100,6 +126,14 @@ void StreamPoseSource::absorb(TraceStreamParser::Output& out, std::int64_t arriv
   }
   received_ += out.poses.size();
   for (Pose& pose : out.poses) {
+    // After a time-base restart the parser's times may go back: shift them
+    // to continue after the last one handed out, a millisecond later.
+    pose.time += timeShift_;
+    if (lastTimeOut_ && !(pose.time > *lastTimeOut_)) {
+      timeShift_ += *lastTimeOut_ + 1e-3 - pose.time;
+      pose.time = *lastTimeOut_ + 1e-3;
+    }
+    lastTimeOut_ = pose.time;
     if (newest_) ++skipped_;
     newest_ = std::move(pose);
     newestArrivalNs_ = arrivalNs;

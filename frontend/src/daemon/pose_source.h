@@ -20,7 +20,10 @@
 //   trace file (TraceStreamParser); a bad line is reported through onError
 //   and skipped; a bad header ends the stream, so do read errors other than
 //   EAGAIN/EINTR. A FIFO opened before its writer waits for one, and a writer
-//   that leaves without writing is waited out (the FIFO is reopened).
+//   that leaves without writing is waited out (the FIFO is reopened). The
+//   poses handed out have strictly increasing times even when the parser
+//   starts a new time base (Options::parser.timeBaseRestartAfter): later
+//   poses are shifted to continue after the last one handed out.
 //   refresh() reads at most kMaxReadPerRefresh bytes, so a flood cannot hold
 //   up a frame.
 // - Single-threaded.
@@ -73,10 +76,13 @@ class StreamPoseSource final : public PoseSource {
     std::function<std::int64_t()> nowNs;  // arrival stamps (required)
     std::function<void(const Status&)> onError;
   };
-  // Takes ownership of `fd` and makes its reads non-blocking (kIoError if it cannot).
+  // Takes ownership of `fd` and makes its reads non-blocking (kIoError if it
+  // cannot; kInvalidArgument without nowNs).
   static Result<std::unique_ptr<StreamPoseSource>> create(int fd, Options options);
-  // Opens `path` ('-' = stdin, through a fresh open of /proc/self/fd/0); a
-  // FIFO gets Options::fifoPath set.
+  // Opens `path`; a FIFO gets Options::fifoPath set. '-' = stdin: a pipe,
+  // FIFO or terminal through a fresh open of /proc/self/fd/0 (so the
+  // caller's stays blocking), a socket read with MSG_DONTWAIT, a regular
+  // file as it is (its reads never block).
   static Result<std::unique_ptr<StreamPoseSource>> open(const std::string& path, Options options);
   ~StreamPoseSource() override;
   StreamPoseSource(const StreamPoseSource&) = delete;
@@ -94,11 +100,17 @@ class StreamPoseSource final : public PoseSource {
   std::size_t rejectedLines() const { return rejectedLines_; }
 
  private:
-  StreamPoseSource(int fd, Options options);
+  enum class ReadMode { kNonBlocking, kSocket, kRegularFile };
+  static Result<std::unique_ptr<StreamPoseSource>> adopt(int fd, Options options, ReadMode mode);
+  StreamPoseSource(int fd, Options options, ReadMode mode);
+  long readSome(char* buffer, std::size_t size);
   void absorb(TraceStreamParser::Output& out, std::int64_t arrivalNs);
   void reopenFifo();
   int fd_;
   Options options_;
+  ReadMode mode_;
+  double timeShift_ = 0.0;  // added to parsed times after a time-base restart
+  std::optional<double> lastTimeOut_;
   TraceStreamParser parser_;
   std::optional<Pose> newest_;  // not yet taken
   std::int64_t newestArrivalNs_ = 0;

@@ -85,10 +85,13 @@ class TraceStreamParser {
     bool stopAtFirstError = false;
     // A pose more than this many seconds after the previous accepted one is
     // rejected, so one bogus future time cannot make every later pose "not
-    // after" it; after maxJumpRejections such rejections in a row the jump
-    // is taken as real and accepted. Times never go backwards.
+    // after" it.
     double maxTimeJumpSeconds = std::numeric_limits<double>::infinity();
-    int maxJumpRejections = 10;
+    // After this many valid poses in a row rejected for their time (not
+    // after the previous one, or too far past it), the next one starts a new
+    // time base, earlier or later (a restarted tracker, a long pause, a bogus
+    // first pose). 0: never (a file keeps strict order).
+    int timeBaseRestartAfter = 0;
   };
   TraceStreamParser() = default;
   explicit TraceStreamParser(const Options& options) : options_(options) {}
@@ -109,7 +112,7 @@ class TraceStreamParser {
   void completeLine(Output& out);
   void reject(Status error, Output& out);
   Options options_;
-  int jumpRejections_ = 0;
+  int timeRejections_ = 0;  // valid poses rejected for their time since the last accepted one
   std::string partial_;
   bool overlong_ = false;
   bool sawHeader_ = false;

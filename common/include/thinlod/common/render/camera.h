@@ -44,8 +44,9 @@ struct Lighting {
 };
 
 // kInvalidArgument (message starting with `what`) for more than kMaxLights
-// lights, a non-finite ambient, or a light with a non-finite or zero vector,
-// colour or negative attenuation; ok otherwise.
+// lights, an ambient or light colour that is negative or not finite, or a
+// light with a non-finite (directional: zero) vector or a negative or
+// non-finite attenuation; ok otherwise.
 Status validateLighting(const Lighting& lighting, const std::string& what);
 
 // World position of pixel (px, py) (y from the top) at window depth `depth`.
