@@ -337,12 +337,19 @@ TEST(BackboneCorePose, RemovalsOfTheFirstPlanSurviveTheReplan) {
 
 // One far-future stamp must not hold the backbone's clock (prediction, link
 // shaper) there: a pose moves it forward by at most 60 s; backwards stamps keep it.
-TEST(BackboneCorePose, APoseMovesTheClockForwardByAtMostAMinute) {
+TEST(BackboneCorePose, APoseMovesTheClockForwardByAtMostAMinuteUnlessTheJumpPersists) {
   auto core = makeCore(polygonBudget(400));
   ASSERT_NE(core, nullptr);
   deliverCurves(*core);
-  const std::vector<double> stamps = {0.0, 1e6, 2.0, 130.0, 50.0};
-  const std::vector<double> expected = {0.0, 60.0, 60.0, 120.0, 120.0};
+  // 0; a bogus 1e6 (clamped to +60 s); 2 and 50 (backwards: held); 130
+  // (+10 s); then eleven poses 1e4 s on: ten clamped steps, the eleventh a
+  // real jump taken as it is.
+  std::vector<double> stamps = {0.0, 1e6, 2.0, 130.0, 50.0};
+  std::vector<double> expected = {0.0, 60.0, 60.0, 120.0, 120.0};
+  for (int k = 0; k < 11; ++k) {
+    stamps.push_back(1e4 + k);
+    expected.push_back(k < 10 ? 120.0 + 60.0 * (k + 1) : 1e4 + k);
+  }
   for (std::size_t i = 0; i < stamps.size(); ++i) {
     ASSERT_TRUE(core->beginPose(poseAt(i, stamps[i], kEntrance, kCow)).ok());
     submitAll(*core);

@@ -12,8 +12,10 @@
 namespace thinlod::backbone_daemon {
 namespace {
 
-// How far one pose may move the backbone's clock (see beginPose).
+// How far one pose may move the backbone's clock, and how many poses in a
+// row beyond that make a jump real (see beginPose).
 constexpr std::int64_t kMaxPoseTimeStepNs = 60'000'000'000LL;
+constexpr int kPosesBeforeJump = 10;
 
 using backbone::RepresentationKind;
 
@@ -622,13 +624,22 @@ Status BackboneCore::beginPose(const protocol::ViewerPose& pose) {
   // A pose moves the backbone's clock forward by at most kMaxPoseTimeStepNs:
   // one bogus far-future stamp would otherwise hold prediction and the link
   // shaper there. Backwards stamps keep the clock where it is.
+  // Several poses in a row that far ahead are a real jump (a long pause, a
+  // bogus very early first stamp) and are taken as they are.
   std::int64_t poseNs = pose.timestampNs;
   if (lastPoseNs_) {
     const std::int64_t limit =
         *lastPoseNs_ > std::numeric_limits<std::int64_t>::max() - kMaxPoseTimeStepNs
             ? std::numeric_limits<std::int64_t>::max()
             : *lastPoseNs_ + kMaxPoseTimeStepNs;
-    poseNs = std::clamp(poseNs, *lastPoseNs_, limit);
+    if (poseNs <= limit) {
+      posesBeyondStep_ = 0;
+    } else if (++posesBeyondStep_ <= kPosesBeforeJump) {
+      poseNs = limit;
+    } else {
+      posesBeyondStep_ = 0;  // the jump is taken; the next one is judged afresh
+    }
+    poseNs = std::max(poseNs, *lastPoseNs_);
   }
   lastPoseNs_ = poseNs;
   poseTimeNs_ = poseNs;
@@ -859,6 +870,7 @@ void BackboneCore::resetFrontend() {
   shaper_.reset();
   lastTime_ = -1e300;
   lastPoseNs_.reset();
+  posesBeyondStep_ = 0;
   lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   inPose_ = false;
   plan_.reset();

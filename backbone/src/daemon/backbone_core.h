@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <limits>
 #include <optional>
 #include <string>
 #include <variant>
@@ -226,8 +227,9 @@ class BackboneCore {
   // Frontend session.
   double lastTime_ = -1e300;
   std::optional<std::int64_t> lastPoseNs_;  // the clamped pose time (see beginPose)
+  int posesBeyondStep_ = 0;                 // in a row, stamps beyond the step limit
   std::int64_t poseTimeNs_ = 0;
-  std::int64_t lastShaperNs_ = 0;
+  std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   std::optional<protocol::LinkShaper> shaper_;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
   double frontendTriangles_ = 0.0;
