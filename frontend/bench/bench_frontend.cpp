@@ -25,8 +25,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <ctime>
+#include <functional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -175,8 +175,7 @@ glm::mat4 facingQuad(const glm::vec3& center, float radius, const glm::vec3& eye
 // Renders `item` alone, orthographically, from `eye`'s direction into a
 // 256x256 texture with a transparent background: the impostor texture.
 std::shared_ptr<const RgbaImage> capture(ReferenceRenderer& capturer, const SceneItem& item,
-                                                 const glm::vec3& eye,
-                                                 const render::Lighting& lighting) {
+                                         const glm::vec3& eye, const render::Lighting& lighting) {
   const glm::vec3 dir = glm::normalize(item.center - eye);
   const glm::vec3 right = glm::normalize(glm::cross(dir, glm::vec3(0, 1, 0)));
   const glm::vec3 up = glm::cross(right, dir);
@@ -576,8 +575,8 @@ int main(int argc, char** argv) {
   auto steadyWorstOf = [&](int n) {
     std::vector<double> windowMax;
     for (std::size_t start = 0; start + n <= frontendMs.size(); start += n) {
-      windowMax.push_back(*std::max_element(frontendMs.begin() + start,
-                                            frontendMs.begin() + start + n));
+      windowMax.push_back(
+          *std::max_element(frontendMs.begin() + start, frontendMs.begin() + start + n));
     }
     return windowMax.empty() ? FrameRecord::kMissing : percentiles(windowMax).median;
   };
@@ -683,8 +682,8 @@ int main(int argc, char** argv) {
       unboundedBurst.framesToApply, unboundedBurst.worstMs,
       unboundedBurst.worstMs / frontendStats.median, unboundedBurst.worstCpuMs,
       unboundedBurst.worstCpuMs / cpuMedian, unboundedBurst.worstExtraMs,
-      unboundedBurst.worstSystematicMs(), unboundedBurst.worstSystematicMs() / sameViewsMedianMs, quality.snrDb,
-      quality.psnrDb);
+      unboundedBurst.worstSystematicMs(), unboundedBurst.worstSystematicMs() / sameViewsMedianMs,
+      quality.snrDb, quality.psnrDb);
   if (rawGl != nullptr) {
     std::fprintf(stderr,
                  "  raw GL     median %.3f ms  p99 %.3f ms  max %.3f ms  (cpu median %.3f ms, "
@@ -693,8 +692,7 @@ int main(int argc, char** argv) {
                  rawStats.median, rawStats.p99, rawStats.max, percentiles(rawCpuMs).median,
                  rawCoveredPixels, p99OverRaw, medianOverRaw);
   } else {
-    std::fprintf(stderr,
-                 "  raw GL     not measured (EGL-only); target judged against bare: %.3f\n",
+    std::fprintf(stderr, "  raw GL     not measured (EGL-only); target judged against bare: %.3f\n",
                  p99Ratio);
   }
   const std::string text = json.dump(2);

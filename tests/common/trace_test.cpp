@@ -271,7 +271,6 @@ TEST(Trace, SamplePoseInterpolatesAndClamps) {
   EXPECT_TRUE(samplePose(trace, 10.0) == trace.poses.back());
 }
 
-
 // ---------------------------------------------------------------- stream parser
 
 TEST(TraceStream, AnySplitOfTheBytesGivesTheSamePosesAsParseTrace) {
@@ -302,8 +301,8 @@ TEST(TraceStream, ABadPoseLineIsReportedAndSkippedAndLaterLinesStillCount) {
   TraceStreamParser parser;
   TraceStreamParser::Output out;
   parser.feed(withHeader("0 0 0 0 quat 1 0 0 0 60\n"
-                         "1 0 0 nan quat 1 0 0 0 60\n"   // line 3: not finite
-                         "0 0 0 0 quat 1 0 0 0 60\n"     // line 4: time does not advance
+                         "1 0 0 nan quat 1 0 0 0 60\n"  // line 3: not finite
+                         "0 0 0 0 quat 1 0 0 0 60\n"    // line 4: time does not advance
                          "2 0 0 0 quat 1 0 0 0 60\n"),
               out);
   ASSERT_EQ(out.errors.size(), 2u);
@@ -335,10 +334,11 @@ TEST(TraceStream, ABogusFutureTimeIsRejectedAndASustainedJumpAccepted) {
   options.timeBaseRestartAfter = 3;
   TraceStreamParser parser(options);
   TraceStreamParser::Output out;
-  std::string text = withHeader("1 0 0 0 quat 1 0 0 0 60\n"
-                                "1e9 0 0 0 quat 1 0 0 0 60\n"  // line 3: bogus jump
-                                "2 0 0 0 quat 1 0 0 0 60\n");  // still accepted
-  for (int i = 0; i < 4; ++i) {  // a real jump: 3 rejections, then accepted
+  std::string text = withHeader(
+      "1 0 0 0 quat 1 0 0 0 60\n"
+      "1e9 0 0 0 quat 1 0 0 0 60\n"  // line 3: bogus jump
+      "2 0 0 0 quat 1 0 0 0 60\n");  // still accepted
+  for (int i = 0; i < 4; ++i) {      // a real jump: 3 rejections, then accepted
     text += std::to_string(1000 + i) + " 0 0 0 quat 1 0 0 0 60\n";
   }
   parser.feed(text, out);

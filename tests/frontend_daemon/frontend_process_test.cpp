@@ -428,7 +428,7 @@ TEST(FrontendProcess, FollowsALivePoseStreamFromAFifoSkippingABadLine) {
   send("0.1 2 1.5 4.7 lookat 2 0.4 1.6 60\n");
   waitForRows(2);
   send("0.2 2 1.5 nan lookat 2 0.4 1.6 60\n");  // line 4: rejected, skipped
-  send("0.3 2 1.5 4.6 look");                     // a pose in two writes
+  send("0.3 2 1.5 4.6 look");                   // a pose in two writes
   std::this_thread::sleep_for(50ms);
   send("at 2 0.4 1.6 60\n");
   waitForRows(3);

@@ -2,8 +2,8 @@
 // reported and skipped, end of stream.
 #include "pose_source.h"
 
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -47,9 +47,7 @@ std::unique_ptr<StreamPoseSource> sourceOn(const Pipe& pipe, std::vector<std::st
   return source.ok() ? std::move(source).value() : nullptr;
 }
 
-std::string poseLine(double t) {
-  return std::to_string(t) + " 1 2 3 lookat 0 0 0 60\n";
-}
+std::string poseLine(double t) { return std::to_string(t) + " 1 2 3 lookat 0 0 0 60\n"; }
 
 TEST(StreamPoseSource, PosesBecomeReadyOnlyWhenTheirLineIsComplete) {
   Pipe pipe;

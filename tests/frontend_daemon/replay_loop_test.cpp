@@ -295,7 +295,7 @@ TEST_F(ReplayLoopTest, LockstepTimeoutRendersWhatItHolds) {
     EXPECT_EQ(result.records[i].plan, 1u);
     EXPECT_DOUBLE_EQ(result.records[i].targetAccuracy, 5.0);
     EXPECT_TRUE(std::isnan(result.records[i].updateLatencyMs));  // nothing new shown
-    EXPECT_DOUBLE_EQ(result.records[i].poseToFrameMs, 45.0);      // the whole wait + render
+    EXPECT_DOUBLE_EQ(result.records[i].poseToFrameMs, 45.0);     // the whole wait + render
   }
 }
 
@@ -531,7 +531,8 @@ TEST_F(ReplayLoopTest, LiveStreamSkipsPosesOvertakenBeforeAFrameTakesThem) {
   ReplayResult result =
       runReplay(stream, options, clock, link, producer, observer, [] { return false; });
   ASSERT_TRUE(result.status.ok());
-  ASSERT_EQ(result.records.size(), 3u);  // 0 ms: pose 0; 50 ms: pose 30 (10, 20 skipped); 100 ms: 60
+  ASSERT_EQ(result.records.size(),
+            3u);  // 0 ms: pose 0; 50 ms: pose 30 (10, 20 skipped); 100 ms: 60
   EXPECT_EQ(result.posesSkipped, 2u);
   EXPECT_EQ(result.records[1].timeS, 0.030);
   EXPECT_EQ(result.records[2].timeS, 0.060);

@@ -157,8 +157,8 @@ TEST_P(MeshRendererTest, LightsOfMixedTypesAddUpInEitherOrder) {
   point.color = glm::vec3(0.0f, 1.0f, 0.0f);
   point.attenuation = 1.0f;
   const DrawItem item{upload(makeQuad(-1, -1, 1, 1, 0)), glm::mat4(1.0f), material};
-  for (const auto& lights : {std::vector<Light>{directional, point},
-                             std::vector<Light>{point, directional}}) {
+  for (const auto& lights :
+       {std::vector<Light>{directional, point}, std::vector<Light>{point, directional}}) {
     lighting.lights = lights;
     const RgbaImage image = render({item}, lighting);
     // 0.25 red from the directional light; 1 / (1 + 1 * 1^2) = 0.5 green from the point light.
@@ -319,8 +319,7 @@ TEST_P(MeshRendererTest, InvalidDrawInputsAreRejectedBeforeDrawing) {
   DrawItem item{mesh, glm::mat4(1.0f), unlitColor(1, 1, 1)};
   EXPECT_EQ(rig_.renderer->draw(&item, 1, orthoCamera(), tooMany).code(),
             ErrorCode::kInvalidArgument);
-  EXPECT_EQ(rig_.renderer->prepare(Material(), false, tooMany).code(),
-            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(rig_.renderer->prepare(Material(), false, tooMany).code(), ErrorCode::kInvalidArgument);
   Lighting two;
   two.lights.resize(2);
   EXPECT_TRUE(rig_.renderer->prepare(Material(), true, two).ok());

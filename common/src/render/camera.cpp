@@ -19,9 +19,9 @@ bool colour(const glm::vec3& c) { return finite(c) && c.x >= 0.0f && c.y >= 0.0f
 
 Status validateLighting(const Lighting& lighting, const std::string& what) {
   if (lighting.lights.size() > static_cast<std::size_t>(kMaxLights)) {
-    return Status(ErrorCode::kInvalidArgument, what + ": " +
-                                                   std::to_string(lighting.lights.size()) +
-                                                   " lights, at most " + std::to_string(kMaxLights));
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": " + std::to_string(lighting.lights.size()) + " lights, at most " +
+                      std::to_string(kMaxLights));
   }
   if (!colour(lighting.ambient)) {
     return Status(ErrorCode::kInvalidArgument,

@@ -70,8 +70,9 @@ Status validateOptions(const DaemonOptions& o) {
   if (!parseBackend(o.backend).ok()) return parseBackend(o.backend).status();
   if (!std::isfinite(o.rate)) return invalid("rate", "not finite");
   if (!o.poseStreamPath.empty() && o.rate < 0.0) {
-    return invalid("rate", "unpaced (negative) with --pose-stream would redraw the last pose "
-                           "back to back; use 0 (a frame per pose) or a positive rate");
+    return invalid("rate",
+                   "unpaced (negative) with --pose-stream would redraw the last pose "
+                   "back to back; use 0 (a frame per pose) or a positive rate");
   }
   if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
   if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");

@@ -48,11 +48,11 @@
 #include <string>
 #include <vector>
 
+#include "pose_source.h"
 #include "thinlod/common/status.h"
 #include "thinlod/common/trace.h"
 #include "thinlod/frontend/frame_record.h"
 #include "thinlod/frontend/frontend_scene.h"
-#include "pose_source.h"
 #include "thinlod/protocol/messages.h"
 #include "wire_conversion.h"
 
@@ -153,8 +153,8 @@ struct ReplayResult {
   std::size_t posesNotSent = 0;  // link down at the time
   std::size_t posesSkipped = 0;  // a stream's poses overtaken by newer ones before a frame
   std::size_t framesRedrawingAPose = 0;
-  bool interrupted = false;      // stopRequested() ended it early
-  Status status;                 // why it ended early with an error
+  bool interrupted = false;  // stopRequested() ended it early
+  Status status;             // why it ended early with an error
 };
 
 ReplayResult runReplay(PoseSource& source, const ReplayOptions& options, Clock& clock,

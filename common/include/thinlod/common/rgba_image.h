@@ -27,7 +27,9 @@ struct RgbaImage {
   RgbaImage() = default;
   // Precondition: w, h >= 0 (sizes from outside are checked before this).
   RgbaImage(int w, int h)
-      : width(w), height(h), pixels(static_cast<std::size_t>(checkedSide(w)) * checkedSide(h) * 4, 0) {}
+      : width(w),
+        height(h),
+        pixels(static_cast<std::size_t>(checkedSide(w)) * checkedSide(h) * 4, 0) {}
 
   bool empty() const { return width <= 0 || height <= 0; }
   // Every alpha is 255 (true for an image without pixels).

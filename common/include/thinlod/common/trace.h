@@ -97,7 +97,7 @@ class TraceStreamParser {
   explicit TraceStreamParser(const Options& options) : options_(options) {}
 
   struct Output {
-    std::vector<Pose> poses;    // in order, times strictly increasing
+    std::vector<Pose> poses;     // in order, times strictly increasing
     std::vector<Status> errors;  // kParseError / kVersionMismatch, "line N: ..."
   };
   // Appends `bytes` and parses every line they complete into `out`.

@@ -33,8 +33,8 @@
 namespace thinlod::render {
 
 // Clip-space y mirror (see "Rows" above): clip = kMirrorClipY * projection * view * world.
-inline const glm::mat4 kMirrorClipY{1.0f, 0.0f, 0.0f,  0.0f, 0.0f, -1.0f, 0.0f, 0.0f,
-                                    0.0f, 0.0f, 1.0f,  0.0f, 0.0f, 0.0f,  0.0f, 1.0f};
+inline const glm::mat4 kMirrorClipY{1.0f, 0.0f, 0.0f, 0.0f, 0.0f, -1.0f, 0.0f, 0.0f,
+                                    0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f,  0.0f, 1.0f};
 
 class RenderTarget {
  public:
