@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/finite.h"
+
 namespace thinlod {
 namespace {
 
@@ -22,10 +24,6 @@ constexpr double kRelativeMargin = 1e-12;
 constexpr double kAngleMargin = 1e-12;
 // Accept float pi (3.14159274) as pi.
 constexpr double kAlphaSlack = 1e-6;
-
-bool isFinite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 // Angle between u (any length) and unit d; accurate near 0 and pi.
 double angleTo(const glm::dvec3& u, const glm::dvec3& d) {
@@ -150,7 +148,7 @@ ConicRange ConicRange::nowhere() {
 }
 
 ConicRange ConicRange::ball(const glm::dvec3& center, double radius) {
-  assert(isFinite(center) && radius >= 0.0 && "ConicRange::ball: bad centre or radius");
+  assert(allFinite(center) && radius >= 0.0 && "ConicRange::ball: bad centre or radius");
   ConicRange r;
   r.center_ = center;
   r.maxDistance_ = radius;
@@ -162,7 +160,7 @@ Result<ConicRange> ConicRange::make(const glm::dvec3& center, double minDistance
   auto error = [](const std::string& what) {
     return Status(ErrorCode::kInvalidArgument, "conic range: " + what);
   };
-  if (!isFinite(center)) return error("center is not finite");
+  if (!allFinite(center)) return error("center is not finite");
   if (!std::isfinite(minDistance) || minDistance < 0.0) {
     return error("distance min " + std::to_string(minDistance) + " is not finite and >= 0");
   }
@@ -170,7 +168,7 @@ Result<ConicRange> ConicRange::make(const glm::dvec3& center, double minDistance
     return error("distance max " + std::to_string(maxDistance) + " is below min " +
                  std::to_string(minDistance));
   }
-  if (!isFinite(direction) || !(glm::length(direction) > 0.0)) {
+  if (!allFinite(direction) || !(glm::length(direction) > 0.0)) {
     return error("direction is zero or not finite");
   }
   if (!(alpha > 0.0) || !(alpha <= kPi + kAlphaSlack)) {
@@ -196,7 +194,7 @@ bool ConicRange::operator==(const ConicRange& other) const {
 }
 
 bool ConicRange::containsPoint(const glm::dvec3& p) const {
-  if (isEmpty() || !isFinite(p)) return false;
+  if (isEmpty() || !allFinite(p)) return false;
   const glm::dvec3 v = p - center_;
   const double distance = glm::length(v);
   if (distance < minDistance_ || distance > maxDistance_) return false;
@@ -205,7 +203,7 @@ bool ConicRange::containsPoint(const glm::dvec3& p) const {
 }
 
 bool ConicRange::containsSphere(const glm::dvec3& center, double radius) const {
-  if (isEmpty() || !isFinite(center) || !std::isfinite(radius) || !(radius >= 0.0)) return false;
+  if (isEmpty() || !allFinite(center) || !std::isfinite(radius) || !(radius >= 0.0)) return false;
   const glm::dvec3 v = center - center_;
   const double distance = glm::length(v);
   const double tolerance =
@@ -221,7 +219,7 @@ bool ConicRange::containsSphere(const glm::dvec3& center, double radius) const {
 }
 
 double ConicRange::clearance(const glm::dvec3& p) const {
-  if (isEmpty() || !isFinite(p)) return 0.0;
+  if (isEmpty() || !allFinite(p)) return 0.0;
   const glm::dvec3 v = p - center_;
   const double distance = glm::length(v);
   const double tolerance = kRelativeMargin * (glm::length(p) + glm::length(center_) + distance);

@@ -2,17 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <glm/geometric.hpp>
 
+#include "thinlod/common/finite.h"
+
 namespace thinlod {
-namespace {
-
-bool isFinite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-}  // namespace
 
 void Bounds::extend(const glm::vec3& p) {
   if (empty) {
@@ -35,18 +29,18 @@ Status IndexedMesh::validate(const std::string& what) const {
                   what + ": attribute count differs from vertex count " + std::to_string(n));
   }
   if (indices.size() % 3 != 0) {
-    return Status(ErrorCode::kInvalidArgument,
-                  what + ": index count " + std::to_string(indices.size()) +
-                      " is not a multiple of 3");
+    return Status(
+        ErrorCode::kInvalidArgument,
+        what + ": index count " + std::to_string(indices.size()) + " is not a multiple of 3");
   }
   for (std::size_t i = 0; i < n; ++i) {
-    if (!isFinite(positions[i])) {
+    if (!allFinite(positions[i])) {
       return Status(ErrorCode::kInvalidArgument,
                     what + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
     }
   }
   for (std::size_t i = 0; i < normals.size(); ++i) {
-    if (!isFinite(normals[i])) {
+    if (!allFinite(normals[i])) {
       return Status(ErrorCode::kInvalidArgument,
                     what + ": normal " + std::to_string(i) + " is NaN or infinite");
     }
@@ -61,8 +55,7 @@ Status IndexedMesh::validate(const std::string& what) const {
     if (indices[i] >= n) {
       return Status(ErrorCode::kInvalidArgument,
                     what + ": triangle " + std::to_string(i / 3) + " references vertex " +
-                        std::to_string(indices[i]) + " (only " + std::to_string(n) +
-                        " vertices)");
+                        std::to_string(indices[i]) + " (only " + std::to_string(n) + " vertices)");
     }
   }
   return Status();

@@ -6,14 +6,14 @@
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
 
+#include "thinlod/common/finite.h"
+
 namespace thinlod::render {
 namespace {
 
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+bool colour(const glm::vec3& c) {
+  return allFinite(c) && c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f;
 }
-
-bool colour(const glm::vec3& c) { return finite(c) && c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f; }
 
 }  // namespace
 
@@ -29,7 +29,7 @@ Status validateLighting(const Lighting& lighting, const std::string& what) {
   }
   for (std::size_t i = 0; i < lighting.lights.size(); ++i) {
     const Light& light = lighting.lights[i];
-    if (!finite(light.vector) || !colour(light.color) || !std::isfinite(light.attenuation) ||
+    if (!allFinite(light.vector) || !colour(light.color) || !std::isfinite(light.attenuation) ||
         light.attenuation < 0.0f ||
         (light.type == Light::Type::kDirectional && glm::length(light.vector) == 0.0f)) {
       return Status(ErrorCode::kInvalidArgument,

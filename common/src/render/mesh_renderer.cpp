@@ -12,6 +12,7 @@
 
 #include "render/gl_functions.h"
 #include "render/shaders.h"
+#include "thinlod/common/finite.h"
 
 namespace thinlod::render {
 namespace {
@@ -46,14 +47,6 @@ struct TextureRecord {
 Status notCurrent(const char* what) {
   return Status(ErrorCode::kUnavailable,
                 std::string(what) + ": the renderer's GL context is not current on this thread");
-}
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-bool finite(const glm::vec4& v) { return finite(glm::vec3(v)) && std::isfinite(v.w); }
-bool finite(const glm::mat4& m) {
-  return finite(m[0]) && finite(m[1]) && finite(m[2]) && finite(m[3]);
 }
 
 Status compileShader(const GlFunctions& gl, GLenum type, const std::string& defines,
@@ -489,7 +482,7 @@ Status MeshRenderer::beginFrame(RenderTarget& target, const glm::vec4& clearColo
     return Status(ErrorCode::kInvalidArgument,
                   "beginFrame: the render target belongs to another context");
   }
-  if (!finite(clearColor)) {
+  if (!allFinite(clearColor)) {
     return Status(ErrorCode::kInvalidArgument, "beginFrame: clear colour is not finite");
   }
   stats_ = RenderStats();
@@ -506,7 +499,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   if (count > 0 && items == nullptr) {
     return Status(ErrorCode::kInvalidArgument, "draw: null item array");
   }
-  if (!finite(camera.view) || !finite(camera.projection)) {
+  if (!allFinite(camera.view) || !allFinite(camera.projection)) {
     return Status(ErrorCode::kInvalidArgument, "draw: camera matrices are not finite");
   }
   THINLOD_RETURN_IF_ERROR(validateLighting(lighting, "draw"));
@@ -519,7 +512,7 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
       return Status(ErrorCode::kNotFound, name + ": no mesh " + std::to_string(item.mesh.id));
     }
     const Material& m = item.material;
-    if (!finite(item.model) || !finite(m.diffuse) || !finite(m.specular) ||
+    if (!allFinite(item.model) || !allFinite(m.diffuse) || !allFinite(m.specular) ||
         !std::isfinite(m.shininess) || !std::isfinite(m.alphaCutoff)) {
       return Status(ErrorCode::kInvalidArgument, name + ": non-finite model matrix or material");
     }

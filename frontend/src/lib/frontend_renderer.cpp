@@ -10,6 +10,7 @@
 
 #include "renderer_checks.h"
 #include "texture_fit.h"
+#include "thinlod/common/finite.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/render_target.h"
 
@@ -337,7 +338,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
     return Status(ErrorCode::kUnavailable,
                   "FrontendRenderer::renderFrame: the GL context is not current on this thread");
   }
-  if (!detail::finiteMatrix(camera.view) || !detail::finiteMatrix(camera.projection)) {
+  if (!allFinite(camera.view) || !allFinite(camera.projection)) {
     return Status(ErrorCode::kInvalidArgument, "renderFrame: camera matrices are not finite");
   }
   THINLOD_RETURN_IF_ERROR(render::validateLighting(lighting, "renderFrame"));

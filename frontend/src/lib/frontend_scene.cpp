@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "renderer_checks.h"
+#include "thinlod/common/finite.h"
 
 namespace thinlod::frontend {
 namespace {
@@ -19,7 +20,7 @@ Status validateRepresentation(const Representation& rep, const std::string& what
     return Status(ErrorCode::kInvalidArgument,
                   what + ": unknown representation kind " + std::to_string(kind));
   }
-  if (!detail::finiteMatrix(rep.transform)) {
+  if (!allFinite(rep.transform)) {
     return Status(ErrorCode::kInvalidArgument, what + ": transform is not finite");
   }
   const float det = glm::determinant(glm::mat3(rep.transform));

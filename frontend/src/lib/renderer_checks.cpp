@@ -1,18 +1,8 @@
 #include "renderer_checks.h"
 
-#include <cmath>
 #include <string>
 
 namespace thinlod::frontend::detail {
-
-bool finiteMatrix(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c) {
-    for (int r = 0; r < 4; ++r) {
-      if (!std::isfinite(m[c][r])) return false;
-    }
-  }
-  return true;
-}
 
 Status checkFrameContext(render::OffscreenContext& context, int width, int height,
                          const char* who) {

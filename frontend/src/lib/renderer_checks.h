@@ -2,15 +2,10 @@
 // FrontendScene. Pure except for querying the (caller-owned) GL context.
 #pragma once
 
-#include <glm/mat4x4.hpp>
-
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::frontend::detail {
-
-// True when all sixteen entries are finite.
-bool finiteMatrix(const glm::mat4& m);
 
 // The checks every renderer's create() starts with: `context` is current on
 // this thread (kUnavailable) and a width x height frame fits its largest
