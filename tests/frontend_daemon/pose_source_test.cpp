@@ -34,6 +34,34 @@ class Pipe {
   int fds_[2] = {-1, -1};
 };
 
+// Options whose arrival clock always reads 0.
+StreamPoseSource::Options stoppedClock() {
+  StreamPoseSource::Options options;
+  options.nowNs = [] { return std::int64_t{0}; };
+  return options;
+}
+
+// StreamPoseSource::open("-") with `fd` standing in as stdin, and stdin's
+// flags right after (to check that opening left the shared description
+// alone); the real stdin is restored before returning.
+struct OpenedAsStdin {
+  Result<std::unique_ptr<StreamPoseSource>> source;
+  int stdinFlagsAfter = -1;
+};
+OpenedAsStdin openAsStdin(int fd) {
+  const int savedStdin = ::dup(STDIN_FILENO);
+  EXPECT_GE(::dup2(fd, STDIN_FILENO), 0);
+  OpenedAsStdin opened{StreamPoseSource::open("-", stoppedClock()), -1};
+  opened.stdinFlagsAfter = ::fcntl(STDIN_FILENO, F_GETFL);
+  if (savedStdin >= 0) {
+    ::dup2(savedStdin, STDIN_FILENO);
+    ::close(savedStdin);
+  } else {
+    ::close(STDIN_FILENO);
+  }
+  return opened;
+}
+
 // A source reading a dup of the pipe's read end, stamping arrivals with `clockNs`.
 std::unique_ptr<StreamPoseSource> sourceOn(const Pipe& pipe, std::vector<std::string>* errors,
                                            const std::int64_t* clockNs = nullptr) {
@@ -152,9 +180,7 @@ TEST(StreamPoseSource, AFifoWaitsOutAWriterThatLeavesWithoutWriting) {
   const std::string fifo = dir + "thinlod_pose_fifo_" + std::to_string(::getpid());
   ::unlink(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  StreamPoseSource::Options options;
-  options.nowNs = [] { return std::int64_t{0}; };
-  auto opened = StreamPoseSource::open(fifo, std::move(options));
+  auto opened = StreamPoseSource::open(fifo, stoppedClock());
   ASSERT_TRUE(opened.ok()) << opened.status().toString();
   StreamPoseSource& source = **opened;
   source.refresh();
@@ -181,21 +207,11 @@ TEST(StreamPoseSource, AFifoWaitsOutAWriterThatLeavesWithoutWriting) {
 TEST(StreamPoseSource, StandardInputIsReopenedSoTheCallersStaysBlocking) {
   // Stdin is a (blocking) pipe for this test, whatever the runner gave us.
   Pipe pipe;
-  const int savedStdin = ::dup(STDIN_FILENO);
-  ASSERT_GE(::dup2(pipe.reader(), STDIN_FILENO), 0);
-  ASSERT_EQ(::fcntl(STDIN_FILENO, F_GETFL) & O_NONBLOCK, 0);
-  StreamPoseSource::Options options;
-  options.nowNs = [] { return std::int64_t{0}; };
-  auto opened = StreamPoseSource::open("-", std::move(options));
-  const int flagsAfter = ::fcntl(STDIN_FILENO, F_GETFL);
-  if (savedStdin >= 0) {
-    ::dup2(savedStdin, STDIN_FILENO);
-    ::close(savedStdin);
-  } else {
-    ::close(STDIN_FILENO);
-  }
+  ASSERT_EQ(::fcntl(pipe.reader(), F_GETFL) & O_NONBLOCK, 0);
+  OpenedAsStdin asStdin = openAsStdin(pipe.reader());
+  auto& opened = asStdin.source;
   ASSERT_TRUE(opened.ok()) << opened.status().toString();
-  EXPECT_EQ(flagsAfter & O_NONBLOCK, 0);  // the shared description was not touched
+  EXPECT_EQ(asStdin.stdinFlagsAfter & O_NONBLOCK, 0);  // the shared description was not touched
   pipe.write("# thinlod-trace 1\n" + poseLine(2));
   (*opened)->refresh();
   ASSERT_TRUE((*opened)->ready());  // and the source reads the same pipe
@@ -203,17 +219,14 @@ TEST(StreamPoseSource, StandardInputIsReopenedSoTheCallersStaysBlocking) {
 }
 
 TEST(StreamPoseSource, AMissingPathIsAnIoError) {
-  StreamPoseSource::Options options;
-  options.nowNs = [] { return std::int64_t{0}; };
-  auto opened = StreamPoseSource::open("/nonexistent/poses", std::move(options));
+  auto opened = StreamPoseSource::open("/nonexistent/poses", stoppedClock());
   EXPECT_EQ(opened.status().code(), ErrorCode::kIoError);
   EXPECT_NE(opened.status().message().find("/nonexistent/poses"), std::string::npos);
 }
 
 TEST(StreamPoseSource, ARestartedTimeBaseStillHandsOutIncreasingTimes) {
   Pipe pipe;
-  StreamPoseSource::Options options;
-  options.nowNs = [] { return std::int64_t{0}; };
+  StreamPoseSource::Options options = stoppedClock();
   options.parser.timeBaseRestartAfter = 2;
   auto source = StreamPoseSource::create(::dup(pipe.reader()), std::move(options));
   ASSERT_TRUE(source.ok());
@@ -234,19 +247,11 @@ TEST(StreamPoseSource, ARestartedTimeBaseStillHandsOutIncreasingTimes) {
 TEST(StreamPoseSource, StandardInputMayBeASocket) {
   int sockets[2];
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, sockets), 0);
-  const int savedStdin = ::dup(STDIN_FILENO);
-  ASSERT_GE(::dup2(sockets[0], STDIN_FILENO), 0);
-  StreamPoseSource::Options options;
-  options.nowNs = [] { return std::int64_t{0}; };
-  auto opened = StreamPoseSource::open("-", std::move(options));
-  const int flagsAfter = ::fcntl(STDIN_FILENO, F_GETFL);
-  if (savedStdin >= 0) {
-    ::dup2(savedStdin, STDIN_FILENO);
-    ::close(savedStdin);
-  }
+  OpenedAsStdin asStdin = openAsStdin(sockets[0]);
+  auto& opened = asStdin.source;
   ::close(sockets[0]);
   ASSERT_TRUE(opened.ok()) << opened.status().toString();
-  EXPECT_EQ(flagsAfter & O_NONBLOCK, 0);
+  EXPECT_EQ(asStdin.stdinFlagsAfter & O_NONBLOCK, 0);
   (*opened)->refresh();  // nothing yet: must not block
   EXPECT_FALSE((*opened)->ready());
   const std::string text = "# thinlod-trace 1\n" + poseLine(7);
