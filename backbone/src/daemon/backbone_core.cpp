@@ -117,6 +117,12 @@ Result<std::unique_ptr<BackboneCore>> BackboneCore::create(scene::Scene scene,
 
 const char* BackboneCore::schedulerName() const { return scheduler_->name(); }
 
+Status BackboneCore::admitFrontend(const protocol::Hello& hello) const {
+  if (hello.role != protocol::Role::kFrontend) return Status();
+  return protocol::checkSameScene("backbone", sceneGraph_.fingerprint, scenePath_, "frontend",
+                                  hello.sceneFingerprint, hello.sceneFile);
+}
+
 Status BackboneCore::initialize() {
   Result<std::vector<scene::SceneObject>> objects = scene::collectSceneObjects(sceneGraph_);
   if (!objects.ok()) return objects.status();
@@ -225,6 +231,7 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
   message.requestId = request.ticket;
   message.objectId = record.id;
   message.sourcePath = scenePath_;
+  message.sceneFingerprint = sceneGraph_.fingerprint;
   message.target = protocol::SimplifyRequest::Target::kTriangles;
   message.targetTriangles = request.targetTriangles;
   message.curvePoints = warmup ? 0 : options_.curvePoints;
@@ -359,6 +366,7 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     protocol::SimplifyRequest simplify;
     simplify.objectId = record.id;
     simplify.sourcePath = scenePath_;
+    simplify.sceneFingerprint = sceneGraph_.fingerprint;
     simplify.target = protocol::SimplifyRequest::Target::kTriangles;
     simplify.targetTriangles = request.targetTriangles;
     message = std::move(simplify);
@@ -386,6 +394,7 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
       return;
     }
     protocol::ImpostorRequest impostor;
+    impostor.sceneFingerprint = sceneGraph_.fingerprint;
     impostor.objectIds = {record.id};
     impostor.eye = glm::vec3(r.viewRegion.center);
     impostor.orientation = pose_.orientation;

@@ -448,7 +448,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   BackboneCore& backbone = **core;
-  spdlog::info("event=scene path={} objects={} lods={} options={} curves_wanted={}", scenePath,
+  spdlog::info("event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={}",
+               scenePath, protocol::fingerprintText(backbone.sceneFingerprint()),
                backbone.objects().size(), backbone.lodNodes(),
                backbone.schedulingScene().options.size(), backbone.curvesPending());
 
@@ -467,6 +468,9 @@ int main(int argc, char** argv) {
   endpointOptions.address = settings.frontendAddress;
   endpointOptions.name = "backbone";
   endpointOptions.transport = settings.transport;
+  endpointOptions.admit = [&backbone](const protocol::Hello& hello) {
+    return backbone.admitFrontend(hello);
+  };
   auto frontends = protocol::Endpoint::bind(endpointOptions);
   if (!frontends.ok()) {
     spdlog::error("event=bind_failed address={} error=\"{}\"", settings.frontendAddress,
