@@ -775,6 +775,86 @@ TEST(BackboneCoreSession, NewFrontendSessionIsServedFromStoredCopies) {
   EXPECT_LE(outcome.frontendTriangles, 400.0);
 }
 
+// The loop is closed: a SceneUpdate the frontend refused (FrameStats
+// rejected_plans) is corrected in the backbone's mirror and its objects are
+// sent again; an applied one is simply forgotten.
+TEST(BackboneCoreAcknowledgement, RefusedUpdateIsCorrectedAndItsObjectsAreSentAgain) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  answer(*core, fake, submitAll(*core));
+  const PoseOutcome first = core->finishPose();
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+  const std::vector<OutgoingRequest> later = submitAll(*core);
+  const PoseOutcome sent = core->finishPose();
+  answer(*core, fake, later);  // nothing is in flight when the refusal comes
+  ASSERT_GT(sent.adds, 0u);
+  ASSERT_GT(core->frontendTriangles(), 0.0);
+  EXPECT_GT(core->frontendMirror().unacknowledged(), 0u);
+  std::set<std::uint64_t> refusedIds;
+  for (const auto& op : sent.update.operations) refusedIds.insert(op.objectId);
+
+  protocol::FrameStats stats;
+  stats.frame = 1;
+  stats.plan = first.update.plan;  // the empty first update was applied
+  stats.rejectedPlans = {sent.update.plan};
+  EXPECT_EQ(core->onFrameStats(stats), refusedIds.size());
+  EXPECT_EQ(core->frontendTriangles(), 0.0);  // the frontend kept nothing of it
+  EXPECT_EQ(core->frontendMirror().unacknowledged(), 0u);
+
+  ASSERT_TRUE(core->beginPose(poseAt(2, 1.0, kEntrance, kCow)).ok());
+  submitAll(*core);
+  const PoseOutcome again = core->finishPose();
+  std::set<std::uint64_t> resent;
+  for (const auto& op : again.update.operations) {
+    EXPECT_EQ(op.type, protocol::SceneOperation::Type::kAddOrReplace);  // sent, not removed
+    resent.insert(op.objectId);
+  }
+  EXPECT_EQ(resent, refusedIds);
+  EXPECT_EQ(again.resyncRemoves, 0u);
+  EXPECT_EQ(again.frontendTriangles, sent.frontendTriangles);
+  EXPECT_TRUE(protocol::validate(protocol::Message(again.update)).ok());
+
+  // Applied: the mirror keeps its picture and forgets the change.
+  stats.plan = again.update.plan;
+  stats.rejectedPlans.clear();
+  EXPECT_EQ(core->onFrameStats(stats), 0u);
+  EXPECT_EQ(core->frontendTriangles(), again.frontendTriangles);
+  EXPECT_EQ(core->frontendMirror().unacknowledged(), 0u);
+}
+
+// A refused update whose objects cannot be sent again at once (here the
+// polygon cap is full of other objects the frontend still shows) is resolved
+// by removing what the frontend may still show of them.
+TEST(BackboneCoreAcknowledgement, RefusedObjectThatIsNotResentIsRemovedAtTheFrontend) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  answer(*core, fake, submitAll(*core));
+  (void)core->finishPose();
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+  submitAll(*core);
+  const PoseOutcome sent = core->finishPose();
+  ASSERT_GT(sent.adds, 0u);
+  protocol::FrameStats stats;
+  stats.rejectedPlans = {sent.update.plan};
+  ASSERT_GT(core->onFrameStats(stats), 0u);
+  // The viewer turns away: nothing is visible, so nothing is sent again and
+  // every refused object is removed at the frontend.
+  const glm::vec3 away = kEntrance + glm::vec3(0.0f, 0.0f, 10.0f);
+  ASSERT_TRUE(core->beginPose(poseAt(2, 1.0, kEntrance, away)).ok());
+  submitAll(*core);
+  const PoseOutcome resync = core->finishPose();
+  EXPECT_EQ(resync.resyncRemoves, sent.adds);
+  EXPECT_EQ(countOps(resync.update, protocol::SceneOperation::Type::kRemove), sent.adds);
+  EXPECT_EQ(core->frontendTriangles(), 0.0);
+  EXPECT_TRUE(protocol::validate(protocol::Message(resync.update)).ok());
+}
+
 TEST(BackboneCoreOptions, InvalidOptionsAreRefused) {
   CoreOptions options = polygonBudget(200);
   options.scheduler = "random";

@@ -450,8 +450,7 @@ void BackboneCore::learnMeshBytes(std::uint32_t object, double meshBytes, double
 
 void BackboneCore::storeBackboneCopy(std::uint32_t option, backbone::RepresentationCopy copy,
                                      protocol::Representation payload) {
-  scene_.options[option].atBackbone = copy;
-  optionStates_[option].backbonePayload = std::move(payload);
+  mirror_.storeGenerated(option, copy, std::move(payload));
   touchObject(optionStates_[option].object);
 }
 
@@ -680,46 +679,6 @@ Status BackboneCore::replan() {
   return planStatus_;
 }
 
-double BackboneCore::frontendTrianglesOf(std::uint32_t object) const {
-  const backbone::SceneObject& o = scene_.objects[object];
-  double sum = 0.0;
-  for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k) {
-    if (scene_.options[k].atFrontend.present) sum += scene_.options[k].atFrontend.triangles;
-  }
-  return sum;
-}
-
-void BackboneCore::removeFromFrontend(std::uint32_t object) {
-  const backbone::SceneObject& o = scene_.objects[object];
-  for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k) {
-    backbone::RepresentationOption& option = scene_.options[k];
-    OptionState& state = optionStates_[k];
-    if (!option.atFrontend.present) continue;
-    frontendTriangles_ -= option.atFrontend.triangles;
-    // Still a valid representation: keep it for a later send.
-    if (!option.atBackbone.present && state.frontendPayload) {
-      option.atBackbone = option.atFrontend;
-      state.backbonePayload = std::move(state.frontendPayload);
-    }
-    option.atFrontend = backbone::RepresentationCopy();
-    state.frontendPayload.reset();
-    touchObject(object);
-  }
-}
-
-void BackboneCore::moveToFrontend(std::uint32_t index) {
-  OptionState& state = optionStates_[index];
-  backbone::RepresentationOption& option = scene_.options[index];
-  removeFromFrontend(state.object);
-  option.atFrontend = option.atBackbone;
-  state.frontendPayload = std::move(state.backbonePayload);
-  option.atBackbone = backbone::RepresentationCopy();
-  state.backbonePayload.reset();
-  frontendTriangles_ += option.atFrontend.triangles;
-  promised_.erase(option.atFrontend.id);  // delivered: a later await needs a new promise
-  touchObject(state.object);
-}
-
 protocol::SceneUpdate BackboneCore::emptyUpdate(const protocol::ViewerPose& pose) {
   protocol::SceneUpdate update;
   update.plan = poseCounter_;
@@ -733,7 +692,7 @@ PoseOutcome BackboneCore::finishPose() {
   out.update.plan = poseCounter_;
   out.update.frame = pose_.sequence;
   out.plans = plansThisPose_;
-  out.frontendTriangles = frontendTriangles_;
+  out.frontendTriangles = mirror_.triangles();
   inPose_ = false;
   if (!planStatus_.ok() || !plan_) {
     out.planError = planStatus_.ok() ? Status(ErrorCode::kInternal, "no plan") : planStatus_;
@@ -769,10 +728,10 @@ PoseOutcome BackboneCore::finishPose() {
         if (d.option < 0 || static_cast<std::size_t>(d.option) >= scene_.options.size()) break;
         const auto index = static_cast<std::uint32_t>(d.option);
         const backbone::RepresentationCopy& back = scene_.options[index].atBackbone;
-        if (!back.present || !optionStates_[index].backbonePayload) break;
+        if (!back.present || !mirror_.generatedPayload(index)) break;
         // Await: deliver the copy the scheduler is waiting for once it is here.
         if (d.action == backbone::ObjectAction::kAwait && promised_.count(back.id) == 0) break;
-        const double before = frontendTrianglesOf(d.object);
+        const double before = mirror_.trianglesOf(d.object);
         adds.push_back({d.object, index, back.triangles - before, before == 0.0});
         break;
       }
@@ -787,14 +746,14 @@ PoseOutcome BackboneCore::finishPose() {
   // Removals of every plan of this pose (the scheduler retires an object
   // once; a re-plan does not list it again) unless the final plan renders it.
   for (std::uint32_t object : retiredThisPose_) {
-    if (object < scene_.objects.size() && !rendered[object] && frontendTrianglesOf(object) > 0.0) {
+    if (object < scene_.objects.size() && !rendered[object] && mirror_.trianglesOf(object) > 0.0) {
       rendered[object] = 2;
       removes.push_back(object);
     }
   }
 
   for (std::uint32_t object : removes) {
-    removeFromFrontend(object);
+    mirror_.remove(object, out.update.plan);
     protocol::SceneOperation op;
     op.type = protocol::SceneOperation::Type::kRemove;
     op.objectId = converted_.records[object].id;
@@ -831,10 +790,12 @@ PoseOutcome BackboneCore::finishPose() {
   const double cap = (options_.hardPolygonCap && options_.budget.maxTriangles)
                          ? *options_.budget.maxTriangles
                          : kInf;
+  const std::vector<std::uint32_t> resync = mirror_.takeResyncRemovals();
+  std::vector<std::uint32_t> sentNow;
   for (const Add& add : adds) {
     const backbone::RepresentationCopy& back = scene_.options[add.option].atBackbone;
-    const double delta = back.triangles - frontendTrianglesOf(add.object);
-    if (delta > 0.0 && frontendTriangles_ + delta > cap) {
+    const double delta = back.triangles - mirror_.trianglesOf(add.object);
+    if (delta > 0.0 && mirror_.triangles() + delta > cap) {
       ++out.deferredByPolygonCap;
       continue;
     }
@@ -862,18 +823,44 @@ PoseOutcome BackboneCore::finishPose() {
     protocol::SceneOperation op;
     op.type = protocol::SceneOperation::Type::kAddOrReplace;
     op.objectId = converted_.records[add.object].id;
-    op.representation = *optionStates_[add.option].backbonePayload;
+    op.representation = *mirror_.generatedPayload(add.option);
     out.update.operations.push_back(std::move(op));
-    moveToFrontend(add.option);
+    mirror_.send(add.object, add.option, out.update.plan);
+    promised_.erase(scene_.options[add.option].atFrontend.id);  // delivered: await anew
+    sentNow.push_back(add.object);
     ++out.adds;
   }
-  out.frontendTriangles = frontendTriangles_;
+  // Objects whose frontend copy is unknown after a refused update: remove
+  // what the frontend may still show, unless this update replaced it.
+  for (std::uint32_t object : resync) {
+    if (std::find(sentNow.begin(), sentNow.end(), object) != sentNow.end()) continue;
+    if (std::find(removes.begin(), removes.end(), object) != removes.end()) continue;
+    protocol::SceneOperation op;
+    op.type = protocol::SceneOperation::Type::kRemove;
+    op.objectId = converted_.records[object].id;
+    out.update.operations.push_back(std::move(op));
+    mirror_.remove(object, out.update.plan);
+    ++out.resyncRemoves;
+  }
+  out.frontendTriangles = mirror_.triangles();
   return out;
 }
 
+std::size_t BackboneCore::onFrameStats(const protocol::FrameStats& stats) {
+  const std::vector<std::uint32_t> corrected = mirror_.acknowledge(stats.plan, stats.rejectedPlans);
+  // The scheduler still awaits the refused copies (they were on their way to
+  // the frontend): promise them again so the next update delivers them.
+  for (std::uint32_t object : corrected) {
+    const backbone::SceneObject& o = scene_.objects[object];
+    for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k)
+      if (scene_.options[k].atBackbone.present)
+        promised_[scene_.options[k].atBackbone.id] = viewer_.timeSeconds;
+  }
+  return corrected.size();
+}
+
 void BackboneCore::resetFrontend() {
-  for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) removeFromFrontend(k);
-  frontendTriangles_ = 0.0;
+  mirror_.reset();
   planner_.reset();
   promised_.clear();
   shaper_.reset();

@@ -37,6 +37,7 @@
 #include <variant>
 #include <vector>
 
+#include "frontend_mirror.h"
 #include "scene_conversion.h"
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/protocol/link_shaper.h"
@@ -91,6 +92,7 @@ struct PoseOutcome {
   std::uint32_t deferredByPolygonCap = 0;
   std::uint32_t deferredByLink = 0;
   std::uint32_t tooLargeForLink = 0;  // larger than the shaper's burst: dropped
+  std::uint32_t resyncRemoves = 0;    // removals of objects a refused update left unknown
   std::uint64_t linkBytes = 0;        // shaped bytes of this update
   double frontendTriangles = 0.0;     // after the update is applied
 };
@@ -126,13 +128,17 @@ class BackboneCore {
   protocol::SceneUpdate emptyUpdate(const protocol::ViewerPose& pose);
 
   void resetFrontend();
+  // The frontend's acknowledgement: corrects the mirror for refused updates
+  // (FrontendMirror::acknowledge); returns the objects corrected.
+  std::size_t onFrameStats(const protocol::FrameStats& stats);
 
   // ---- introspection (tests, logs) ----
   const backbone::SchedulingScene& schedulingScene() const { return scene_; }
   const std::vector<ObjectRecord>& objects() const { return converted_.records; }
   const std::vector<scene::SceneObject>& sceneObjects() const { return sceneObjects_; }
   std::uint32_t lodNodes() const { return converted_.lodNodes; }
-  double frontendTriangles() const { return frontendTriangles_; }
+  double frontendTriangles() const { return mirror_.triangles(); }
+  const FrontendMirror& frontendMirror() const { return mirror_; }
   // The latest plan of the current (or last) pose; null before the first.
   const backbone::Plan* latestPlan() const { return plan_ ? &*plan_ : nullptr; }
   std::size_t outstandingRequests() const { return byTicket_.size(); }
@@ -158,8 +164,6 @@ class BackboneCore {
     double estimatedTriangles = 0.0;
     double estimatedBytes = 0.0;
     bool learned = false;
-    std::optional<protocol::Representation> backbonePayload;
-    std::optional<protocol::Representation> frontendPayload;
   };
   struct Outstanding {
     std::uint64_t ticket = 0;
@@ -189,9 +193,6 @@ class BackboneCore {
   void learnMeshBytes(std::uint32_t object, double meshBytes, double triangles);
   void storeBackboneCopy(std::uint32_t option, backbone::RepresentationCopy copy,
                          protocol::Representation payload);
-  void moveToFrontend(std::uint32_t option);
-  void removeFromFrontend(std::uint32_t object);
-  double frontendTrianglesOf(std::uint32_t object) const;
   double timeoutSeconds() const;
 
   scene::Scene sceneGraph_;
@@ -200,6 +201,7 @@ class BackboneCore {
   CoreOptions options_;
   ConvertedScene converted_;
   backbone::SchedulingScene scene_;
+  FrontendMirror mirror_{scene_, [this](std::uint32_t object) { touchObject(object); }};
   std::vector<OptionState> optionStates_;
   std::vector<double> meshBytesPerTriangle_;  // per object
   std::vector<bool> meshBytesLearned_;
@@ -236,7 +238,6 @@ class BackboneCore {
   std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   std::optional<protocol::LinkShaper> shaper_;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
-  double frontendTriangles_ = 0.0;
 };
 
 }  // namespace thinlod::backbone_daemon

@@ -266,8 +266,14 @@ class Daemon {
         if (auto* pose = std::get_if<protocol::ViewerPose>(&event.message)) {
           poses_.emplace_back(event.peer, *pose);
         } else if (auto* stats = std::get_if<protocol::FrameStats>(&event.message)) {
-          spdlog::debug("event=frame_stats frame={} polygons={} link_bytes={}", stats->frame,
-                        stats->polygons, stats->linkBytes);
+          spdlog::debug("event=frame_stats frame={} plan={} polygons={} link_bytes={}",
+                        stats->frame, stats->plan, stats->polygons, stats->linkBytes);
+          if (active_ && *active_ == event.peer) {
+            const std::size_t corrected = core_.onFrameStats(*stats);
+            if (!stats->rejectedPlans.empty())
+              spdlog::warn("event=updates_refused frame={} plans={} objects_corrected={}",
+                           stats->frame, stats->rejectedPlans.size(), corrected);
+          }
         } else {
           spdlog::warn("event=unexpected_dropped endpoint=frontends peer={} message={}",
                        event.peer.value, protocol::messageName(event.message));

@@ -76,6 +76,7 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   produced.appliedPlan = report->appliedPlan;
   produced.committedBatches = report->committedBatches;
   produced.droppedBatches = report->droppedBatches;
+  produced.droppedPlans = report->droppedPlans;
   produced.lastUploadError = report->lastUploadError;
   produced.renderMs = report->timing.totalMs;
   produced.drawCalls = report->drawCalls;

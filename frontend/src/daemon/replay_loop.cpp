@@ -177,6 +177,7 @@ class Replay {
         ++result_.updatesRejected;
         ++extras_.updatesRejected;
         observer_.onUpdateRejected(update, submitted);
+        refusedPlans_.push_back(update.plan);  // the backbone corrects its mirror
         continue;
       }
       submitted_.push_back({update.plan, update.frame, update.targetAccuracy});
@@ -194,6 +195,8 @@ class Replay {
     record.drawCalls = produced.drawCalls;
     record.uploadedBytes = produced.uploadedBytes;
     if (produced.droppedBatches > 0) observer_.onUploadDropped(frame, produced.lastUploadError);
+    refusedPlans_.insert(refusedPlans_.end(), produced.droppedPlans.begin(),
+                         produced.droppedPlans.end());
     if (produced.committedBatches > 0) {
       result_.updatesApplied += produced.committedBatches;
       // Batches become visible in arrival order; the newest visible one is
@@ -224,7 +227,13 @@ class Replay {
     stats.hasSnr = std::isfinite(record.snrDb);
     stats.snrDb = stats.hasSnr ? record.snrDb : 0.0;
     stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
+    // Oldest first; a flood beyond the message's limit keeps the newest.
+    const std::size_t skip = refusedPlans_.size() > protocol::kMaxRejectedPlans
+                                 ? refusedPlans_.size() - protocol::kMaxRejectedPlans
+                                 : 0;
+    stats.rejectedPlans.assign(refusedPlans_.begin() + skip, refusedPlans_.end());
     const Status sent = link_.send(stats);
+    if (sent.ok()) refusedPlans_.clear();
     if (!sent.ok()) observer_.onSendFailed("FrameStats", record.frame, sent);
   }
 
@@ -238,6 +247,8 @@ class Replay {
   std::vector<std::int64_t> poseSentNs_;  // -1: not sent
   std::vector<bool> answered_;            // an update for this pose arrived
   std::deque<SubmittedUpdate> submitted_;
+  // Plans of updates refused or dropped since the last FrameStats.
+  std::vector<std::uint64_t> refusedPlans_;
   double targetAccuracy_ = FrameRecord::kMissing;
   FrameExtras extras_;
   ReplayResult result_;

@@ -88,6 +88,7 @@ struct ProducedFrame {
   std::uint64_t appliedPlan = 0;
   std::size_t committedBatches = 0;
   std::size_t droppedBatches = 0;
+  std::vector<std::uint64_t> droppedPlans;  // plans of the dropped batches
   std::string lastUploadError;
   double renderMs = 0.0;
   std::size_t drawCalls = 0;

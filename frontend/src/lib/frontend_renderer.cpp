@@ -187,6 +187,7 @@ struct FrontendRenderer::Impl {
       // The batch can never be shown whole: drop it and free what it uploaded.
       for (RepresentationKey key : scene.dropBatch(upload.batchSequence)) releasePart(key);
       ++report.droppedBatches;
+      report.droppedPlans.push_back(upload.batchPlan);
       report.lastUploadError = status.toString();
       break;  // dropBatch may have invalidated the remaining plan entries
     }

@@ -163,7 +163,7 @@ std::vector<PendingUpload> FrontendScene::planUploads(std::size_t byteBudget) co
       // Strict arrival order: stop at the first item that does not fit, unless
       // nothing went yet (an oversized item goes alone rather than stall).
       if (!fits && !plan.empty()) return plan;
-      plan.push_back(PendingUpload{object.key, batch.sequence, &object});
+      plan.push_back(PendingUpload{object.key, batch.sequence, batch.plan, &object});
       spent += object.uploadBytes;
       if (!fits) return plan;
     }

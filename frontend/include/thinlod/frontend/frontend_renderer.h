@@ -78,9 +78,10 @@ struct FrameReport {
   std::size_t uploadedObjects = 0;
   std::size_t geometryBytesRebuilt = 0;  // merged vertex/index bytes re-sent this frame
   std::size_t committedBatches = 0;
-  std::size_t pendingBatches = 0;  // still queued after this frame
-  std::size_t droppedBatches = 0;  // dropped this frame because an upload failed
-  std::string lastUploadError;     // why, when droppedBatches > 0
+  std::size_t pendingBatches = 0;           // still queued after this frame
+  std::size_t droppedBatches = 0;           // dropped this frame because an upload failed
+  std::vector<std::uint64_t> droppedPlans;  // their plans (told to the backbone)
+  std::string lastUploadError;              // why, when droppedBatches > 0
   std::size_t texturePages = 0;
   std::uint64_t appliedPlan = 0;  // FrontendScene::lastAppliedPlan()
 };

@@ -84,6 +84,7 @@ struct SceneObject {
 struct PendingUpload {
   RepresentationKey key = 0;
   std::uint64_t batchSequence = 0;      // which queued batch it belongs to
+  std::uint64_t batchPlan = 0;          // that batch's plan (reported back if it is dropped)
   const SceneObject* object = nullptr;  // valid until the next non-const call
 };
 
