@@ -406,6 +406,11 @@ TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
   EXPECT_FALSE(result.extras[1].lockstepTimedOut);  // the answer came, it was just bad
   EXPECT_EQ(result.records[2].plan, 3u);
   EXPECT_EQ(producer.scene.objects().size(), 1u);
+  // The backbone hears of the refusal once, in the FrameStats of that frame.
+  ASSERT_EQ(link.frameStats.size(), 3u);
+  EXPECT_TRUE(link.frameStats[0].rejectedPlans.empty());
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, (std::vector<std::uint64_t>{2}));
+  EXPECT_TRUE(link.frameStats[2].rejectedPlans.empty());
 }
 
 TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {
