@@ -72,8 +72,8 @@ void deliver(SchedulingScene& scene, const Plan& plan, std::vector<std::uint32_t
     option.atFrontend.relativeAccuracy = r.relativeAccuracy;
     option.atFrontend.triangles = r.expectedTriangles;
     option.atFrontend.encodedBytes = r.expectedBytes;
-    const bool impostor = option.kind == RepresentationKind::kMeshedImpostor ||
-                          option.kind == RepresentationKind::kSimpleImpostor;
+    const bool impostor = option.kind == OptionKind::kMeshedImpostor ||
+                          option.kind == OptionKind::kSimpleImpostor;
     option.atFrontend.validity = impostor
                                      ? ConicRange::ball(r.viewRegion.center, r.viewRegion.radius)
                                      : ConicRange::everywhere();

@@ -85,7 +85,7 @@ TEST(Regions, GrownRegionContainsOriginalAndNearbyOnes) {
 TEST(Candidates, ImpostorOnlyWhenItsRangeHoldsTheWholeRegion) {
   SceneBuilder b;
   const int root = b.group(-1);
-  auto imp = pointOption(RepresentationKind::kSimpleImpostor, 30, 2, 6000);
+  auto imp = pointOption(OptionKind::kSimpleImpostor, 30, 2, 6000);
   imp.validity = fromDistance({0, 0, -10}, 5.0);
   b.leaf(root, {{0, 0, -10}, 0.5}, {meshOption(5, 10, 100, 1000), imp});
   const SchedulingScene scene = b.build();

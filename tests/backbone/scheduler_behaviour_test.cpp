@@ -158,7 +158,7 @@ TEST(FixedAccuracy, EveryVisibleObjectMeetsTheTargetOrIsReported) {
   b.leaf(root, {{0, 0, -3}, 0.5}, {meshOption(4, 8, 400, 4000)});
   b.leaf(root, {{1, 0, -8}, 0.5}, {meshOption(4, 8, 400, 4000)});
   // Only a coarse point near the viewer: 30 * 1.62 / 1 < 200 rad^-1.
-  b.leaf(root, {{-1, 0, -2}, 0.5}, {pointOption(RepresentationKind::kSimpleImpostor, 30, 2, 500)});
+  b.leaf(root, {{-1, 0, -2}, 0.5}, {pointOption(OptionKind::kSimpleImpostor, 30, 2, 500)});
   SchedulingScene scene = b.build();
   auto scheduler = curveScheduler(paperConfig());
   PlannerState state;
@@ -308,7 +308,7 @@ TEST(Stability, CurvesAreReusedForAStandingViewer) {
 int switchesWhileOscillating(double rangeHysteresis) {
   SceneBuilder b;
   const int root = b.group(-1);
-  auto simple = pointOption(RepresentationKind::kSimpleImpostor, 400, 2, 6000);
+  auto simple = pointOption(OptionKind::kSimpleImpostor, 400, 2, 6000);
   simple.validity = fromDistance({0, 0, -20}, 10.0);
   b.leaf(root, {{0, 0, -20}, 0.5}, {meshOption(4, 8, 400, 4000), simple});
   SchedulingScene scene = b.build();
@@ -549,9 +549,9 @@ SchedulingScene paperRoom() {
   auto object = [&](glm::dvec3 at, double radius, double fullTriangles) {
     auto mesh = meshOption(2.0, 8.0, 150.0, fullTriangles);
     auto meshed = meshOption(4.0, 8.0, 60.0, 800.0, 8.0);
-    meshed.kind = RepresentationKind::kMeshedImpostor;
+    meshed.kind = OptionKind::kMeshedImpostor;
     meshed.validity = fromDistance(at, 3.0 * radius);
-    auto simple = pointOption(RepresentationKind::kSimpleImpostor, 25.0, 2.0, 6000.0);
+    auto simple = pointOption(OptionKind::kSimpleImpostor, 25.0, 2.0, 6000.0);
     simple.validity = fromDistance(at, 5.0 * radius);
     b.leaf(root, {at, radius}, {mesh, meshed, simple});
   };

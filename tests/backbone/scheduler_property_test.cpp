@@ -14,7 +14,7 @@ using namespace testing;
 RepresentationOption randomOption(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   RepresentationOption o;
-  o.kind = static_cast<RepresentationKind>(rng() % 4);
+  o.kind = static_cast<OptionKind>(rng() % 4);
   const int pieces = static_cast<int>(rng() % 4);  // 0: a point
   double a = 1.0 + 30.0 * u(rng);
   double t = 1.0 + 200.0 * u(rng);

@@ -33,13 +33,13 @@ inline ValidityRange fromDistance(const glm::dvec3& center, double minDistance) 
 inline RepresentationOption meshOption(double a0, double t0, double a1, double t1,
                                        double bytesPerTriangle = 2.0) {
   RepresentationOption o;
-  o.kind = RepresentationKind::kSimplifiedMesh;
+  o.kind = OptionKind::kSimplifiedMesh;
   o.relativeTriangles = curveThrough({a0, a1}, {t0, t1});
   o.relativeLinkBytes = curveThrough({a0, a1}, {t0 * bytesPerTriangle, t1 * bytesPerTriangle});
   return o;
 }
 
-inline RepresentationOption pointOption(RepresentationKind kind, double accuracy, double triangles,
+inline RepresentationOption pointOption(OptionKind kind, double accuracy, double triangles,
                                         double bytes) {
   RepresentationOption o;
   o.kind = kind;
@@ -178,8 +178,8 @@ inline void applyPlan(SchedulingScene& scene, const Plan& plan) {
     copy.relativeAccuracy = r.relativeAccuracy;
     copy.triangles = r.expectedTriangles;
     copy.encodedBytes = r.expectedBytes;
-    const bool impostor = option.kind == RepresentationKind::kMeshedImpostor ||
-                          option.kind == RepresentationKind::kSimpleImpostor;
+    const bool impostor = option.kind == OptionKind::kMeshedImpostor ||
+                          option.kind == OptionKind::kSimpleImpostor;
     copy.validity = impostor ? ConicRange::ball(r.viewRegion.center, r.viewRegion.radius)
                              : ConicRange::everywhere();
   }

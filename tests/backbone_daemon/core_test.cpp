@@ -19,7 +19,7 @@ namespace {
 
 using namespace testing;
 using backbone::ObjectAction;
-using backbone::RepresentationKind;
+using backbone::OptionKind;
 using backbone::SceneNodeKind;
 
 const glm::vec3 kEntrance(2.0f, 1.1f, 3.5f);
@@ -64,7 +64,7 @@ TEST(BackboneCoreScene, PaperRoomHasFourObjectsUnderTheRootGroup) {
     // simplified mesh + meshed impostor + simple impostor
     ASSERT_EQ(scene.objects[k].optionCount, 3u);
     const auto& first = scene.options[scene.objects[k].firstOption];
-    EXPECT_EQ(first.kind, RepresentationKind::kSimplifiedMesh);
+    EXPECT_EQ(first.kind, OptionKind::kSimplifiedMesh);
   }
   EXPECT_TRUE(backbone::validateScene(scene).ok());
   // Ids 1-3 are the primitives (spheres, cylinder), 4 the cow.

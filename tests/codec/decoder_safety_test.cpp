@@ -149,8 +149,18 @@ TEST(DecoderSafety, TruncatedPngPayloadIsRejectedBeforeTheImageLibrary) {
 
 TEST(DecoderSafety, UnknownVersionIsVersionMismatch) {
   Bytes frame = meshFrame();
-  frame[4] = 2;
+  frame[4] = static_cast<std::uint8_t>(kFrameVersion + 1);
   EXPECT_EQ(decodeMesh(frame.data(), frame.size()).status().code(), ErrorCode::kVersionMismatch);
+}
+
+TEST(DecoderSafety, UnframedCodecInATextureFrameIsUnsupported) {
+  for (TextureCodec unframed : {TextureCodec::kNone, TextureCodec::kRawRgba8}) {
+    Bytes frame = textureFrame(TextureCodec::kZstd);
+    frame[6] = static_cast<std::uint8_t>(unframed);
+    EXPECT_EQ(decodeTexture(frame.data(), frame.size()).status().code(), ErrorCode::kUnsupported);
+    RgbaImage image(4, 4);
+    EXPECT_EQ(encodeTextureWith(image, unframed).status().code(), ErrorCode::kInvalidArgument);
+  }
 }
 
 TEST(DecoderSafety, WrongMagicIsParseError) {

@@ -80,11 +80,7 @@ inline protocol::Texture wireTexture(const RgbaImage& texture, protocol::Texture
     wire.data = texture.pixels;
     return wire;
   }
-  const codec::TextureCodec used = codec == protocol::TextureCodec::kPng ? codec::TextureCodec::kPng
-                                   : codec == protocol::TextureCodec::kJpeg
-                                       ? codec::TextureCodec::kJpeg
-                                       : codec::TextureCodec::kZstd;
-  auto bytes = codec::encodeTextureWith(texture, used);
+  auto bytes = codec::encodeTextureWith(texture, codec);
   EXPECT_TRUE(bytes.ok()) << bytes.status().toString();
   if (bytes.ok()) wire.data = std::move(bytes).value();
   return wire;

@@ -59,7 +59,7 @@ TEST(WireConversion, MeshedImpostorDecodesTextureAndStaysWhite) {
   options.meshColors = &colours;
   const RgbaImage expected = gradientTexture(32, 32);
   for (TextureCodec codec :
-       {TextureCodec::kPng, TextureCodec::kZstdRgba8, TextureCodec::kRawRgba8}) {
+       {TextureCodec::kPng, TextureCodec::kZstd, TextureCodec::kRawRgba8}) {
     SCOPED_TRACE(static_cast<int>(codec));
     auto rep = convertRepresentation(impostorRepresentation(codec), 3, options, "op");
     ASSERT_TRUE(rep.ok()) << rep.status().toString();
@@ -159,7 +159,7 @@ TEST(WireConversion, RawTextureWithWrongByteCountIsRejected) {
 
 TEST(WireConversion, TextureFrameOfAnotherCodecIsRejected) {
   protocol::Representation wire = impostorRepresentation(TextureCodec::kPng);
-  wire.texture.codec = TextureCodec::kZstdRgba8;  // bytes are still a PNG frame
+  wire.texture.codec = TextureCodec::kZstd;  // bytes are still a PNG frame
   auto rep = convertRepresentation(wire, 2, {}, "op");
   ASSERT_FALSE(rep.ok());
   EXPECT_NE(rep.status().message().find("does not match the wire codec"), std::string::npos)
@@ -216,7 +216,7 @@ TEST(WireConversion, UpdateKeepsPlanOrderAndRemovals) {
   remove.type = protocol::SceneOperation::Type::kRemove;
   remove.objectId = 2;
   update.operations.push_back(remove);
-  update.operations.push_back(addOp(3, impostorRepresentation(TextureCodec::kZstdRgba8)));
+  update.operations.push_back(addOp(3, impostorRepresentation(TextureCodec::kZstd)));
   auto batch = convertUpdate(update, {});
   ASSERT_TRUE(batch.ok()) << batch.status().toString();
   EXPECT_EQ(batch->plan, 12u);

@@ -159,7 +159,7 @@ TEST(SimplifierServiceImpostor, SeveralObjectsInOneImpostor) {
 
 TEST(SimplifierServiceImpostor, TextureCodecsDecode) {
   SimplifierService service(withDefaultScene());
-  for (auto codec : {protocol::TextureCodec::kPng, protocol::TextureCodec::kZstdRgba8}) {
+  for (auto codec : {protocol::TextureCodec::kPng, protocol::TextureCodec::kZstd}) {
     const protocol::ImpostorResult result = service.renderImpostor(
         impostorOf(kCow, protocol::RepresentationKind::kSimpleImpostor, 64, codec));
     ASSERT_TRUE(result.status.ok()) << result.status.toString();

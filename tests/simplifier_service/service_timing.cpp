@@ -76,7 +76,7 @@ const char* codecName(protocol::TextureCodec codec) {
   switch (codec) {
     case protocol::TextureCodec::kPng:
       return "png";
-    case protocol::TextureCodec::kZstdRgba8:
+    case protocol::TextureCodec::kZstd:
       return "zstd";
     case protocol::TextureCodec::kRawRgba8:
       return "raw";
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
     for (auto kind : {protocol::RepresentationKind::kSimpleImpostor,
                       protocol::RepresentationKind::kMeshedImpostor}) {
       for (std::uint32_t size : {128u, 256u}) {
-        for (auto codec : {protocol::TextureCodec::kPng, protocol::TextureCodec::kZstdRgba8,
+        for (auto codec : {protocol::TextureCodec::kPng, protocol::TextureCodec::kZstd,
                            protocol::TextureCodec::kRawRgba8}) {
           protocol::ImpostorResult last;
           const Timing t = timeIt(repetitions, [&] {

@@ -17,7 +17,7 @@ namespace {
 constexpr std::int64_t kMaxPoseTimeStepNs = 60'000'000'000LL;
 constexpr int kPosesBeforeJump = 10;
 
-using backbone::RepresentationKind;
+using backbone::OptionKind;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -28,8 +28,8 @@ constexpr double kMinTrianglesToLearnBytes = 64.0;
 
 Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
 
-bool isMeshKind(RepresentationKind kind) {
-  return kind == RepresentationKind::kOriginalMesh || kind == RepresentationKind::kSimplifiedMesh;
+bool isMeshKind(OptionKind kind) {
+  return kind == OptionKind::kOriginalMesh || kind == OptionKind::kSimplifiedMesh;
 }
 
 protocol::ConicRange everywhereOnWire() {
@@ -158,7 +158,7 @@ Status BackboneCore::initialize() {
       state.object = k;
       state.wireKind = protocol::RepresentationKind::kMesh;
       backbone::RepresentationOption option;
-      option.kind = RepresentationKind::kSimplifiedMesh;
+      option.kind = OptionKind::kSimplifiedMesh;
       if (record.primitive) {
         Result<AccuracyCurve> curve =
             primitiveAccuracyCurve(record.object->shape->geometry.primitive);
@@ -180,7 +180,7 @@ Status BackboneCore::initialize() {
     }
 
     // Impostors: usable from `radii` bounding radii on, every direction.
-    auto addImpostor = [&](RepresentationKind kind, protocol::RepresentationKind wireKind,
+    auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind,
                            double radii, double triangles) -> Status {
       if (!(radii > 0.0)) return Status();
       Result<ConicRange> validity = ConicRange::make(
@@ -202,9 +202,9 @@ Status BackboneCore::initialize() {
       return Status();
     };
     THINLOD_RETURN_IF_ERROR(addImpostor(
-        RepresentationKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
+        OptionKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
         options_.meshedImpostorRadii, options_.meshedImpostorTriangles));
-    THINLOD_RETURN_IF_ERROR(addImpostor(RepresentationKind::kSimpleImpostor,
+    THINLOD_RETURN_IF_ERROR(addImpostor(OptionKind::kSimpleImpostor,
                                         protocol::RepresentationKind::kSimpleImpostor,
                                         options_.simpleImpostorRadii, 2.0));
     object.optionCount = static_cast<std::uint32_t>(scene_.options.size()) - object.firstOption;

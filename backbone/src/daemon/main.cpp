@@ -132,7 +132,7 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
   } else if (s.textureCodec == "jpeg") {
     o.textureCodec = protocol::TextureCodec::kJpeg;
   } else if (s.textureCodec == "zstd") {
-    o.textureCodec = protocol::TextureCodec::kZstdRgba8;
+    o.textureCodec = protocol::TextureCodec::kZstd;
   } else if (s.textureCodec == "raw") {
     o.textureCodec = protocol::TextureCodec::kRawRgba8;
   } else {
@@ -390,7 +390,7 @@ class Daemon {
       spdlog::debug(
           "event=request frame={} object={} kind={} reason={} relative_accuracy={:.4g} "
           "triangles={:.0f} bytes={:.0f}",
-          frame, core_.objects()[r.object].id, thinlod::backbone::representationKindName(r.kind),
+          frame, core_.objects()[r.object].id, thinlod::backbone::optionKindName(r.kind),
           kReasons[static_cast<int>(r.reason) & 3], r.relativeAccuracy, r.expectedTriangles,
           r.expectedBytes);
     }

@@ -49,15 +49,15 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
 
 }  // namespace
 
-const char* representationKindName(RepresentationKind kind) {
+const char* optionKindName(OptionKind kind) {
   switch (kind) {
-    case RepresentationKind::kOriginalMesh:
+    case OptionKind::kOriginalMesh:
       return "original";
-    case RepresentationKind::kSimplifiedMesh:
+    case OptionKind::kSimplifiedMesh:
       return "simplified";
-    case RepresentationKind::kMeshedImpostor:
+    case OptionKind::kMeshedImpostor:
       return "meshed-impostor";
-    case RepresentationKind::kSimpleImpostor:
+    case OptionKind::kSimpleImpostor:
       return "simple-impostor";
   }
   return "unknown";

@@ -81,13 +81,13 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
     auto meshBytes = [](double t) { return 1.5 * t + 500.0; };
     if (coarseOnly) {
       RepresentationOption point;
-      point.kind = RepresentationKind::kSimpleImpostor;
+      point.kind = OptionKind::kSimpleImpostor;
       point.relativeTriangles = AccuracyCurve::point(15.0, 2.0);
       point.relativeLinkBytes = AccuracyCurve::point(15.0, 4000.0);
       scene.options.push_back(std::move(point));
     } else {
       RepresentationOption simplified;
-      simplified.kind = RepresentationKind::kSimplifiedMesh;
+      simplified.kind = OptionKind::kSimplifiedMesh;
       const std::vector<double> a{4.0, 40.0, 400.0};
       const std::vector<double> t{8.0, std::max(20.0, 0.05 * full), std::max(40.0, 0.6 * full)};
       simplified.relativeTriangles = through(a, t);
@@ -96,14 +96,14 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
       scene.options.push_back(std::move(simplified));
       if (o.originalMesh) {
         RepresentationOption original;
-        original.kind = RepresentationKind::kOriginalMesh;
+        original.kind = OptionKind::kOriginalMesh;
         original.relativeTriangles = AccuracyCurve::point(1000.0, full);
         original.relativeLinkBytes = AccuracyCurve::point(1000.0, meshBytes(full));
         scene.options.push_back(std::move(original));
       }
       if (o.meshedImpostor) {
         RepresentationOption meshed;
-        meshed.kind = RepresentationKind::kMeshedImpostor;
+        meshed.kind = OptionKind::kMeshedImpostor;
         const std::vector<double> ma{5.0, 50.0, 150.0};
         const std::vector<double> mt{8.0, 200.0, 2000.0};
         meshed.relativeTriangles = through(ma, mt);
@@ -116,7 +116,7 @@ Result<SchedulingScene> makeSyntheticScene(const SyntheticSceneOptions& o) {
       }
       if (o.simpleImpostor) {
         RepresentationOption simple;
-        simple.kind = RepresentationKind::kSimpleImpostor;
+        simple.kind = OptionKind::kSimpleImpostor;
         simple.relativeTriangles = AccuracyCurve::point(30.0, 2.0);
         simple.relativeLinkBytes = AccuracyCurve::point(30.0, 6000.0);
         simple.validity = ConicRange::make(bounds.center, 10.0 * bounds.radius,

@@ -111,8 +111,12 @@ Result<std::vector<std::uint8_t>> payloadFor(const RgbaImage& texture, TextureCo
     case TextureCodec::kPng:
     case TextureCodec::kJpeg:
       return imagePayload(texture, codec, options);
+    case TextureCodec::kNone:
+    case TextureCodec::kRawRgba8:
+      break;
   }
-  return textureError(ErrorCode::kInvalidArgument, "unknown codec");
+  return textureError(ErrorCode::kInvalidArgument,
+                      std::string("codec ") + textureCodecName(codec) + " has no frame");
 }
 
 Status decodeZstd(const std::uint8_t* payload, std::size_t size, RgbaImage& out) {
@@ -260,8 +264,7 @@ Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
       detail::parseFrame(data, size, detail::kTextureMagic, limits, "decodeTexture");
   if (!parsed.ok()) return parsed.status();
   const detail::FrameHeader& header = *parsed;
-  if (header.codec < static_cast<std::uint8_t>(TextureCodec::kZstd) ||
-      header.codec > static_cast<std::uint8_t>(TextureCodec::kJpeg)) {
+  if (!isFramedTextureCodec(static_cast<TextureCodec>(header.codec))) {
     return textureError(ErrorCode::kUnsupported, "unknown codec " + std::to_string(header.codec));
   }
   if (header.attributes != 0) {

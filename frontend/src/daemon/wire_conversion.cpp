@@ -17,18 +17,6 @@ Status invalid(const std::string& what, const std::string& problem) {
   return Status(ErrorCode::kInvalidArgument, what + ": " + problem);
 }
 
-RepresentationKind toFrontendKind(protocol::RepresentationKind kind) {
-  switch (kind) {
-    case protocol::RepresentationKind::kSimpleImpostor:
-      return RepresentationKind::kSimpleImpostor;
-    case protocol::RepresentationKind::kMeshedImpostor:
-      return RepresentationKind::kMeshedImpostor;
-    case protocol::RepresentationKind::kMesh:
-      break;
-  }
-  return RepresentationKind::kMesh;
-}
-
 bool knownKind(protocol::RepresentationKind kind) {
   return kind == protocol::RepresentationKind::kMesh ||
          kind == protocol::RepresentationKind::kSimpleImpostor ||
@@ -38,18 +26,7 @@ bool knownKind(protocol::RepresentationKind kind) {
 // The codec byte a frame of this wire codec must carry, or 0 when the wire
 // codec is not a framed one.
 std::uint8_t frameCodecOf(protocol::TextureCodec codec) {
-  switch (codec) {
-    case protocol::TextureCodec::kZstdRgba8:
-      return static_cast<std::uint8_t>(codec::TextureCodec::kZstd);
-    case protocol::TextureCodec::kPng:
-      return static_cast<std::uint8_t>(codec::TextureCodec::kPng);
-    case protocol::TextureCodec::kJpeg:
-      return static_cast<std::uint8_t>(codec::TextureCodec::kJpeg);
-    case protocol::TextureCodec::kNone:
-    case protocol::TextureCodec::kRawRgba8:
-      break;
-  }
-  return 0;
+  return isFramedTextureCodec(codec) ? static_cast<std::uint8_t>(codec) : 0;
 }
 
 std::string sizeText(std::uint64_t width, std::uint64_t height) {
@@ -122,7 +99,7 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
                    "unknown representation kind " + std::to_string(static_cast<int>(wire.kind)));
   }
   Representation rep;
-  rep.kind = toFrontendKind(wire.kind);
+  rep.kind = wire.kind;  // one enum on the wire and at the frontend
   rep.transform = wire.transform;
   rep.generation = wire.generation;
   const std::string kindName = representationKindName(rep.kind);

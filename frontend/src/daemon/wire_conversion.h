@@ -12,7 +12,7 @@
 //   wire must equal the decoded triangles (the wire contract says exact; an
 //   empty simple-impostor mesh may say 0 or 2).
 // - Textures: kRawRgba8 is taken as is (width*height*4 bytes); kPng, kJpeg,
-//   kZstdRgba8 are codec frames (codec::decodeTexture) whose own codec byte
+//   kZstd are codec frames (codec::decodeTexture) whose own codec byte
 //   and decoded size must match the wire's codec, width and height. kNone is
 //   "no texture": an error for impostors (their lighting lives in it).
 // - Colour: impostors are white (lighting baked in); meshes take the colour

@@ -66,17 +66,6 @@ Status validateRepresentation(const Representation& rep, const std::string& what
 
 }  // namespace
 
-const char* representationKindName(RepresentationKind kind) {
-  switch (kind) {
-    case RepresentationKind::kMesh:
-      return "Mesh";
-    case RepresentationKind::kSimpleImpostor:
-      return "SimpleImpostor";
-    case RepresentationKind::kMeshedImpostor:
-      return "MeshedImpostor";
-  }
-  return "unknown";
-}
 
 std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture) {
   std::size_t bytes = mesh.vertexCount() * kGpuVertexBytes + mesh.indices.size() * kGpuIndexBytes;

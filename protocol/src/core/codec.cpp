@@ -29,7 +29,7 @@ static_assert(static_cast<int>(w::ErrorCode::MAX) == static_cast<int>(ErrorCode:
 static_assert(static_cast<int>(w::Role::MAX) == static_cast<int>(Role::kTool));
 static_assert(static_cast<int>(w::RepresentationKind::MAX) ==
               static_cast<int>(RepresentationKind::kMeshedImpostor));
-static_assert(static_cast<int>(w::TextureCodec::MAX) == static_cast<int>(TextureCodec::kZstdRgba8));
+static_assert(static_cast<int>(w::TextureCodec::MAX) == static_cast<int>(TextureCodec::kZstd));
 
 // ---------------------------------------------------------------- encode
 

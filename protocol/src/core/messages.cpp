@@ -21,17 +21,6 @@ const char* roleName(Role role) {
   return "invalid-role";
 }
 
-const char* representationKindName(RepresentationKind kind) {
-  switch (kind) {
-    case RepresentationKind::kMesh:
-      return "Mesh";
-    case RepresentationKind::kSimpleImpostor:
-      return "SimpleImpostor";
-    case RepresentationKind::kMeshedImpostor:
-      return "MeshedImpostor";
-  }
-  return "invalid-kind";
-}
 
 const char* messageName(const Message& message) {
   static constexpr const char* kNames[] = {"Hello",           "HelloReply",      "ViewerPose",

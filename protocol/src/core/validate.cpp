@@ -96,7 +96,7 @@ bool validKind(RepresentationKind kind) {
   return static_cast<unsigned>(kind) <= static_cast<unsigned>(RepresentationKind::kMeshedImpostor);
 }
 bool validCodec(TextureCodec codec) {
-  return static_cast<unsigned>(codec) <= static_cast<unsigned>(TextureCodec::kZstdRgba8);
+  return static_cast<unsigned>(codec) <= static_cast<unsigned>(TextureCodec::kZstd);
 }
 
 Status checkConicRange(const FieldPath& path, const ConicRange& range) {

@@ -44,16 +44,12 @@ Result<protocol::Texture> encodeTexture(RgbaImage image, protocol::TextureCodec 
     texture.data = std::move(image.pixels);
     return texture;
   }
-  codec::TextureCodec used = codec::TextureCodec::kPng;
+  // PNG unless zstd was asked for, or JPEG for an opaque image.
   texture.codec = protocol::TextureCodec::kPng;
-  if (requested == protocol::TextureCodec::kZstdRgba8) {
-    used = codec::TextureCodec::kZstd;
+  if (requested == protocol::TextureCodec::kZstd ||
+      (requested == protocol::TextureCodec::kJpeg && image.opaque()))
     texture.codec = requested;
-  } else if (requested == protocol::TextureCodec::kJpeg && image.opaque()) {
-    used = codec::TextureCodec::kJpeg;
-    texture.codec = requested;
-  }
-  Result<std::vector<std::uint8_t>> bytes = codec::encodeTextureWith(image, used);
+  Result<std::vector<std::uint8_t>> bytes = codec::encodeTextureWith(image, texture.codec);
   if (!bytes.ok()) return bytes.status();
   texture.data = std::move(bytes).value();
   return texture;

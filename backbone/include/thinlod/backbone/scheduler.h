@@ -55,7 +55,7 @@ struct ObjectDecision {
   std::uint32_t object = 0;
   ObjectAction action = ObjectAction::kRemove;
   std::int32_t option = -1;
-  RepresentationKind kind = RepresentationKind::kOriginalMesh;
+  OptionKind kind = OptionKind::kOriginalMesh;
   CandidateSource source = CandidateSource::kNew;
   double relativeAccuracy = 0.0;  // of the representation (to generate, sent or kept)
   double absoluteAccuracy = 0.0;  // guaranteed over the predicted region, rad^-1
@@ -75,7 +75,7 @@ struct RepresentationRequest {
   std::uint64_t requestId = 0;
   std::uint32_t object = 0;
   std::uint32_t option = 0;
-  RepresentationKind kind = RepresentationKind::kOriginalMesh;
+  OptionKind kind = OptionKind::kOriginalMesh;
   RequestReason reason = RequestReason::kMissing;
   double relativeAccuracy = 0.0;  // generate at least this accurate
   double expectedTriangles = 0.0;

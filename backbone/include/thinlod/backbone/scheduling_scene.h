@@ -33,13 +33,13 @@ namespace thinlod::backbone {
 
 inline constexpr int kMaxSceneDepth = 256;
 
-enum class RepresentationKind : std::uint8_t {
+enum class OptionKind : std::uint8_t {
   kOriginalMesh = 0,
   kSimplifiedMesh = 1,
   kMeshedImpostor = 2,
   kSimpleImpostor = 3,
 };
-const char* representationKindName(RepresentationKind kind);
+const char* optionKindName(OptionKind kind);
 
 // One generated representation that exists somewhere (frontend or backbone).
 struct RepresentationCopy {
@@ -52,7 +52,7 @@ struct RepresentationCopy {
 };
 
 struct RepresentationOption {
-  RepresentationKind kind = RepresentationKind::kSimplifiedMesh;
+  OptionKind kind = OptionKind::kSimplifiedMesh;
   // A newly generated representation: relative accuracy -> triangles and ->
   // encoded bytes. A fixed representation is a point curve.
   AccuracyCurve relativeTriangles;

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/representation_kind.h"
 #include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
 
@@ -40,12 +41,8 @@ namespace thinlod::frontend {
 using ObjectId = std::uint64_t;
 using RepresentationKey = std::uint64_t;  // 0 = none
 
-enum class RepresentationKind : std::uint8_t {
-  kMesh = 0,
-  kSimpleImpostor = 1,
-  kMeshedImpostor = 2
-};
-const char* representationKindName(RepresentationKind kind);  // "Mesh", "SimpleImpostor", ...
+using ::thinlod::RepresentationKind;  // common/representation_kind.h
+using ::thinlod::representationKindName;
 
 struct Representation {
   RepresentationKind kind = RepresentationKind::kMesh;

@@ -25,7 +25,9 @@
 #include <vector>
 
 #include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/representation_kind.h"
 #include "thinlod/common/status.h"
+#include "thinlod/common/texture_codec.h"
 
 namespace thinlod::protocol {
 
@@ -62,20 +64,10 @@ enum class Role : std::uint8_t {
 };
 const char* roleName(Role role);
 
-enum class RepresentationKind : std::uint8_t {
-  kMesh = 0,
-  kSimpleImpostor = 1,
-  kMeshedImpostor = 2
-};
-const char* representationKindName(RepresentationKind kind);
+using ::thinlod::RepresentationKind;  // common/representation_kind.h: the wire's values
+using ::thinlod::representationKindName;
 
-enum class TextureCodec : std::uint8_t {
-  kNone = 0,
-  kRawRgba8 = 1,
-  kPng = 2,
-  kJpeg = 3,
-  kZstdRgba8 = 4
-};
+using ::thinlod::TextureCodec;  // common/texture_codec.h: the wire's values
 
 using Bytes = std::vector<std::uint8_t>;
 

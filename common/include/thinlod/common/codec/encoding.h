@@ -35,10 +35,12 @@
 #include "thinlod/common/indexed_mesh.h"
 #include "thinlod/common/rgba_image.h"
 #include "thinlod/common/status.h"
+#include "thinlod/common/texture_codec.h"
 
 namespace thinlod::codec {
 
-inline constexpr std::uint16_t kFrameVersion = 1;
+// 2: texture frames carry the one TextureCodec's values (zstd = 4, was 1).
+inline constexpr std::uint16_t kFrameVersion = 2;
 inline constexpr std::size_t kFrameHeaderBytes = 32;
 
 struct DecodeLimits {
@@ -79,7 +81,9 @@ Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
 // than 65500 pixels, or pixels.size() != width * height * 4. A decoded image
 // has 1..limits.maxTextureDimension pixels per side and is consistent().
 
-enum class TextureCodec : std::uint8_t { kZstd = 1, kPng = 2, kJpeg = 3 };
+// The frame's codec byte is the TextureCodec value (texture_codec.h); only
+// the framed codecs (png, jpeg, zstd) are encoded here.
+using ::thinlod::TextureCodec;
 
 // Codec choice (256x256 impostor-like image, CPU ms encode / decode, bytes;
 // docs/results/error-validation.md): zstd-1 0.09 / 0.04 / 7.9 KB, PNG-6

@@ -1,0 +1,17 @@
+#include "thinlod/common/representation_kind.h"
+
+namespace thinlod {
+
+const char* representationKindName(RepresentationKind kind) {
+  switch (kind) {
+    case RepresentationKind::kMesh:
+      return "Mesh";
+    case RepresentationKind::kSimpleImpostor:
+      return "SimpleImpostor";
+    case RepresentationKind::kMeshedImpostor:
+      return "MeshedImpostor";
+  }
+  return "invalid-kind";
+}
+
+}  // namespace thinlod
