@@ -59,7 +59,7 @@ inline constexpr double kDefaultTextureBytesPerTexel = 0.35;
 inline constexpr double kQuantizationShare = 0.1;
 
 struct CoreOptions {
-  std::string scheduler = "curves";  // curves | static | greedy
+  std::string scheduler = "accuracy-curve";  // a name of backbone::schedulerCatalogue()
   backbone::SchedulerConfig config;
   backbone::Budget budget;
   std::uint32_t textureSize = 256;

@@ -33,7 +33,7 @@ using Clock = std::chrono::steady_clock;
 struct Settings {
   std::string scene;
   std::string modelsDir;
-  std::string scheduler = "curves";
+  std::string scheduler = "accuracy-curve";
   double budgetPolygons = 0.0;
   double budgetLink = 0.0;
   double accuracy = 0.0;
@@ -65,7 +65,8 @@ struct Settings {
 void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("scene", &s.scene, "scene file (required)");
   runtime.addOption("models-dir", &s.modelsDir, "where the scene's mesh files are looked up first");
-  runtime.addOption("scheduler", &s.scheduler, "curves | static | greedy");
+  runtime.addOption("scheduler", &s.scheduler,
+                    "selection method, by name or alias:\n" + thinlod::backbone::schedulerHelp());
   runtime.addOption("budget-polygons", &s.budgetPolygons,
                     "triangles the frontend may hold (0: no polygon budget)");
   runtime.addOption("budget-link", &s.budgetLink, "link budget in bytes/s (0: unlimited)");
