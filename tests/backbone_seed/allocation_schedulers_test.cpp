@@ -312,3 +312,35 @@ TEST(AllocationSchedulers, AslodHysteresisReducesRequestsOfAJitteringViewer) {
 
 }  // namespace
 }  // namespace thinlod::backbone
+
+namespace thinlod::backbone {
+namespace {
+using namespace testing;
+
+TEST(AllocationSchedulers, AslodGivesTheSlackOfACandidateGapToTheOthers) {
+  // Equal projected areas, 80 triangles each by the formula; B's candidates
+  // are a 2-triangle impostor and meshes from 100 triangles on, so B renders
+  // 2 and A receives the other 78.
+  SceneBuilder b;
+  const int root = b.group(-1);
+  b.leaf(root, {{1.0, 0, -5.0}, 0.5}, {meshOption(1.0, 16.0, 400.0, 20000.0)});
+  b.leaf(root, {{-1.0, 0, -5.0}, 0.5},
+         {meshOption(4.0, 100.0, 400.0, 5000.0),
+          pointOption(RepresentationKind::kSimpleImpostor, 2.0, 2.0, 6000.0)});
+  const SchedulingScene scene = b.build();
+  AslodSchedulerConfig config;
+  config.hysteresisShare = 0.0;
+  PlannerState state;
+  Budget budget;
+  budget.maxTriangles = 160.0;
+  auto plan =
+      aslod(exactConfig(), config)->plan(scene, viewerAt({0, 0, 0}, {0, 0, -1}), budget, state);
+  ASSERT_TRUE(plan.ok());
+  const auto t = trianglesByObject(*plan);
+  EXPECT_EQ(t.at(1), 2.0);
+  EXPECT_GE(t.at(0), 157.0);
+  EXPECT_LE(plan->predictedTriangles, 160.0);
+}
+
+}  // namespace
+}  // namespace thinlod::backbone

@@ -200,8 +200,36 @@ Result<Selection> AslodMethod::select(const SelectionStep& step) const {
   config.alpha = config_.alpha;
   config.hysteresisTriangles = config_.hysteresisTriangles;
   config.hysteresisShare = config_.hysteresisShare;
-  Result<AslodAllocation> allocation = allocateAslod(allocated, cap, config);
-  if (!allocation.ok()) return allocation.status();
+  // Gaps: the paper assumes progressive meshes that use any count; here an
+  // object's candidates may leave a gap (a 2-triangle impostor, then meshes
+  // from 100 triangles on) and an allocation inside it renders the cheaper
+  // side. Such an object is capped at what it renders and the allocation is
+  // redone, so the others receive the slack (allocations of uncapped objects
+  // only grow from round to round; at most kGapRounds rounds).
+  constexpr int kGapRounds = 8;
+  std::vector<int> picks(allocated.size(), -1);
+  std::vector<double> accuracies(allocated.size(), 0.0);
+  std::vector<std::uint32_t> keptLeaf;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+    if (kept[i]) keptLeaf.push_back(static_cast<std::uint32_t>(i));
+  Result<AslodAllocation> allocation = Status(ErrorCode::kInternal, "aslod: no allocation");
+  for (int round = 0; round < kGapRounds; ++round) {
+    allocation = allocateAslod(allocated, cap, config);
+    if (!allocation.ok()) return allocation.status();
+    bool capped = false;
+    for (std::size_t k = 0; k < allocated.size(); ++k) {
+      const VisibleNode& n = tree.nodes[leaves[keptLeaf[k]].treeNode];
+      const double p = static_cast<double>(allocation->triangles[k]);
+      picks[k] = mostAccurateWithin(n.candidates, p, accuracies[k]);
+      if (picks[k] < 0) continue;
+      const double used = candidateCost(n.candidates[picks[k]], accuracies[k]).triangles;
+      if (std::ceil(used) < p && used < allocated[k].maxTriangles) {
+        allocated[k].maxTriangles = std::max(allocated[k].minTriangles, used);
+        capped = true;
+      }
+    }
+    if (!capped) break;
+  }
 
   step.state.aslodAllocations.clear();
   std::size_t next = 0;
@@ -211,16 +239,14 @@ Result<Selection> AslodMethod::select(const SelectionStep& step) const {
       selection.leaves.push_back(droppedSelection(n, leaves[i].object));
       continue;
     }
-    const std::int64_t p = allocation->triangles[next++];
-    step.state.aslodAllocations[leaves[i].object] = p;
-    double accuracy = 0.0;
-    const int pick = mostAccurateWithin(n.candidates, static_cast<double>(p), accuracy);
-    if (pick < 0) {  // cannot happen: p >= ceil(cheapest); kept defensive
+    const std::size_t k = next++;
+    step.state.aslodAllocations[leaves[i].object] = allocation->triangles[k];
+    if (picks[k] < 0) {  // cannot happen: p >= ceil(cheapest); kept defensive
       selection.leaves.push_back(droppedSelection(n, leaves[i].object));
       continue;
     }
-    selection.leaves.push_back(makeSelection(n.sceneNode, leaves[i].object, n.candidates[pick],
-                                             accuracy, n.distance, n.diameter));
+    selection.leaves.push_back(makeSelection(n.sceneNode, leaves[i].object, n.candidates[picks[k]],
+                                             accuracies[k], n.distance, n.diameter));
   }
   return selection;
 }
