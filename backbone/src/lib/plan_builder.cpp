@@ -198,6 +198,7 @@ void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const Sche
     state.switchCounters.assign(scene.objects.size(), 0);
     state.scannedFrontend = false;
     state.pending.clear();
+    state.aslodAllocations.clear();
     ++state.pendingGeneration;
   }
   for (ResourceCache& cache : state.cache) {

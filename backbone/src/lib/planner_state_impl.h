@@ -60,6 +60,9 @@ struct PlannerStateImpl {
   std::vector<std::uint32_t> lastRendered;    // objects rendered by the previous plan
   bool scannedFrontend = false;
   double lastTime = -std::numeric_limits<double>::infinity();
+  // ASLOD hysteresis: each visible object's triangle allocation of the
+  // previous step (by object; rewritten every aslod step).
+  std::unordered_map<std::uint32_t, std::int64_t> aslodAllocations;
 
   void clearCaches() {
     for (ResourceCache& c : cache) {

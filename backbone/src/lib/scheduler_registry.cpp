@@ -27,6 +27,15 @@ const std::vector<CatalogueEntry>& entries() {
       {{"greedy-fs93", "greedy",
         "Funkhouser-Sequin 1993: greedy benefit per triangle under the polygon budget", false},
        [](const SchedulerOptions& o) { return makeGreedyScheduler(o.config, o.greedy); }},
+      {{"aslod", "",
+        "Schmalstieg-Fuhrmann ASLOD: triangles allocated analytically by projected area", false},
+       [](const SchedulerOptions& o) { return makeAslodScheduler(o.config, o.aslod); }},
+      {{"span-of-level-changed", "slc",
+        "Yu-Liang-Chen: importance heap on the span of level changed under the polygon budget",
+        false},
+       [](const SchedulerOptions& o) {
+         return makeSpanOfLevelChangedScheduler(o.config, o.spanOfLevelChanged);
+       }},
       {{"brute-force", "", "every combination of options (exponential; tests and benchmarks only)",
         true},
        [](const SchedulerOptions& o) { return makeBruteForceScheduler(o.config, o.bruteForce); }},

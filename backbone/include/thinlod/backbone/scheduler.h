@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/backbone/allocation_schedulers.h"
 #include "thinlod/backbone/decision_row.h"
 #include "thinlod/backbone/pipeline.h"
 
@@ -211,6 +212,8 @@ struct SchedulerOptions {
   VrmlStaticConfig vrml;
   GreedyConfig greedy;
   BruteForceConfig bruteForce;
+  AslodSchedulerConfig aslod;
+  SpanOfLevelChangedConfig spanOfLevelChanged;
 };
 
 struct SchedulerEntry {
