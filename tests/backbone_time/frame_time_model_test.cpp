@@ -164,6 +164,27 @@ TEST(FrameCostFit, RecoversKnownConstantsFromExactData) {
   EXPECT_LT(fit->fillBoundShare, 0.95);
 }
 
+TEST(FrameCostFit, AdditiveModelRecoversItsConstants) {
+  FrameCostConstants truth = someConstants();
+  truth.additive = true;
+  const auto samples = syntheticSamples(truth, 4, 0.0);
+  const auto fit = fitFrameCostConstants(samples, 0.5, true);
+  ASSERT_TRUE(fit.ok());
+  EXPECT_TRUE(fit->constants.additive);
+  EXPECT_NEAR(fit->constants.triangleSeconds, truth.triangleSeconds, 1e-9 * truth.triangleSeconds);
+  EXPECT_NEAR(fit->constants.pixelSeconds, truth.pixelSeconds, 1e-9 * truth.pixelSeconds);
+  EXPECT_NEAR(fit->constants.setupSeconds, truth.setupSeconds, 1e-9 * truth.setupSeconds);
+  EXPECT_NEAR(fit->rSquared, 1.0, 1e-12);
+  // The max model cannot explain additive data exactly.
+  const auto wrong = fitFrameCostConstants(samples, 0.5, false);
+  ASSERT_TRUE(wrong.ok());
+  EXPECT_LT(wrong->rSquared, fit->rSquared);
+  // Additive objects have no fill-bound floor and pay fill on top.
+  const ObjectFrameLoad load{10000.0, 20000.0};
+  EXPECT_DOUBLE_EQ(fillBoundResolution(truth, load), 0.0);
+  EXPECT_DOUBLE_EQ(objectRenderSeconds(truth, load, 0.5), 3e-5 + 1e-4 + 1e-4);
+}
+
 TEST(FrameCostFit, NoisyDataGivesCloseConstantsAndHighRSquared) {
   const FrameCostConstants truth = someConstants();
   for (std::uint64_t seed = 2; seed < 12; ++seed) {
@@ -209,7 +230,8 @@ TEST(FrameCostFit, RejectsPoorDesignsAndBadValues) {
 }
 
 TEST(FrameCostFile, RoundTripsExactly) {
-  const FrameCostConstants c = someConstants();
+  FrameCostConstants c = someConstants();
+  c.additive = true;
   const std::string text = formatFrameCostToml(c, "renderer: test\nR^2 = 0.99");
   EXPECT_NE(text.find("# renderer: test\n# R^2 = 0.99\n"), std::string::npos) << text;
   const auto parsed = parseFrameCostToml(text);
@@ -219,6 +241,7 @@ TEST(FrameCostFile, RoundTripsExactly) {
   EXPECT_EQ(parsed->setupSeconds, c.setupSeconds);
   EXPECT_EQ(parsed->triangleSeconds, c.triangleSeconds);
   EXPECT_EQ(parsed->pixelSeconds, c.pixelSeconds);
+  EXPECT_TRUE(parsed->additive);
   EXPECT_TRUE(validateFrameCostConstants(*parsed).ok());
 }
 
@@ -245,6 +268,7 @@ TEST(FrameCostFile, RejectsMalformedFiles) {
        ErrorCode::kParseError},
       {replaced("init_seconds = 0.00040000000000000002", "init_seconds ="), ErrorCode::kParseError},
       {good + "init_seconds = 1\n", ErrorCode::kParseError},
+      {replaced("additive = 0", "additive = 2"), ErrorCode::kInvalidArgument},
       {std::string(70000, '#'), ErrorCode::kInvalidArgument},
   };
   for (const Case& c : cases) {
@@ -254,7 +278,7 @@ TEST(FrameCostFile, RejectsMalformedFiles) {
   }
   // Every truncated prefix fails cleanly until the last key has a value
   // (then a cut-off number may still parse, or not: "5e" does not).
-  const std::size_t lastValue = good.find("pixel_seconds = ") + 16;
+  const std::size_t lastValue = good.find("additive = ") + 11;
   for (std::size_t n = 0; n <= good.size(); ++n) {
     const auto parsed = parseFrameCostToml(good.substr(0, n));
     if (n <= lastValue) {

@@ -34,11 +34,13 @@ glm::dvec3 rotateLike(const glm::dvec3& v, const glm::dvec3& from, const glm::dv
 
 double objectRenderSeconds(const FrameCostConstants& c, const ObjectFrameLoad& load,
                            double resolution) {
-  return c.setupSeconds + std::max(resolution * load.maxTriangles * c.triangleSeconds,
-                                   load.coveredPixels * c.pixelSeconds);
+  const double triangles = resolution * load.maxTriangles * c.triangleSeconds;
+  const double pixels = load.coveredPixels * c.pixelSeconds;
+  return c.setupSeconds + (c.additive ? triangles + pixels : std::max(triangles, pixels));
 }
 
 double fillBoundResolution(const FrameCostConstants& c, const ObjectFrameLoad& load) {
+  if (c.additive) return 0.0;  // every triangle costs time: no floor
   const double perResolution = load.maxTriangles * c.triangleSeconds;
   const double fill = load.coveredPixels * c.pixelSeconds;
   if (!(perResolution > 0.0)) return 1.0;

@@ -7,10 +7,12 @@
 // Contract:
 // - Units: seconds, pixels, degrees (acuity), metres (geometry). Resolution r
 //   is the fraction of an object's maximum triangle count T_max, in (0, 1].
-// - objectRenderSeconds = t_setup + max(r * T_max * t_tri, N_pix * t_pix).
+// - objectRenderSeconds = t_setup + max(r * T_max * t_tri, N_pix * t_pix)
+//   (the sum instead of the max when constants.additive).
 // - fillBoundResolution r_fill = N_pix * t_pix / (T_max * t_tri), clamped to
-//   [0, 1] (1 when T_max * t_tri = 0): below it fewer triangles save no time,
-//   so above it the object time is linear in r with slope T_max * t_tri.
+//   [0, 1] (1 when T_max * t_tri = 0; 0 for the additive model): below it
+//   fewer triangles save no time, so above it the object time is linear in r
+//   with slope T_max * t_tri.
 // - projectedSpherePixels: pixels covered by the perspective image of a
 //   sphere, approximated by the disc of its angular radius asin(R / d) seen
 //   on the view axis: pi * (f * tan(asin(R / d)))^2 with f = (H / 2) /
@@ -38,7 +40,8 @@ double objectRenderSeconds(const FrameCostConstants& constants, const ObjectFram
                            double resolution);
 double fillBoundResolution(const FrameCostConstants& constants, const ObjectFrameLoad& load);
 // t_init + t_final + reserveSeconds + objectCount * t_setup: the part of the
-// frame time that does not depend on the resolutions (for r >= r_fill).
+// frame time that does not depend on the resolutions for r >= r_fill (the
+// additive model adds each object's N_pix * t_pix to it as well).
 double fixedFrameSeconds(const FrameCostConstants& constants, std::size_t objectCount,
                          double reserveSeconds);
 

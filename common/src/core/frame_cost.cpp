@@ -142,14 +142,16 @@ Status validateFrameCostConstants(const FrameCostConstants& c) {
 double predictFrameSeconds(const FrameCostConstants& c,
                            const std::vector<DrawnObjectLoad>& objects) {
   double t = c.initSeconds + c.finalSeconds;
-  for (const DrawnObjectLoad& o : objects)
-    t += c.setupSeconds +
-         std::max(o.triangles * c.triangleSeconds, o.coveredPixels * c.pixelSeconds);
+  for (const DrawnObjectLoad& o : objects) {
+    const double triangles = o.triangles * c.triangleSeconds;
+    const double pixels = o.coveredPixels * c.pixelSeconds;
+    t += c.setupSeconds + (c.additive ? triangles + pixels : std::max(triangles, pixels));
+  }
   return t;
 }
 
 Result<FrameCostFit> fitFrameCostConstants(const std::vector<FrameTimeSample>& samples,
-                                           double initShare) {
+                                           double initShare, bool additive) {
   if (!(initShare >= 0.0 && initShare <= 1.0))
     return Status(ErrorCode::kInvalidArgument,
                   "fitFrameCostConstants: initShare must be in [0, 1]");
@@ -202,9 +204,14 @@ Result<FrameCostFit> fitFrameCostConstants(const std::vector<FrameTimeSample>& s
     return Status(ErrorCode::kInvalidArgument, "fitFrameCostConstants: no solvable subset");
   FrameCostFit fit;
   double bestSse = std::numeric_limits<double>::infinity();
+  if (additive) {
+    fit.constants = toConstants(x, initShare);
+    fit.constants.additive = true;
+    bestSse = sumSquaredError(rows, y, x);
+  }
   std::vector<std::uint8_t> fillBound;
   std::vector<std::uint8_t> previous;
-  for (int round = 0; round < 64; ++round) {
+  for (int round = 0; round < 64 && !additive; ++round) {
     // Assign each object to its bottleneck under the current constants; the
     // max() model is then linear in the constants.
     fillBound.clear();
@@ -274,6 +281,7 @@ std::string formatFrameCostToml(const FrameCostConstants& c, const std::string& 
     std::snprintf(line, sizeof line, "%s = %.17g\n", key, value);
     out += line;
   }
+  out += c.additive ? "additive = 1\n" : "additive = 0\n";
   return out;
 }
 
@@ -282,10 +290,11 @@ Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
   if (text.size() > kMaxBytes)
     return Status(ErrorCode::kInvalidArgument,
                   "frame cost file: " + std::to_string(text.size()) + " bytes exceed 64 KiB");
-  const char* keys[] = {"version",       "init_seconds",     "final_seconds",
-                        "setup_seconds", "triangle_seconds", "pixel_seconds"};
-  double values[6] = {};
-  bool seen[6] = {};
+  constexpr int kKeys = 7;
+  const char* keys[kKeys] = {"version",          "init_seconds",  "final_seconds", "setup_seconds",
+                             "triangle_seconds", "pixel_seconds", "additive"};
+  double values[kKeys] = {};
+  bool seen[kKeys] = {};
   std::size_t start = 0;
   int lineNumber = 0;
   while (start < text.size()) {
@@ -305,7 +314,7 @@ Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
     const std::string key = trim(line.substr(0, eq));
     const std::string valueText = trim(line.substr(eq + 1));
     int k = -1;
-    for (int i = 0; i < 6; ++i)
+    for (int i = 0; i < kKeys; ++i)
       if (key == keys[i]) k = i;
     if (k < 0) return Status(ErrorCode::kParseError, where + "unknown key '" + key + "'");
     if (seen[k]) return Status(ErrorCode::kParseError, where + "duplicate key '" + key + "'");
@@ -320,10 +329,12 @@ Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
     if (k == 0 && v != 1.0)
       return Status(ErrorCode::kVersionMismatch,
                     where + "version " + valueText + " is not supported (expected 1)");
+    if (k == kKeys - 1 && v != 0.0 && v != 1.0)
+      return Status(ErrorCode::kInvalidArgument, where + "additive must be 0 or 1");
     values[k] = v;
     seen[k] = true;
   }
-  for (int i = 0; i < 6; ++i)
+  for (int i = 0; i < kKeys; ++i)
     if (!seen[i])
       return Status(ErrorCode::kParseError,
                     std::string("frame cost file: missing key '") + keys[i] + "'");
@@ -333,6 +344,7 @@ Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
   c.setupSeconds = values[3];
   c.triangleSeconds = values[4];
   c.pixelSeconds = values[5];
+  c.additive = values[6] == 1.0;
   return c;
 }
 

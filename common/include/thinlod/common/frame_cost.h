@@ -7,18 +7,22 @@
 //     t_frame = t_init + t_final + sum_j (t_setup + max(T_j * t_tri, P_j * t_pix)).
 //   (The paper's text lost its symbols; this is derived from its definitions:
 //   per-object setup, then whichever of triangle processing and pixel fill is
-//   the bottleneck, plus fixed initialisation and finalisation.)
+//   the bottleneck, plus fixed initialisation and finalisation.) A software
+//   rasteriser does not overlap the two stages; `additive` replaces the max()
+//   by a sum: t_setup + T_j * t_tri + P_j * t_pix (bench_calibrate fits both
+//   and keeps the better R^2).
 // - fitFrameCostConstants: non-negative least squares of that model over
 //   measured frames. The max() is handled by alternating regime assignment
 //   (each object triangle- or fill-bound under the current constants) with an
-//   exact NNLS of the then linear model (all subsets of the 4 unknowns). Only
+//   exact NNLS of the then linear model (all subsets of the 4 unknowns); the
+//   additive model is that NNLS directly. Only
 //   the sum t_init + t_final is identifiable from frame times: the fit returns
 //   it in initSeconds + finalSeconds split by `initShare` (measure the split
 //   separately, e.g. by timing the clear). Errors (kInvalidArgument): NaN/Inf
 //   or negative inputs, fewer samples than unknowns, a design that cannot
 //   separate the constants (e.g. every frame has the same object count).
 // - formatFrameCostToml / parseFrameCostToml: a small versioned text file
-//   ("version = 1" and one "key = number" line per constant). The parser takes
+//   ("version = 1", one "key = number" line per constant, "additive = 0|1"). The parser takes
 //   untrusted text: bounded (64 KiB), every key known and present once, every
 //   value finite and >= 0; errors name the line.
 // - Pure functions: no I/O, no globals.
@@ -37,6 +41,7 @@ struct FrameCostConstants {
   double setupSeconds = 0.0;     // t_setup: per object (state, material, draw call)
   double triangleSeconds = 0.0;  // t_tri: per triangle
   double pixelSeconds = 0.0;     // t_pix: per covered pixel
+  bool additive = false;         // false: max(triangles, pixels); true: their sum
 };
 Status validateFrameCostConstants(const FrameCostConstants& constants);
 
@@ -61,7 +66,7 @@ struct FrameCostFit {
 };
 
 Result<FrameCostFit> fitFrameCostConstants(const std::vector<FrameTimeSample>& samples,
-                                           double initShare = 0.5);
+                                           double initShare = 0.5, bool additive = false);
 
 // Predicted time of one frame under the model above.
 double predictFrameSeconds(const FrameCostConstants& constants,
