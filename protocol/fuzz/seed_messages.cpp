@@ -62,6 +62,8 @@ std::vector<NamedMessage> seedMessages() {
   hello.instanceId = 0x1234abcd5678ef00ull;
   hello.capabilities = {"qem", "impostor.simple", "impostor.meshed", "draco"};
   hello.capacity = 2;
+  hello.sceneFingerprint = 0x0123456789abcdefull;
+  hello.sceneFile = "/srv/thinlod/scenes/paper-room.wrl";
   out.push_back({"hello_simplifier", hello});
 
   HelloReply accepted;
@@ -120,6 +122,7 @@ std::vector<NamedMessage> seedMessages() {
   byPath.target = SimplifyRequest::Target::kTriangles;
   byPath.targetTriangles = 500;
   byPath.curvePoints = 16;
+  byPath.sceneFingerprint = 0x0123456789abcdefull;
   out.push_back({"simplify_request_path", byPath});
 
   SimplifyRequest inlineMesh;
@@ -156,6 +159,7 @@ std::vector<NamedMessage> seedMessages() {
   impostor.kind = RepresentationKind::kMeshedImpostor;
   impostor.accuracyBound = 30.0;
   impostor.textureCodec = TextureCodec::kJpeg;
+  impostor.sceneFingerprint = 0x0123456789abcdefull;
   out.push_back({"impostor_request", impostor});
 
   ImpostorResult impostorResult;
@@ -180,6 +184,7 @@ std::vector<NamedMessage> seedMessages() {
   stats.hasSnr = true;
   stats.snrDb = 23.75;
   stats.renderMs = 2.6f;
+  stats.rejectedPlans = {15, 16};
   out.push_back({"frame_stats", stats});
 
   out.push_back({"heartbeat", Heartbeat{1'700'000'000'300'000'000, 9}});

@@ -177,6 +177,7 @@ class FakeWorker {
       if (e.kind != ChannelEvent::Kind::kMessage) continue;
       if (auto* s = std::get_if<SimplifyRequest>(&e.message)) {
         ++simplifyRequests;
+        requestsWithoutFingerprint += s->sceneFingerprint == 0 ? 1 : 0;
         curveRequests += s->curvePoints > 0 ? 1 : 0;
         sendFailures += channel_->send(simplify(*s)).ok() ? 0 : 1;
       } else if (auto* i = std::get_if<ImpostorRequest>(&e.message)) {
@@ -187,6 +188,7 @@ class FakeWorker {
   }
   bool connected() const { return channel_ && channel_->connected(); }
   int simplifyRequests = 0;
+  int requestsWithoutFingerprint = 0;
   int curveRequests = 0;
   int impostorRequests = 0;
   int sendFailures = 0;  // only after the daemon has gone
@@ -407,6 +409,75 @@ TEST(BackboneDaemonProcess, ServesWithoutASimplifierAndCatchesUpWhenOneJoins) {
   }
   EXPECT_TRUE(hasOperations()) << daemon.log();
   EXPECT_EQ(daemon.stopWith(SIGINT), 0) << daemon.log();
+}
+
+}  // namespace
+}  // namespace thinlod::protocol
+
+namespace thinlod::protocol {
+namespace {
+
+// The handshake carries the scene fingerprint: a frontend that loaded another
+// scene is refused with a reason naming both files; one that loaded the same
+// scene is served; the simplifier's requests carry the backbone's fingerprint.
+TEST(BackboneDaemonProcess, RefusesAFrontendThatLoadedAnotherScene) {
+  BackboneProcess daemon({"--budget-polygons", "400", "--curve-timeout-s", "20"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+  FakeWorker worker(daemon.simplifierAddress());
+  ASSERT_TRUE(
+      pumpUntil([&] { worker.poll(10ms); }, [&] { return daemon.logContains("event=ready"); }))
+      << daemon.log();
+  EXPECT_GT(worker.simplifyRequests, 0);
+  EXPECT_EQ(worker.requestsWithoutFingerprint, 0);
+
+  const std::string log = daemon.log();
+  const std::size_t at = log.find("fingerprint=");
+  ASSERT_NE(at, std::string::npos) << log;
+  const std::uint64_t fingerprint = std::stoull(log.substr(at + 12, 16), nullptr, 16);
+  ASSERT_NE(fingerprint, 0u);
+
+  auto hello = [&](std::uint64_t sceneFingerprint, const std::string& sceneFile) {
+    Channel::Options options;
+    options.address = daemon.frontendAddress();
+    options.hello.role = Role::kFrontend;
+    options.hello.name = "frontend-" + std::to_string(sceneFingerprint);
+    options.hello.sceneFingerprint = sceneFingerprint;
+    options.hello.sceneFile = sceneFile;
+    options.transport = testTransport();
+    return Channel::connect(options);
+  };
+  auto other = hello(fingerprint ^ 0x5a5a, "/elsewhere/other-room.wrl");
+  ASSERT_TRUE(other.ok());
+  Status refused;
+  bool rejected = false;
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        worker.poll(5ms);
+        for (ChannelEvent& e : (*other)->poll(5ms)) {
+          if (e.kind == ChannelEvent::Kind::kRejected) {
+            rejected = true;
+            refused = e.reason;
+          }
+        }
+      },
+      [&] { return rejected; }))
+      << daemon.log();
+  EXPECT_FALSE((*other)->connected());
+  EXPECT_NE(refused.message().find("scene mismatch"), std::string::npos) << refused.toString();
+  EXPECT_NE(refused.message().find("other-room.wrl"), std::string::npos) << refused.toString();
+  EXPECT_NE(refused.message().find("paper-room.wrl"), std::string::npos) << refused.toString();
+  EXPECT_TRUE(daemon.logContains("event=hello_rejected"));
+
+  auto same = hello(fingerprint, "deploy/data/paper-room.wrl");
+  ASSERT_TRUE(same.ok());
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        worker.poll(5ms);
+        (void)(*same)->poll(5ms);
+      },
+      [&] { return (*same)->connected(); }))
+      << daemon.log();
+  EXPECT_EQ(daemon.stopWith(SIGTERM), 0);
 }
 
 }  // namespace

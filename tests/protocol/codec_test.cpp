@@ -369,3 +369,44 @@ TEST(Codec, NegotiatesTheHighestCommonVersion) {
 
 }  // namespace
 }  // namespace thinlod::protocol
+
+namespace thinlod::protocol {
+namespace {
+
+TEST(SceneIdentity, EqualOrUnclaimedFingerprintsPass) {
+  EXPECT_TRUE(checkSameScene("backbone", 7, "a.wrl", "frontend", 7, "b.wrl").ok());
+  EXPECT_TRUE(checkSameScene("backbone", 7, "a.wrl", "frontend", 0, "").ok());
+  EXPECT_TRUE(checkSameScene("backbone", 0, "a.wrl", "frontend", 9, "b.wrl").ok());
+}
+
+TEST(SceneIdentity, DifferentFingerprintsAreRefusedNamingBothSides) {
+  const Status s =
+      checkSameScene("backbone", 0xabcull, "/srv/room.wrl", "frontend", 0xdefull, "/tmp/hall.wrl");
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  for (const char* part : {"scene mismatch", "backbone", "/srv/room.wrl", "0000000000000abc",
+                           "frontend", "/tmp/hall.wrl", "0000000000000def"})
+    EXPECT_NE(s.message().find(part), std::string::npos) << part << " in " << s.message();
+}
+
+TEST(SceneIdentity, FingerprintsAndRejectedPlansSurviveTheWire) {
+  Hello hello;
+  hello.role = Role::kFrontend;
+  hello.name = "f";
+  hello.sceneFingerprint = 0xfeedfacecafebeefull;
+  hello.sceneFile = "deploy/data/paper-room.wrl";
+  FrameStats stats;
+  stats.rejectedPlans = {3, 4, 9};
+  for (const Message& m : {Message(hello), Message(stats)}) {
+    Result<Bytes> bytes = encode(m);
+    ASSERT_TRUE(bytes.ok()) << bytes.status().toString();
+    Result<Message> back = decode(*bytes);
+    ASSERT_TRUE(back.ok()) << back.status().toString();
+    EXPECT_TRUE(*back == m);
+  }
+  stats.rejectedPlans.assign(kMaxRejectedPlans + 1, 1);
+  EXPECT_FALSE(encode(Message(stats)).ok());
+}
+
+}  // namespace
+}  // namespace thinlod::protocol

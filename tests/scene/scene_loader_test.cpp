@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "thinlod/common/scene_parser.h"
@@ -73,6 +76,72 @@ TEST(SceneLoader, NonMeshUrlIsUnsupported) {
   ASSERT_TRUE(s.ok());
   const Status st = resolveMeshes(*s, std::string(THINLOD_TEST_DATA_DIR) + "/scene", {});
   EXPECT_EQ(st.code(), ErrorCode::kUnsupported) << st.toString();
+}
+
+}  // namespace
+}  // namespace thinlod::scene
+
+namespace thinlod::scene {
+namespace {
+
+// The fingerprint the daemons compare at the handshake: equal for the same
+// text and meshes wherever they were found, different when either changes.
+class SceneFingerprint : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("thinlod-fingerprint-" +
+            std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
+            std::to_string(reinterpret_cast<std::uintptr_t>(this)));
+    std::filesystem::create_directories(dir_);
+    std::filesystem::copy_file(dataPath("meshes.wrl"), dir_ / "meshes.wrl");
+    std::filesystem::copy_file(dataPath("tetra.off"), dir_ / "tetra.off");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::uint64_t fingerprint() {
+    Result<Scene> r = loadSceneFile((dir_ / "meshes.wrl").string(), withModels());
+    EXPECT_TRUE(r.ok()) << r.status().toString();
+    return r.ok() ? r->fingerprint : 0;
+  }
+  void write(const char* file, const std::string& text) {
+    std::ofstream out(dir_ / file, std::ios::trunc);
+    out << text;
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(SceneFingerprint, SameTextAndMeshesGiveTheSameNonZeroFingerprintWhereverTheyLie) {
+  const std::uint64_t copied = fingerprint();
+  Result<Scene> original = loadSceneFile(dataPath("meshes.wrl"), withModels());
+  ASSERT_TRUE(original.ok());
+  EXPECT_NE(copied, 0u);
+  EXPECT_EQ(copied, original->fingerprint);
+  EXPECT_EQ(copied, fingerprint());
+}
+
+TEST_F(SceneFingerprint, ChangedSceneTextChangesIt) {
+  const std::uint64_t before = fingerprint();
+  std::ifstream in(dir_ / "meshes.wrl");
+  std::stringstream text;
+  text << in.rdbuf();
+  write("meshes.wrl", text.str() + "# one more comment\n");
+  EXPECT_NE(fingerprint(), before);
+}
+
+TEST_F(SceneFingerprint, ChangedMeshGeometryChangesIt) {
+  const std::uint64_t before = fingerprint();
+  // The same tetrahedron with one vertex moved.
+  write("tetra.off",
+        "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1.5\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_NE(fingerprint(), before);
+}
+
+TEST(SceneFingerprintOfText, ParsedWithoutLoadingIsZero) {
+  Result<Scene> parsed =
+      parseScene("#thinlod scene 1\nShape { geometry Sphere { radius 1 } }\n", "inline.wrl");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().toString();
+  EXPECT_EQ(parsed->fingerprint, 0u);
+  EXPECT_NE(sceneFingerprint("#thinlod scene 1\n", *parsed), 0u);
 }
 
 }  // namespace

@@ -59,15 +59,21 @@ AccuracyCurve affineResources(const AccuracyCurve& curve, double offset, double 
 
 std::string idText(std::uint64_t id) { return std::to_string(id); }
 
+backbone::SchedulerOptions schedulerOptions(const CoreOptions& o) {
+  backbone::SchedulerOptions options;
+  options.config = o.config;
+  return options;
+}
+
 }  // namespace
 
 Status validateCoreOptions(const CoreOptions& o) {
-  if (o.scheduler != "curves" && o.scheduler != "static" && o.scheduler != "greedy")
-    return invalid("scheduler '" + o.scheduler + "': expected curves, static or greedy");
   THINLOD_RETURN_IF_ERROR(backbone::validateConfig(o.config));
   THINLOD_RETURN_IF_ERROR(backbone::validateBudget(o.budget));
-  if (o.scheduler == "greedy" && !o.budget.maxTriangles)
-    return invalid("the greedy scheduler needs a polygon budget (--budget-polygons)");
+  Result<std::unique_ptr<backbone::Scheduler>> scheduler =
+      backbone::makeScheduler(o.scheduler, schedulerOptions(o));
+  if (!scheduler.ok()) return invalid(scheduler.status().message());
+  THINLOD_RETURN_IF_ERROR((*scheduler)->accepts(o.budget));
   if (o.textureSize < 8 || o.textureSize > 4096)
     return invalid("texture size " + std::to_string(o.textureSize) + ": expected 8..4096");
   if (o.textureCodec == protocol::TextureCodec::kNone)
@@ -111,6 +117,12 @@ Result<std::unique_ptr<BackboneCore>> BackboneCore::create(scene::Scene scene,
 
 const char* BackboneCore::schedulerName() const { return scheduler_->name(); }
 
+Status BackboneCore::admitFrontend(const protocol::Hello& hello) const {
+  if (hello.role != protocol::Role::kFrontend) return Status();
+  return protocol::checkSameScene("backbone", sceneGraph_.fingerprint, scenePath_, "frontend",
+                                  hello.sceneFingerprint, hello.sceneFile);
+}
+
 Status BackboneCore::initialize() {
   Result<std::vector<scene::SceneObject>> objects = scene::collectSceneObjects(sceneGraph_);
   if (!objects.ok()) return objects.status();
@@ -121,14 +133,8 @@ Status BackboneCore::initialize() {
   scene_ = std::move(converted_.scheduling);
   converted_.scheduling = backbone::SchedulingScene();
 
-  Result<std::unique_ptr<backbone::Scheduler>> scheduler = Status(ErrorCode::kInternal, "none");
-  if (options_.scheduler == "curves") {
-    scheduler = backbone::makeAccuracyCurveScheduler(options_.config);
-  } else if (options_.scheduler == "static") {
-    scheduler = backbone::makeVrmlStaticScheduler(options_.config, backbone::VrmlStaticConfig{});
-  } else {
-    scheduler = backbone::makeGreedyScheduler(options_.config, backbone::GreedyConfig{});
-  }
+  Result<std::unique_ptr<backbone::Scheduler>> scheduler =
+      backbone::makeScheduler(options_.scheduler, schedulerOptions(options_));
   if (!scheduler.ok()) return scheduler.status();
   scheduler_ = std::move(scheduler).value();
 
@@ -225,6 +231,7 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
   message.requestId = request.ticket;
   message.objectId = record.id;
   message.sourcePath = scenePath_;
+  message.sceneFingerprint = sceneGraph_.fingerprint;
   message.target = protocol::SimplifyRequest::Target::kTriangles;
   message.targetTriangles = request.targetTriangles;
   message.curvePoints = warmup ? 0 : options_.curvePoints;
@@ -359,6 +366,7 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     protocol::SimplifyRequest simplify;
     simplify.objectId = record.id;
     simplify.sourcePath = scenePath_;
+    simplify.sceneFingerprint = sceneGraph_.fingerprint;
     simplify.target = protocol::SimplifyRequest::Target::kTriangles;
     simplify.targetTriangles = request.targetTriangles;
     message = std::move(simplify);
@@ -386,6 +394,7 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
       return;
     }
     protocol::ImpostorRequest impostor;
+    impostor.sceneFingerprint = sceneGraph_.fingerprint;
     impostor.objectIds = {record.id};
     impostor.eye = glm::vec3(r.viewRegion.center);
     impostor.orientation = pose_.orientation;

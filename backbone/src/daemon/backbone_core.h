@@ -59,7 +59,7 @@ inline constexpr double kDefaultTextureBytesPerTexel = 0.35;
 inline constexpr double kQuantizationShare = 0.1;
 
 struct CoreOptions {
-  std::string scheduler = "curves";  // curves | static | greedy
+  std::string scheduler = "accuracy-curve";  // a name of backbone::schedulerCatalogue()
   backbone::SchedulerConfig config;
   backbone::Budget budget;
   std::uint32_t textureSize = 256;
@@ -138,6 +138,10 @@ class BackboneCore {
   std::size_t outstandingRequests() const { return byTicket_.size(); }
   const CoreOptions& options() const { return options_; }
   const char* schedulerName() const;
+  std::uint64_t sceneFingerprint() const { return sceneGraph_.fingerprint; }
+  // The frontend handshake: a frontend that loaded another scene is refused
+  // (protocol::checkSameScene); other roles pass.
+  Status admitFrontend(const protocol::Hello& hello) const;
 
  private:
   struct OptionState {

@@ -33,7 +33,7 @@ using Clock = std::chrono::steady_clock;
 struct Settings {
   std::string scene;
   std::string modelsDir;
-  std::string scheduler = "curves";
+  std::string scheduler = "accuracy-curve";
   double budgetPolygons = 0.0;
   double budgetLink = 0.0;
   double accuracy = 0.0;
@@ -65,7 +65,8 @@ struct Settings {
 void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("scene", &s.scene, "scene file (required)");
   runtime.addOption("models-dir", &s.modelsDir, "where the scene's mesh files are looked up first");
-  runtime.addOption("scheduler", &s.scheduler, "curves | static | greedy");
+  runtime.addOption("scheduler", &s.scheduler,
+                    "selection method, by name or alias:\n" + thinlod::backbone::schedulerHelp());
   runtime.addOption("budget-polygons", &s.budgetPolygons,
                     "triangles the frontend may hold (0: no polygon budget)");
   runtime.addOption("budget-link", &s.budgetLink, "link budget in bytes/s (0: unlimited)");
@@ -447,7 +448,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   BackboneCore& backbone = **core;
-  spdlog::info("event=scene path={} objects={} lods={} options={} curves_wanted={}", scenePath,
+  spdlog::info("event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={}",
+               scenePath, protocol::fingerprintText(backbone.sceneFingerprint()),
                backbone.objects().size(), backbone.lodNodes(),
                backbone.schedulingScene().options.size(), backbone.curvesPending());
 
@@ -466,6 +468,9 @@ int main(int argc, char** argv) {
   endpointOptions.address = settings.frontendAddress;
   endpointOptions.name = "backbone";
   endpointOptions.transport = settings.transport;
+  endpointOptions.admit = [&backbone](const protocol::Hello& hello) {
+    return backbone.admitFrontend(hello);
+  };
   auto frontends = protocol::Endpoint::bind(endpointOptions);
   if (!frontends.ok()) {
     spdlog::error("event=bind_failed address={} error=\"{}\"", settings.frontendAddress,

@@ -1,29 +1,17 @@
 // Baselines on the same input and output as the accuracy-curve scheduler:
 // VRML97 static LOD, Funkhouser-Sequin greedy cost/benefit, brute force.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <queue>
 
 #include "scheduler_common.h"
+#include "selection_method.h"
 #include "visible_tree.h"
 
 namespace thinlod::backbone {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double elapsedMicroseconds(std::chrono::steady_clock::time_point started) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started)
-      .count();
-}
-
-Status commonChecks(const SchedulingScene& scene, const ViewerState& viewer, const Budget& budget) {
-  THINLOD_RETURN_IF_ERROR(validateViewer(viewer));
-  THINLOD_RETURN_IF_ERROR(validateBudget(budget));
-  if (scene.nodes.empty()) return Status(ErrorCode::kInvalidArgument, "scheduling scene: no nodes");
-  return Status::okStatus();
-}
 
 void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
                         std::vector<LeafSelection>& out) {
@@ -40,43 +28,29 @@ void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, s
 
 // ---------------------------------------------------------------- VRML97
 
-class VrmlStaticScheduler final : public Scheduler {
+class VrmlStaticMethod final : public SelectionMethod {
  public:
-  VrmlStaticScheduler(const SchedulerConfig& config, const VrmlStaticConfig& vrml)
-      : config_(config), vrml_(vrml) {}
+  explicit VrmlStaticMethod(const VrmlStaticConfig& vrml) : vrml_(vrml) {}
   const char* name() const override { return "vrml-static"; }
+  // VRML97 looks at the current position only (no motion, no rotation) and
+  // knows no budgets.
+  bool predictsMotion() const override { return false; }
+  bool honoursBudgets() const override { return false; }
 
-  Result<Plan> plan(const SchedulingScene& scene, const ViewerState& viewer, const Budget& budget,
-                    PlannerState& outer) const override {
-    const auto started = std::chrono::steady_clock::now();
-    THINLOD_RETURN_IF_ERROR(commonChecks(scene, viewer, budget));
-    PlannerStateImpl& state = outer.impl();
-    beginStep(state, scene, config_, viewer);
-    // VRML97 looks at the current position only: no motion, no rotation.
-    SchedulerConfig still = config_;
-    still.maxSpeed = 0.0;
-    still.maxAngularSpeed = 0.0;
-    const PredictedRegion region = predictRegion(viewer, still);
-    Plan plan;
-    plan.scheduler = name();
-    plan.mode = "static";
-    std::vector<LeafSelection> selections;
+  Result<Selection> select(const SelectionStep& step) const override {
+    Selection selection;
+    selection.mode = "static";
     std::vector<LeafCandidate> candidates;
-    walk(scene, region, state, 0, false, selections, candidates, plan.stats);
-    double achieved = kInf;
-    for (const LeafSelection& s : selections)
-      if (s.rendered) achieved = std::min(achieved, s.absoluteAccuracy());
-    PlanContext context{scene, still, viewer, region, state};
-    finishPlan(context, selections, std::isfinite(achieved) ? achieved : 0.0, plan);
-    plan.row.schedulingMicroseconds = elapsedMicroseconds(started);
-    return plan;
+    walk(step, 0, false, selection.leaves, candidates);
+    return selection;
   }
 
  private:
-  void walk(const SchedulingScene& scene, const PredictedRegion& region,
-            const PlannerStateImpl& state, std::uint32_t n, bool parentInside,
-            std::vector<LeafSelection>& out, std::vector<LeafCandidate>& candidates,
-            PlanStats& stats) const {
+  void walk(const SelectionStep& step, std::uint32_t n, bool parentInside,
+            std::vector<LeafSelection>& out, std::vector<LeafCandidate>& candidates) const {
+    const SchedulingScene& scene = step.scene;
+    const PredictedRegion& region = step.region;
+    PlanStats& stats = step.stats;
     const SceneNode& node = scene.nodes[n];
     const Visibility v = parentInside ? Visibility::kInside : classifySphere(region, node.bounds);
     if (v == Visibility::kCulled) {
@@ -86,8 +60,7 @@ class VrmlStaticScheduler final : public Scheduler {
     ++stats.visitedNodes;
     if (node.kind == SceneNodeKind::kGroup) {
       for (std::uint32_t i = 0; i < node.childCount; ++i)
-        walk(scene, region, state, scene.children[node.firstChild + i], v == Visibility::kInside,
-             out, candidates, stats);
+        walk(step, scene.children[node.firstChild + i], v == Visibility::kInside, out, candidates);
       return;
     }
     if (node.kind == SceneNodeKind::kLod) {
@@ -95,8 +68,7 @@ class VrmlStaticScheduler final : public Scheduler {
       for (std::uint32_t i = 0; i < node.childCount; ++i) {
         const std::uint32_t slot = node.firstChild + i;
         if (containsBall(scene.childRanges[slot], {region.center, 0.0})) {
-          walk(scene, region, state, scene.children[slot], v == Visibility::kInside, out,
-               candidates, stats);
+          walk(step, scene.children[slot], v == Visibility::kInside, out, candidates);
           return;
         }
       }
@@ -104,9 +76,9 @@ class VrmlStaticScheduler final : public Scheduler {
     }
     const double diameter = 2.0 * node.bounds.radius;
     const double distance =
-        conversionDistance(region.center, 0.0, node.bounds, config_.minimalDistance);
-    collectLeafCandidates(scene, node.object, region, config_, CandidateContext::kExact,
-                          pendingFor(state, node.object), node.bounds, candidates);
+        conversionDistance(region.center, 0.0, node.bounds, step.config.minimalDistance);
+    collectLeafCandidates(scene, node.object, region, step.config, CandidateContext::kExact,
+                          pendingFor(step.state, node.object), node.bounds, candidates);
     const double ratio = distance / diameter;
     std::size_t band = 0;
     while (band < vrml_.bandDistanceOverDiameter.size() &&
@@ -125,20 +97,21 @@ class VrmlStaticScheduler final : public Scheduler {
     out.push_back(makeSelection(n, node.object, candidates[pick], need, distance, diameter));
   }
 
-  SchedulerConfig config_;
   VrmlStaticConfig vrml_;
 };
 
 // ---------------------------------------------------- Funkhouser-Sequin
 
-class GreedyScheduler final : public Scheduler {
+class GreedyMethod final : public SelectionMethod {
  public:
-  GreedyScheduler(const SchedulerConfig& config, const GreedyConfig& greedy)
-      : config_(config), greedy_(greedy) {}
+  explicit GreedyMethod(const GreedyConfig& greedy) : greedy_(greedy) {}
   const char* name() const override { return "greedy-fs93"; }
-
-  Result<Plan> plan(const SchedulingScene& scene, const ViewerState& viewer, const Budget& budget,
-                    PlannerState& outer) const override;
+  Status accepts(const Budget& budget) const override {
+    if (!budget.maxTriangles)
+      return Status(ErrorCode::kUnsupported, "greedy-fs93 needs Budget.maxTriangles");
+    return Status::okStatus();
+  }
+  Result<Selection> select(const SelectionStep& step) const override;
 
  private:
   struct Level {
@@ -156,11 +129,10 @@ class GreedyScheduler final : public Scheduler {
 
   void addLevels(const VisibleNode& leaf, Item& item) const;
 
-  SchedulerConfig config_;
   GreedyConfig greedy_;
 };
 
-void GreedyScheduler::addLevels(const VisibleNode& leaf, Item& item) const {
+void GreedyMethod::addLevels(const VisibleNode& leaf, Item& item) const {
   const double toAbsolute = leaf.distance / leaf.diameter;
   const double weight = leaf.diameter / leaf.distance;  // projected size
   auto benefit = [&](double relative) {
@@ -200,20 +172,13 @@ void GreedyScheduler::addLevels(const VisibleNode& leaf, Item& item) const {
   item.levels = std::move(kept);
 }
 
-Result<Plan> GreedyScheduler::plan(const SchedulingScene& scene, const ViewerState& viewer,
-                                   const Budget& budget, PlannerState& outer) const {
-  const auto started = std::chrono::steady_clock::now();
-  THINLOD_RETURN_IF_ERROR(commonChecks(scene, viewer, budget));
-  if (!budget.maxTriangles)
-    return Status(ErrorCode::kUnsupported, "greedy-fs93 needs Budget.maxTriangles");
-  PlannerStateImpl& state = outer.impl();
-  beginStep(state, scene, config_, viewer);
-  const PredictedRegion region = predictRegion(viewer, config_);
-  Plan plan;
-  plan.scheduler = name();
-  plan.mode = "polygon";
-  const VisibleTree tree = buildVisibleTree(scene, config_, region, state, plan.stats);
-  std::vector<LeafSelection> selections;
+Result<Selection> GreedyMethod::select(const SelectionStep& step) const {
+  const SchedulingScene& scene = step.scene;
+  const VisibleTree tree =
+      buildVisibleTree(scene, step.config, step.region, step.state, step.stats);
+  Selection selection;
+  selection.mode = "polygon";
+  std::vector<LeafSelection>& selections = selection.leaves;
   std::vector<Item> items;
   // LOD nodes: FS93 has one object with levels; an LOD is resolved to its
   // first eligible level here, whose leaves become objects.
@@ -238,7 +203,7 @@ Result<Plan> GreedyScheduler::plan(const SchedulingScene& scene, const ViewerSta
       stack.push_back(n.children.front());
     }
   }
-  const double cap = *budget.maxTriangles;
+  const double cap = *step.budget.maxTriangles;
   double used = 0.0;
   for (const Item& item : items) used += item.levels.front().triangles;
   // Over budget at the cheapest levels: drop the least visible objects.
@@ -302,7 +267,6 @@ Result<Plan> GreedyScheduler::plan(const SchedulingScene& scene, const ViewerSta
     ++item.version;
     bestUpgrade(u.item);
   }
-  double achieved = kInf;
   for (std::size_t i = 0; i < items.size(); ++i) {
     const VisibleNode& n = tree.nodes[items[i].treeNode];
     if (dropped[i]) {
@@ -317,26 +281,19 @@ Result<Plan> GreedyScheduler::plan(const SchedulingScene& scene, const ViewerSta
     selections.push_back(makeSelection(n.sceneNode, scene.nodes[n.sceneNode].object,
                                        n.candidates[level.candidate], level.relative, n.distance,
                                        n.diameter));
-    achieved = std::min(achieved, selections.back().absoluteAccuracy());
   }
-  PlanContext context{scene, config_, viewer, region, state};
-  finishPlan(context, selections, std::isfinite(achieved) ? achieved : 0.0, plan);
-  plan.row.schedulingMicroseconds = elapsedMicroseconds(started);
-  return plan;
+  return selection;
 }
 
 // ------------------------------------------------------------ brute force
 
-class BruteForceScheduler final : public Scheduler {
+class BruteForceMethod final : public SelectionMethod {
  public:
-  BruteForceScheduler(const SchedulerConfig& config, const BruteForceConfig& brute)
-      : config_(config), brute_(brute) {}
+  explicit BruteForceMethod(const BruteForceConfig& brute) : brute_(brute) {}
   const char* name() const override { return "brute-force"; }
-  Result<Plan> plan(const SchedulingScene& scene, const ViewerState& viewer, const Budget& budget,
-                    PlannerState& outer) const override;
+  Result<Selection> select(const SelectionStep& step) const override;
 
  private:
-  SchedulerConfig config_;
   BruteForceConfig brute_;
 };
 
@@ -401,19 +358,14 @@ struct BruteSearch {
   }
 };
 
-Result<Plan> BruteForceScheduler::plan(const SchedulingScene& scene, const ViewerState& viewer,
-                                       const Budget& budget, PlannerState& outer) const {
-  const auto started = std::chrono::steady_clock::now();
-  THINLOD_RETURN_IF_ERROR(commonChecks(scene, viewer, budget));
-  PlannerStateImpl& state = outer.impl();
-  beginStep(state, scene, config_, viewer);
-  const PredictedRegion region = predictRegion(viewer, config_);
-  Plan plan;
-  plan.scheduler = name();
-  plan.mode = modeName(budget);
-  const VisibleTree tree = buildVisibleTree(scene, config_, region, state, plan.stats);
-  const JointBudget hard = hardBudget(budget, state, viewer, config_);
-  std::vector<LeafSelection> selections;
+Result<Selection> BruteForceMethod::select(const SelectionStep& step) const {
+  const SchedulingScene& scene = step.scene;
+  const Budget& budget = step.budget;
+  const JointBudget& hard = step.hard;
+  const VisibleTree tree =
+      buildVisibleTree(scene, step.config, step.region, step.state, step.stats);
+  Selection selection;
+  std::vector<LeafSelection>& selections = selection.leaves;
   double target = budget.fixedAccuracy.value_or(kInf);
   if (!tree.nodes.empty() && tree.nodes[0].maxAccuracy != -kInf) {
     // Mixed-radix enumeration of every leaf and LOD choice.
@@ -500,10 +452,8 @@ Result<Plan> BruteForceScheduler::plan(const SchedulingScene& scene, const Viewe
     target = budget.fixedAccuracy && best >= high ? *budget.fixedAccuracy : best;
     search.select(0, target, scene, selections);
   }
-  PlanContext context{scene, config_, viewer, region, state};
-  finishPlan(context, selections, target, plan);
-  plan.row.schedulingMicroseconds = elapsedMicroseconds(started);
-  return plan;
+  selection.targetAccuracy = target;
+  return selection;
 }
 
 Status checkVrml(const VrmlStaticConfig& vrml) {
@@ -530,7 +480,7 @@ Result<std::unique_ptr<Scheduler>> makeVrmlStaticScheduler(const SchedulerConfig
                                                            const VrmlStaticConfig& vrml) {
   THINLOD_RETURN_IF_ERROR(validateConfig(config));
   THINLOD_RETURN_IF_ERROR(checkVrml(vrml));
-  return std::unique_ptr<Scheduler>(new VrmlStaticScheduler(config, vrml));
+  return std::make_unique<Scheduler>(config, std::make_unique<VrmlStaticMethod>(vrml));
 }
 
 Result<std::unique_ptr<Scheduler>> makeGreedyScheduler(const SchedulerConfig& config,
@@ -541,7 +491,7 @@ Result<std::unique_ptr<Scheduler>> makeGreedyScheduler(const SchedulerConfig& co
   if (!std::isfinite(greedy.halfBenefitAccuracy) || greedy.halfBenefitAccuracy <= 0.0)
     return Status(ErrorCode::kInvalidArgument,
                   "GreedyConfig.halfBenefitAccuracy must be finite and > 0");
-  return std::unique_ptr<Scheduler>(new GreedyScheduler(config, greedy));
+  return std::make_unique<Scheduler>(config, std::make_unique<GreedyMethod>(greedy));
 }
 
 Result<std::unique_ptr<Scheduler>> makeBruteForceScheduler(const SchedulerConfig& config,
@@ -549,7 +499,7 @@ Result<std::unique_ptr<Scheduler>> makeBruteForceScheduler(const SchedulerConfig
   THINLOD_RETURN_IF_ERROR(validateConfig(config));
   if (!(brute.maxCombinations >= 1.0))
     return Status(ErrorCode::kInvalidArgument, "BruteForceConfig.maxCombinations must be >= 1");
-  return std::unique_ptr<Scheduler>(new BruteForceScheduler(config, brute));
+  return std::make_unique<Scheduler>(config, std::make_unique<BruteForceMethod>(brute));
 }
 
 }  // namespace thinlod::backbone

@@ -3,15 +3,12 @@
 #include <algorithm>
 #include <string>
 
+#include "thinlod/common/hash.h"
+
 namespace thinlod::codec {
 
 std::uint64_t frameChecksum(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a 64 offset basis
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= data[i];
-    hash *= 0x100000001b3ull;  // FNV prime
-  }
-  return hash;
+  return fnv1a64(data, size);
 }
 
 namespace detail {

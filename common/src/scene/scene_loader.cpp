@@ -4,6 +4,7 @@
 #include <fstream>
 #include <map>
 
+#include "thinlod/common/hash.h"
 #include "thinlod/common/scene_parser.h"
 
 namespace thinlod::scene {
@@ -39,7 +40,33 @@ void forEachShape(const Node& node, std::map<const Node*, bool>& seen,
   for (const NodePtr& c : node.children) forEachShape(*c, seen, out);
 }
 
+template <typename T>
+std::uint64_t hashVector(const std::vector<T>& v, std::uint64_t seed) {
+  const std::uint64_t count = v.size();
+  seed = fnv1a64(&count, sizeof count, seed);
+  return v.empty() ? seed : fnv1a64(v.data(), v.size() * sizeof(T), seed);
+}
+
 }  // namespace
+
+std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene) {
+  std::uint64_t hash = fnv1a64(text.data(), text.size());
+  std::map<const Node*, bool> seen;
+  std::vector<ShapeNode*> shapes;
+  for (const NodePtr& root : scene.roots) forEachShape(*root, seen, shapes);
+  std::map<const IndexedMesh*, bool> hashed;
+  for (const ShapeNode* shape : shapes) {
+    const IndexedMesh* mesh =
+        shape->geometry.kind == GeometryKind::kMeshFile ? shape->geometry.mesh.get() : nullptr;
+    if (mesh == nullptr || !hashed.emplace(mesh, true).second) continue;
+    hash = hashVector(mesh->positions, hash);
+    hash = hashVector(mesh->indices, hash);
+    hash = hashVector(mesh->normals, hash);
+    hash = hashVector(mesh->uvs, hash);
+    hash = hashVector(mesh->colors, hash);
+  }
+  return hash == 0 ? 1 : hash;  // 0 means "no scene"
+}
 
 Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
                      const SceneLoadOptions& options) {
@@ -54,8 +81,8 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
   for (ShapeNode* shape : shapes) {
     Geometry& g = shape->geometry;
     if (g.kind != GeometryKind::kMeshFile || g.mesh) continue;
-    const std::string where = scene.sourceName + ":" + std::to_string(shape->sourceLocation.line) + ":" +
-                              std::to_string(shape->sourceLocation.column);
+    const std::string where = scene.sourceName + ":" + std::to_string(shape->sourceLocation.line) +
+                              ":" + std::to_string(shape->sourceLocation.column);
     std::vector<std::string> tried;
     for (const std::string& url : g.urls) {
       THINLOD_RETURN_IF_ERROR(checkUrl(url, where));
@@ -121,6 +148,7 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   Result<Scene> scene = parseScene(text, path, options.limits);
   if (!scene.ok()) return scene.status();
   THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  scene->fingerprint = sceneFingerprint(text, *scene);
   return scene;
 }
 

@@ -18,12 +18,15 @@ std::string defaultPeerName() {
 
 Result<std::unique_ptr<ChannelLink>> ChannelLink::connect(
     const std::string& address, const std::string& name,
-    const protocol::TransportOptions& transport, int wakeFd) {
+    const protocol::TransportOptions& transport, int wakeFd, std::uint64_t sceneFingerprint,
+    const std::string& sceneFile) {
   protocol::Channel::Options options;
   options.address = address;
   options.hello.role = protocol::Role::kFrontend;
   options.hello.name = name;
   options.hello.capacity = 0;
+  options.hello.sceneFingerprint = sceneFingerprint;
+  options.hello.sceneFile = sceneFile;
   std::random_device entropy;
   options.hello.instanceId = (static_cast<std::uint64_t>(entropy()) << 32) ^ entropy();
   options.transport = transport;
@@ -68,6 +71,7 @@ void ChannelLink::drain(std::chrono::milliseconds timeout, int wakeFd) {
       case protocol::ChannelEvent::Kind::kRejected:
         spdlog::error("event=backbone_rejected address={} reason=\"{}\"", address_,
                       event.reason.toString());
+        rejection_ = event.reason;
         break;
       case protocol::ChannelEvent::Kind::kMessage:
         if (auto* update = std::get_if<protocol::SceneUpdate>(&event.message)) {
@@ -92,7 +96,7 @@ bool ChannelLink::waitConnected(std::chrono::milliseconds timeout,
   using SteadyTime = std::chrono::steady_clock;
   const auto start = SteadyTime::now();
   auto nextProgress = start + progressEvery;
-  while (!channel_->connected() && !stop()) {
+  while (!channel_->connected() && !rejection_ && !stop()) {
     const auto now = SteadyTime::now();
     if (now - start >= timeout) break;
     if (now >= nextProgress) {

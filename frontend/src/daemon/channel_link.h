@@ -7,6 +7,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,10 +19,14 @@ namespace thinlod::frontend::daemon {
 class ChannelLink final : public BackboneLink {
  public:
   // `name` must be unique among the backbone's frontends (docs/protocol.md).
+  // The Hello names the scene this frontend loaded (fingerprint 0: none), so
+  // a backbone with another scene refuses it.
   static Result<std::unique_ptr<ChannelLink>> connect(const std::string& address,
                                                       const std::string& name,
                                                       const protocol::TransportOptions& transport,
-                                                      int wakeFd);
+                                                      int wakeFd,
+                                                      std::uint64_t sceneFingerprint = 0,
+                                                      const std::string& sceneFile = {});
 
   bool connected() const override;
   Status send(const protocol::Message& message) override;
@@ -31,9 +36,13 @@ class ChannelLink final : public BackboneLink {
 
   // Polls until the handshake is done, `timeout` passes or stop() is true,
   // logging progress every `progressEvery`. SceneUpdates arriving meanwhile
-  // are kept for the next poll(). True when connected.
+  // are kept for the next poll(). True when connected; false at once when the
+  // backbone refused the Hello (see rejection()).
   bool waitConnected(std::chrono::milliseconds timeout, std::chrono::milliseconds progressEvery,
                      const std::function<bool()>& stop);
+  // Why the backbone refused this frontend's Hello (e.g. another scene); null
+  // while it has not.
+  const Status* rejection() const { return rejection_ ? &*rejection_ : nullptr; }
 
  private:
   explicit ChannelLink(std::unique_ptr<protocol::Channel> channel, int wakeFd);
@@ -43,6 +52,7 @@ class ChannelLink final : public BackboneLink {
   protocol::Poller poller_;
   std::string address_;
   std::vector<protocol::SceneUpdate> received_;
+  std::optional<Status> rejection_;
 };
 
 // "frontend@<host>#<pid>": unique per process on a host.

@@ -229,7 +229,8 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   }
 
   Result<std::unique_ptr<ChannelLink>> link = ChannelLink::connect(
-      options.backboneAddress, defaultPeerName(), options.transport, runtime.wakeFd());
+      options.backboneAddress, defaultPeerName(), options.transport, runtime.wakeFd(),
+      scene ? scene->scene->fingerprint : 0, options.scenePath);
   if (!link.ok()) {
     spdlog::error("event=connect_failed address={} error=\"{}\"", options.backboneAddress,
                   link.status().toString());
@@ -238,6 +239,11 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   const auto stop = [&runtime] { return runtime.shutdownRequested(); };
   const bool connected = (*link)->waitConnected(std::chrono::milliseconds(options.connectTimeoutMs),
                                                 std::chrono::milliseconds(1000), stop);
+  if (const Status* refused = (*link)->rejection()) {
+    spdlog::error("event=backbone_refused address={} error=\"{}\"", options.backboneAddress,
+                  refused->toString());
+    return 1;
+  }
   if (!connected && !runtime.shutdownRequested()) {
     spdlog::warn("event=backbone_unavailable address={} waited_ms={} action=replay_anyway",
                  options.backboneAddress, options.connectTimeoutMs);

@@ -82,8 +82,9 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Hello
   auto name = stringOrNull(b, m.name);
   fb::Offset<fb::Vector<fb::Offset<fb::String>>> caps = 0;
   if (!m.capabilities.empty()) caps = b.CreateVectorOfStrings(m.capabilities);
+  auto sceneFile = stringOrNull(b, m.sceneFile);
   auto t = w::CreateHello(b, m.minVersion, m.maxVersion, static_cast<w::Role>(m.role), name,
-                          m.instanceId, caps, m.capacity);
+                          m.instanceId, caps, m.capacity, m.sceneFingerprint, sceneFile);
   return {w::Body::Hello, t.Union()};
 }
 
@@ -121,7 +122,7 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Simpl
   auto mesh = bytesOrNull(b, m.sourceMesh);
   auto t = w::CreateSimplifyRequest(b, m.requestId, m.objectId, path, mesh,
                                     static_cast<w::SimplifyTarget>(m.target), m.targetTriangles,
-                                    m.targetAccuracy, m.curvePoints);
+                                    m.targetAccuracy, m.curvePoints, m.sceneFingerprint);
   return {w::Body::SimplifyRequest, t.Union()};
 }
 
@@ -146,7 +147,8 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Impos
   const w::Quat orientation = toWire(m.orientation);
   auto t = w::CreateImpostorRequest(b, m.requestId, ids, &eye, &orientation, m.fovY, m.textureWidth,
                                     m.textureHeight, static_cast<w::RepresentationKind>(m.kind),
-                                    m.accuracyBound, static_cast<w::TextureCodec>(m.textureCodec));
+                                    m.accuracyBound, static_cast<w::TextureCodec>(m.textureCodec),
+                                    m.sceneFingerprint);
   return {w::Body::ImpostorRequest, t.Union()};
 }
 
@@ -160,8 +162,9 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Impos
 }
 
 std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const FrameStats& m) {
+  auto rejected = idsOrNull(b, m.rejectedPlans);
   auto t = w::CreateFrameStats(b, m.frame, m.plan, m.timestampNs, m.polygons, m.linkBytes, m.hasSnr,
-                               m.snrDb, m.renderMs);
+                               m.snrDb, m.renderMs, rejected);
   return {w::Body::FrameStats, t.Union()};
 }
 
@@ -306,6 +309,10 @@ Result<Message> fromWire(const FieldPath& path, const w::Hello* m) {
     }
   }
   out.capacity = m->capacity();
+  out.sceneFingerprint = m->scene_fingerprint();
+  auto sceneFile = toString(path.child("scene_file"), m->scene_file(), kMaxPathBytes);
+  if (!sceneFile.ok()) return sceneFile.status();
+  out.sceneFile = std::move(*sceneFile);
   return Message(std::move(out));
 }
 
@@ -378,6 +385,7 @@ Result<Message> fromWire(const FieldPath& path, const w::SimplifyRequest* m) {
   out.targetTriangles = m->target_triangles();
   out.targetAccuracy = m->target_accuracy();
   out.curvePoints = m->curve_points();
+  out.sceneFingerprint = m->scene_fingerprint();
   return Message(std::move(out));
 }
 
@@ -413,6 +421,7 @@ Result<Message> fromWire(const FieldPath& path, const w::ImpostorRequest* m) {
   out.kind = static_cast<RepresentationKind>(m->kind());
   out.accuracyBound = m->accuracy_bound();
   out.textureCodec = static_cast<TextureCodec>(m->texture_codec());
+  out.sceneFingerprint = m->scene_fingerprint();
   return Message(std::move(out));
 }
 
@@ -433,7 +442,7 @@ Result<Message> fromWire(const FieldPath& path, const w::ImpostorResult* m) {
   return Message(std::move(out));
 }
 
-Result<Message> fromWire(const FieldPath&, const w::FrameStats* m) {
+Result<Message> fromWire(const FieldPath& path, const w::FrameStats* m) {
   FrameStats out;
   out.frame = m->frame();
   out.plan = m->plan();
@@ -443,6 +452,10 @@ Result<Message> fromWire(const FieldPath&, const w::FrameStats* m) {
   out.hasSnr = m->has_snr();
   out.snrDb = m->snr_db();
   out.renderMs = m->render_ms();
+  THINLOD_RETURN_IF_ERROR(
+      checkVectorCount(path.child("rejected_plans"), m->rejected_plans(), kMaxRejectedPlans));
+  if (const auto* rejected = m->rejected_plans())
+    out.rejectedPlans.assign(rejected->begin(), rejected->end());
   return Message(std::move(out));
 }
 

@@ -1,5 +1,6 @@
 #include "thinlod/protocol/messages.h"
 
+#include <cstdio>
 #include <type_traits>
 
 namespace thinlod::protocol {
@@ -70,7 +71,8 @@ bool operator==(const Representation& a, const Representation& b) {
 bool operator==(const Hello& a, const Hello& b) {
   return a.minVersion == b.minVersion && a.maxVersion == b.maxVersion && a.role == b.role &&
          a.name == b.name && a.instanceId == b.instanceId && a.capabilities == b.capabilities &&
-         a.capacity == b.capacity;
+         a.capacity == b.capacity && a.sceneFingerprint == b.sceneFingerprint &&
+         a.sceneFile == b.sceneFile;
 }
 bool operator==(const HelloReply& a, const HelloReply& b) {
   return a.accepted == b.accepted && a.version == b.version && a.role == b.role &&
@@ -92,13 +94,13 @@ bool operator==(const SceneUpdate& a, const SceneUpdate& b) {
 bool operator==(const FrameStats& a, const FrameStats& b) {
   return a.frame == b.frame && a.plan == b.plan && a.timestampNs == b.timestampNs &&
          a.polygons == b.polygons && a.linkBytes == b.linkBytes && a.hasSnr == b.hasSnr &&
-         a.snrDb == b.snrDb && a.renderMs == b.renderMs;
+         a.snrDb == b.snrDb && a.renderMs == b.renderMs && a.rejectedPlans == b.rejectedPlans;
 }
 bool operator==(const SimplifyRequest& a, const SimplifyRequest& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && a.sourcePath == b.sourcePath &&
          a.sourceMesh == b.sourceMesh && a.target == b.target &&
          a.targetTriangles == b.targetTriangles && a.targetAccuracy == b.targetAccuracy &&
-         a.curvePoints == b.curvePoints;
+         a.curvePoints == b.curvePoints && a.sceneFingerprint == b.sceneFingerprint;
 }
 bool operator==(const SimplifyResult& a, const SimplifyResult& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && sameStatus(a.status, b.status) &&
@@ -109,7 +111,8 @@ bool operator==(const ImpostorRequest& a, const ImpostorRequest& b) {
   return a.requestId == b.requestId && a.objectIds == b.objectIds && a.eye == b.eye &&
          a.orientation == b.orientation && a.fovY == b.fovY && a.textureWidth == b.textureWidth &&
          a.textureHeight == b.textureHeight && a.kind == b.kind &&
-         a.accuracyBound == b.accuracyBound && a.textureCodec == b.textureCodec;
+         a.accuracyBound == b.accuracyBound && a.textureCodec == b.textureCodec &&
+         a.sceneFingerprint == b.sceneFingerprint;
 }
 bool operator==(const ImpostorResult& a, const ImpostorResult& b) {
   return a.requestId == b.requestId && a.objectIds == b.objectIds &&
@@ -119,5 +122,24 @@ bool operator==(const Heartbeat& a, const Heartbeat& b) {
   return a.timestampNs == b.timestampNs && a.sequence == b.sequence;
 }
 bool operator==(const Shutdown& a, const Shutdown& b) { return a.reason == b.reason; }
+
+std::string fingerprintText(std::uint64_t fingerprint) {
+  char text[19];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(fingerprint));
+  return text;
+}
+
+Status checkSameScene(const char* ourRole, std::uint64_t ourFingerprint, const std::string& ourFile,
+                      const char* theirRole, std::uint64_t theirFingerprint,
+                      const std::string& theirFile) {
+  if (ourFingerprint == 0 || theirFingerprint == 0 || ourFingerprint == theirFingerprint)
+    return Status();
+  return Status(ErrorCode::kInvalidArgument,
+                std::string("scene mismatch: the ") + ourRole + " loaded " + ourFile +
+                    " (fingerprint " + fingerprintText(ourFingerprint) + "), the " + theirRole +
+                    " loaded " + (theirFile.empty() ? std::string("an unnamed scene") : theirFile) +
+                    " (fingerprint " + fingerprintText(theirFingerprint) +
+                    "): start every daemon with the same scene file and models");
+}
 
 }  // namespace thinlod::protocol

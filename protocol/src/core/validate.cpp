@@ -216,6 +216,7 @@ Status check(const FieldPath& path, const Hello& m) {
     return tooLarge(path.child("capacity"), "is " + std::to_string(m.capacity) + ", limit " +
                                                 std::to_string(kMaxWorkerCapacity));
   }
+  THINLOD_RETURN_IF_ERROR(checkText(path.child("scene_file"), m.sceneFile, kMaxPathBytes));
   return Status();
 }
 
@@ -286,6 +287,8 @@ Status check(const FieldPath& path, const FrameStats& m) {
   if (!m.hasSnr && m.snrDb != 0.0)
     return invalidField(path.child("snr_db"), "must be 0 when has_snr is false");
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("render_ms"), m.renderMs));
+  THINLOD_RETURN_IF_ERROR(
+      checkCount(path.child("rejected_plans"), m.rejectedPlans.size(), kMaxRejectedPlans));
   return Status();
 }
 

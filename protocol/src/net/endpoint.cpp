@@ -249,6 +249,15 @@ void Endpoint::Impl::onHello(const std::string& routingId, const Hello& hello,
     reject(routingId, why);
     return;
   }
+  if (options.admit) {
+    const Status why = options.admit(hello);
+    if (!why.ok()) {
+      spdlog::warn("event=hello_rejected endpoint={} peer_name={} error=\"{}\"", options.name,
+                   hello.name, why.toString());
+      reject(routingId, why);
+      return;
+    }
+  }
   auto known = byRouting.find(routingId);
   if (known != byRouting.end()) {
     Peer& peer = peers[known->second];

@@ -358,8 +358,14 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
                           : Result<protocol::SimplifyResult>(model.status());
     } else {
       Result<LoadedScene*> loaded = impl_->scene(request.sourcePath);
+      Status same = loaded.ok() ? protocol::checkSameScene(
+                                      "simplifier", (*loaded)->scene.fingerprint, (*loaded)->path,
+                                      "backbone", request.sceneFingerprint, request.sourcePath)
+                                : Status();
       if (!loaded.ok()) {
         result = loaded.status();
+      } else if (!same.ok()) {
+        result = same;
       } else if (const scene::SceneObject* object =
                      scene::findSceneObject((*loaded)->objects, request.objectId)) {
         if (object->shape != nullptr &&

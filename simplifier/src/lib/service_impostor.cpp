@@ -135,11 +135,20 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
     if (!found.ok()) return found.status();
     loaded = *found;
   }
+  if (request.sceneFingerprint != 0) {
+    // Several backbones may share this worker: render from the scene the
+    // requesting backbone loaded, whichever was loaded last.
+    for (const auto& cached : scenes)
+      if (cached->scene.fingerprint == request.sceneFingerprint) loaded = cached.get();
+  }
   if (loaded == nullptr) {
     return Status(ErrorCode::kUnavailable,
                   "impostor: no scene loaded (configure a default scene or send a "
                   "SimplifyRequest with the scene path first)");
   }
+  THINLOD_RETURN_IF_ERROR(protocol::checkSameScene("simplifier", loaded->scene.fingerprint,
+                                                   loaded->path, "backbone",
+                                                   request.sceneFingerprint, "its scene"));
   std::vector<const scene::SceneObject*> objects;
   for (std::uint64_t id : request.objectIds) {
     const scene::SceneObject* object = scene::findSceneObject(loaded->objects, id);

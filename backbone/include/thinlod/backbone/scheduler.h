@@ -20,10 +20,14 @@
 //   threads. A Scheduler object is immutable after construction; plan() is
 //   reentrant with distinct states.
 // - Timing: Plan::row.schedulingMicroseconds is measured with steady_clock.
+// - Methods: every selection method runs inside the same frame
+//   (Scheduler::plan); schedulerCatalogue() lists them by name and
+//   makeScheduler(name) builds one (a new method: selection_method.h).
 #pragma once
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "thinlod/backbone/decision_row.h"
@@ -141,12 +145,29 @@ class PlannerState {
   std::unique_ptr<PlannerStateImpl> impl_;
 };
 
+class SelectionMethod;  // private: backbone/src/lib/selection_method.h
+
+// One planning step, the same for every selection method: validate, begin the
+// step, predict the region, hard budget, the method's selection, hard-budget
+// verification, plan building, timing. Only the selection differs.
 class Scheduler {
  public:
-  virtual ~Scheduler() = default;
-  virtual const char* name() const = 0;
-  virtual Result<Plan> plan(const SchedulingScene& scene, const ViewerState& viewer,
-                            const Budget& budget, PlannerState& state) const = 0;
+  Scheduler(const SchedulerConfig& config, std::unique_ptr<const SelectionMethod> method);
+  ~Scheduler();
+  Scheduler(const Scheduler&) = delete;
+  Scheduler& operator=(const Scheduler&) = delete;
+
+  const char* name() const;
+  const SchedulerConfig& config() const { return config_; }
+  // kUnsupported when the method cannot honour this budget (greedy-fs93
+  // without a polygon budget); plan() checks it too.
+  Status accepts(const Budget& budget) const;
+  Result<Plan> plan(const SchedulingScene& scene, const ViewerState& viewer, const Budget& budget,
+                    PlannerState& state) const;
+
+ private:
+  SchedulerConfig config_;
+  std::unique_ptr<const SelectionMethod> method_;
 };
 
 // The paper's method: accuracy curves, one uniform target, hysteresis.
@@ -181,5 +202,29 @@ struct BruteForceConfig {
 };
 Result<std::unique_ptr<Scheduler>> makeBruteForceScheduler(const SchedulerConfig& config,
                                                            const BruteForceConfig& brute);
+
+// ------------------------------------------------------------- registry
+// Every selection method by name, for --scheduler NAME (one name each; the
+// alias is the short name older configs and scripts use).
+struct SchedulerOptions {
+  SchedulerConfig config;
+  VrmlStaticConfig vrml;
+  GreedyConfig greedy;
+  BruteForceConfig bruteForce;
+};
+
+struct SchedulerEntry {
+  const char* name;
+  const char* alias;    // "" when none
+  const char* summary;  // one line for --help
+  bool forExperiments;  // true: tests and benchmarks only (not offered by the daemon)
+};
+const std::vector<SchedulerEntry>& schedulerCatalogue();
+// Name or alias -> canonical name; kNotFound listing the known names.
+Result<const char*> canonicalSchedulerName(const std::string& nameOrAlias);
+Result<std::unique_ptr<Scheduler>> makeScheduler(const std::string& nameOrAlias,
+                                                 const SchedulerOptions& options);
+// "name (alias): summary" lines of the daemon's methods, for --help.
+std::string schedulerHelp();
 
 }  // namespace thinlod::backbone

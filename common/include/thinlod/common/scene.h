@@ -202,7 +202,16 @@ struct Scene {
   std::map<std::string, NodePtr> defs;  // DEF'd scene-graph nodes (last DEF wins)
   std::uint32_t nodeCount = 0;          // distinct nodes (ids 1..nodeCount)
   std::vector<std::string> warnings;    // from mesh loading
+  // loadSceneFile(): sceneFingerprint() of the file's text and its meshes
+  // (0 for a scene parsed from text alone). Daemons compare it at the
+  // handshake: equal scene text and mesh geometry give equal fingerprints.
+  std::uint64_t fingerprint = 0;
 };
+
+// FNV-1a 64 of the scene text, then of every loaded mesh geometry
+// (positions, indices, normals, uvs, colours) in the order Shapes first name
+// them. Independent of where the files were found.
+std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene);
 
 // Bounds of what the node draws, in its content frame; empty for lights,
 // viewpoints, empty groups and unloaded meshes.

@@ -46,6 +46,7 @@ inline constexpr std::size_t kMaxCurveSamples = 4096;
 inline constexpr std::uint32_t kMaxTriangleCount = 1u << 26;  // per representation
 inline constexpr std::uint32_t kMaxViewportDimension = 16384;
 inline constexpr std::uint32_t kMaxWorkerCapacity = 1024;
+inline constexpr std::size_t kMaxRejectedPlans = 1024;  // per FrameStats
 // Verifier limits: nesting depth and number of tables per message.
 inline constexpr unsigned kMaxTableDepth = 16;
 inline constexpr unsigned kMaxTables = 4 * kMaxSceneOperations + 64;
@@ -121,6 +122,11 @@ struct Hello {
   std::uint64_t instanceId = 0;  // random per process start: detects restarts
   std::vector<std::string> capabilities;
   std::uint32_t capacity = 1;  // requests a worker runs at once (0 for non-workers)
+  // The scene the peer loaded (scene::Scene::fingerprint) and its file as the
+  // peer named it; 0 / empty: no scene (tools, workers, older peers). The
+  // backbone refuses a frontend whose non-zero fingerprint differs from its own.
+  std::uint64_t sceneFingerprint = 0;
+  std::string sceneFile;
 };
 
 struct HelloReply {
@@ -167,6 +173,9 @@ struct FrameStats {
   bool hasSnr = false;
   double snrDb = 0.0;  // finite when hasSnr
   float renderMs = 0.0f;
+  // Plans of SceneUpdates the frontend refused (whole batch) since the
+  // previous FrameStats: the backbone corrects its mirror of the frontend.
+  std::vector<std::uint64_t> rejectedPlans;  // at most kMaxRejectedPlans
 };
 
 // --- Backbone <-> simplifier workers (request ids are idempotency keys) ---
@@ -180,6 +189,9 @@ struct SimplifyRequest {
   std::uint32_t targetTriangles = 0;  // >= 1 for kTriangles
   double targetAccuracy = 0.0;        // > 0 for kAccuracy
   std::uint16_t curvePoints = 0;      // accuracy-curve samples wanted (0: none)
+  // The backbone's scene::Scene::fingerprint (0: not checked): a worker whose
+  // load of sourcePath differs answers kFailedPrecondition naming both.
+  std::uint64_t sceneFingerprint = 0;
 };
 
 struct SimplifyResult {
@@ -203,6 +215,9 @@ struct ImpostorRequest {
   RepresentationKind kind = RepresentationKind::kSimpleImpostor;  // not kMesh
   double accuracyBound = 0.0;
   TextureCodec textureCodec = TextureCodec::kPng;  // not kNone
+  // The backbone's scene fingerprint: the worker renders from the loaded
+  // scene with this fingerprint (0: the scene it loaded last).
+  std::uint64_t sceneFingerprint = 0;
 };
 
 struct ImpostorResult {
@@ -245,5 +260,13 @@ bool operator==(const ImpostorRequest& a, const ImpostorRequest& b);
 bool operator==(const ImpostorResult& a, const ImpostorResult& b);
 bool operator==(const Heartbeat& a, const Heartbeat& b);
 bool operator==(const Shutdown& a, const Shutdown& b);
+
+// Scene identity at the handshake and in requests: OK when either
+// fingerprint is 0 (no scene claimed) or both are equal; otherwise
+// kInvalidArgument naming both roles, files and fingerprints.
+Status checkSameScene(const char* ourRole, std::uint64_t ourFingerprint, const std::string& ourFile,
+                      const char* theirRole, std::uint64_t theirFingerprint,
+                      const std::string& theirFile);
+std::string fingerprintText(std::uint64_t fingerprint);  // 16 hex digits
 
 }  // namespace thinlod::protocol

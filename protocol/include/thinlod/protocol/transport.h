@@ -29,6 +29,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,6 +91,9 @@ class Endpoint {
     std::string name = "backbone";
     std::vector<Role> acceptedRoles = {Role::kFrontend, Role::kTool};
     TransportOptions transport;
+    // Optional: a non-OK status refuses the Hello with that reason (in the
+    // HelloReply and the log), e.g. a peer that loaded another scene.
+    std::function<Status(const Hello&)> admit;
   };
 
   static Result<std::unique_ptr<Endpoint>> bind(Options options);

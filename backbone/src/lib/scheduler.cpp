@@ -1,0 +1,87 @@
+// The shared frame of every planning step (selection_method.h says what it
+// does around a method's selection).
+#include "thinlod/backbone/scheduler.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "scheduler_common.h"
+#include "selection_method.h"
+
+namespace thinlod::backbone {
+namespace {
+
+// A method that overshoots a hard cap loses its least visible objects
+// (smallest diameter / distance first) until the plan fits: the budget is a
+// cap on every plan, whatever the method.
+void dropUntilWithin(std::vector<LeafSelection>& leaves, const JointBudget& hard) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+    if (leaves[i].rendered) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return leaves[a].diameter * leaves[b].distance < leaves[b].diameter * leaves[a].distance;
+  });
+  for (std::size_t i : order) {
+    if (withinBudget(leaves, hard)) return;
+    leaves[i].rendered = false;
+    leaves[i].dropped = true;
+  }
+}
+
+double lowestRenderedAccuracy(const std::vector<LeafSelection>& leaves) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const LeafSelection& s : leaves)
+    if (s.rendered) lowest = std::min(lowest, s.absoluteAccuracy());
+  return std::isfinite(lowest) ? lowest : 0.0;
+}
+
+}  // namespace
+
+Scheduler::Scheduler(const SchedulerConfig& config, std::unique_ptr<const SelectionMethod> method)
+    : config_(config), method_(std::move(method)) {}
+
+Scheduler::~Scheduler() = default;
+
+const char* Scheduler::name() const { return method_->name(); }
+
+Status Scheduler::accepts(const Budget& budget) const { return method_->accepts(budget); }
+
+Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& viewer,
+                             const Budget& budget, PlannerState& outer) const {
+  const auto started = std::chrono::steady_clock::now();
+  THINLOD_RETURN_IF_ERROR(validateViewer(viewer));
+  THINLOD_RETURN_IF_ERROR(validateBudget(budget));
+  if (scene.nodes.empty()) return Status(ErrorCode::kInvalidArgument, "scheduling scene: no nodes");
+  THINLOD_RETURN_IF_ERROR(method_->accepts(budget));
+  PlannerStateImpl& state = outer.impl();
+  beginStep(state, scene, config_, viewer);
+
+  SchedulerConfig seen = config_;
+  if (!method_->predictsMotion()) {
+    seen.maxSpeed = 0.0;
+    seen.maxAngularSpeed = 0.0;
+  }
+  const PredictedRegion region = predictRegion(viewer, seen);
+  const JointBudget hard =
+      method_->honoursBudgets() ? hardBudget(budget, state, viewer, config_) : JointBudget{};
+
+  Plan plan;
+  plan.scheduler = method_->name();
+  const SelectionStep step{scene, seen, viewer, budget, region, hard, state, plan.stats};
+  Result<Selection> selected = method_->select(step);
+  if (!selected.ok()) return selected.status();
+  Selection& selection = selected.value();
+  if (!withinBudget(selection.leaves, hard)) dropUntilWithin(selection.leaves, hard);
+  plan.mode = selection.mode ? selection.mode : modeName(budget);
+  const double target = selection.targetAccuracy.value_or(lowestRenderedAccuracy(selection.leaves));
+
+  PlanContext context{scene, seen, viewer, region, state};
+  finishPlan(context, selection.leaves, target, plan);
+  plan.row.schedulingMicroseconds =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
+  return plan;
+}
+
+}  // namespace thinlod::backbone
