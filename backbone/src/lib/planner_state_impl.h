@@ -60,6 +60,11 @@ struct PlannerStateImpl {
   std::vector<std::uint32_t> lastRendered;    // objects rendered by the previous plan
   bool scannedFrontend = false;
   double lastTime = -std::numeric_limits<double>::infinity();
+  // active-set (time_critical_scheduler.cpp): the previous step's resolution
+  // per object (NaN: not rendered; the optimiser's warm start) and viewer
+  // (for apparent speeds).
+  std::vector<double> timeCriticalResolution;
+  std::optional<ViewerState> timeCriticalViewer;
 
   void clearCaches() {
     for (ResourceCache& c : cache) {
