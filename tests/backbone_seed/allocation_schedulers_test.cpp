@@ -326,7 +326,7 @@ TEST(AllocationSchedulers, AslodGivesTheSlackOfACandidateGapToTheOthers) {
   b.leaf(root, {{1.0, 0, -5.0}, 0.5}, {meshOption(1.0, 16.0, 400.0, 20000.0)});
   b.leaf(root, {{-1.0, 0, -5.0}, 0.5},
          {meshOption(4.0, 100.0, 400.0, 5000.0),
-          pointOption(RepresentationKind::kSimpleImpostor, 2.0, 2.0, 6000.0)});
+          pointOption(OptionKind::kSimpleImpostor, 2.0, 2.0, 6000.0)});
   const SchedulingScene scene = b.build();
   AslodSchedulerConfig config;
   config.hysteresisShare = 0.0;

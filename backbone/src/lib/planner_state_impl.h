@@ -63,6 +63,11 @@ struct PlannerStateImpl {
   // ASLOD hysteresis: each visible object's triangle allocation of the
   // previous step (by object; rewritten every aslod step).
   std::unordered_map<std::uint32_t, std::int64_t> aslodAllocations;
+  // active-set (time_critical_scheduler.cpp): the previous step's resolution
+  // per object (NaN: not rendered; the optimiser's warm start) and viewer
+  // (for apparent speeds).
+  std::vector<double> timeCriticalResolution;
+  std::optional<ViewerState> timeCriticalViewer;
 
   void clearCaches() {
     for (ResourceCache& c : cache) {

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "thinlod/backbone/scheduler.h"
+#include "thinlod/backbone/time_critical_scheduler.h"
 
 namespace thinlod::backbone {
 namespace {
@@ -35,6 +36,13 @@ const std::vector<CatalogueEntry>& entries() {
         false},
        [](const SchedulerOptions& o) {
          return makeSpanOfLevelChangedScheduler(o.config, o.spanOfLevelChanged);
+       }},
+      {{"active-set", "time-critical",
+        "Gobbetti-Bouvier 1999: per-object resolutions by an any-time active-set optimiser "
+        "under the polygon budget (frame-time budget: TimeCriticalConfig)",
+        false},
+       [](const SchedulerOptions& o) {
+         return makeTimeCriticalScheduler(o.config, TimeCriticalConfig{});
        }},
       {{"brute-force", "", "every combination of options (exponential; tests and benchmarks only)",
         true},

@@ -1,0 +1,261 @@
+// The "active-set" scheduler: polygon and frame-time budgets held, the
+// least visible objects dropped when even the floors do not fit, warm start
+// across steps, registry names, unsupported budgets and bad configs.
+#include "thinlod/backbone/time_critical_scheduler.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "frame_time_model.h"
+#include "scheduler_test_util.h"
+#include "thinlod/backbone/synthetic_scene.h"
+
+namespace thinlod::backbone {
+namespace {
+using namespace testing;
+
+SchedulingScene scene(std::uint64_t seed, std::size_t objects) {
+  SyntheticSceneOptions o;
+  o.seed = seed;
+  o.objects = objects;
+  o.lodShare = 0.2;
+  return makeSyntheticScene(o).value();
+}
+
+// A standing viewer: the predicted region is the viewer's position, so the
+// pixels the method estimates can be recomputed here from the geometry.
+SchedulerConfig standing() {
+  SchedulerConfig c;
+  c.maxSpeed = 0.0;
+  c.maxAngularSpeed = 0.0;
+  return c;
+}
+
+FrameCostConstants llvmpipeLike() {
+  FrameCostConstants c;
+  c.initSeconds = 5e-4;
+  c.finalSeconds = 5e-4;
+  c.setupSeconds = 2e-5;
+  c.triangleSeconds = 1.5e-7;
+  c.pixelSeconds = 2e-8;
+  return c;
+}
+
+// The modelled frame time of a plan: fixed + sum over rendered objects of
+// t_setup + max(triangles t_tri, N_pix t_pix), N_pix of the bounding sphere
+// seen from the viewer (D clamped by minimalDistance, as the method does).
+double modelledSeconds(const SchedulingScene& s, const Plan& plan, const ViewerState& viewer,
+                       const FrameCostConstants& c, const SchedulerConfig& config) {
+  std::vector<const SceneNode*> leafOf(s.objects.size(), nullptr);
+  for (const SceneNode& n : s.nodes)
+    if (n.kind == SceneNodeKind::kLeaf) leafOf[n.object] = &n;
+  const ScreenProjection screen{640.0, 480.0, viewer.verticalFov};
+  double t = c.initSeconds + c.finalSeconds;
+  for (const ObjectDecision& d : plan.decisions) {
+    if (d.action == ObjectAction::kRemove) continue;
+    const Sphere& b = leafOf[d.object]->bounds;
+    const double distance =
+        std::max(glm::length(b.center - viewer.position) - b.radius, config.minimalDistance);
+    const double pixels = projectedSpherePixels(distance + b.radius, b.radius, screen);
+    t += c.setupSeconds + std::max(d.triangles * c.triangleSeconds, pixels * c.pixelSeconds);
+  }
+  return t;
+}
+
+// Budget has no frame-time field yet and needs some budget: a polygon cap
+// that never binds.
+Budget noPolygonCap() {
+  Budget b;
+  b.maxTriangles = 1e12;
+  return b;
+}
+
+TEST(TimeCriticalScheduler, HoldsThePolygonBudgetAndUsesIt) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto scheduler = makeTimeCriticalScheduler(standing(), {}).value();
+  double used = 0.0;
+  double offered = 0.0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SchedulingScene s = scene(seed, 80);
+    PlannerState state;
+    Budget budget;
+    budget.maxTriangles = 2000.0 + 40000.0 * u(rng);
+    const ViewerState viewer = viewerAt({0.0, 0.0, 120.0}, {0.0, 0.0, -1.0});
+    auto plan = scheduler->plan(s, viewer, budget, state);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    EXPECT_STREQ(plan->mode, "polygon");
+    EXPECT_LE(plan->predictedTriangles, *budget.maxTriangles);
+    used += plan->predictedTriangles;
+    offered += *budget.maxTriangles;
+  }
+  // Candidates are discrete, so a little stays unused; most is spent.
+  EXPECT_GT(used, 0.5 * offered);
+}
+
+TEST(TimeCriticalScheduler, HoldsTheFrameTimeBudget) {
+  const FrameCostConstants costs = llvmpipeLike();
+  int dropping = 0;
+  for (double budgetMs : {2.0, 5.0, 10.0, 30.0}) {
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      SchedulingScene s = scene(seed, 120);
+      TimeCriticalConfig tc;
+      tc.frameBudgetSeconds = budgetMs * 1e-3;
+      tc.costs = costs;
+      auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
+      PlannerState state;
+      const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+      auto plan = scheduler->plan(s, viewer, noPolygonCap(), state);
+      ASSERT_TRUE(plan.ok()) << plan.status().toString();
+      EXPECT_STREQ(plan->mode, "frame-time");
+      const double t = modelledSeconds(s, *plan, viewer, costs, standing());
+      EXPECT_LE(t, *tc.frameBudgetSeconds * (1.0 + 1e-9)) << budgetMs << " ms, seed " << seed;
+      if (budgetMs >= 10.0) {
+        EXPECT_GT(t, 0.5 * *tc.frameBudgetSeconds);  // the budget is used
+      }
+      dropping += plan->dropped.empty() ? 0 : 1;
+    }
+  }
+  EXPECT_GT(dropping, 0);  // the 2 ms budget cannot hold every floor: objects are dropped
+}
+
+TEST(TimeCriticalScheduler, FrameBudgetWithABindingPolygonCapHoldsBoth) {
+  const FrameCostConstants costs = llvmpipeLike();
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    SchedulingScene s = scene(seed, 120);
+    TimeCriticalConfig tc;
+    tc.frameBudgetSeconds = 30e-3;
+    tc.costs = costs;
+    auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
+    PlannerState state;
+    Budget budget;
+    budget.maxTriangles = 20000.0;  // 3 ms of triangles: binds before 30 ms
+    const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+    auto plan = scheduler->plan(s, viewer, budget, state);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    EXPECT_LE(plan->predictedTriangles, 20000.0);
+    EXPECT_GT(plan->predictedTriangles, 10000.0);
+    EXPECT_LE(modelledSeconds(s, *plan, viewer, costs, standing()), 30e-3);
+  }
+}
+
+TEST(TimeCriticalScheduler, ImpossibleFrameBudgetDropsTheLeastVisible) {
+  SchedulingScene s = scene(5, 60);
+  TimeCriticalConfig tc;
+  tc.costs = llvmpipeLike();
+  tc.frameBudgetSeconds = 1.2e-3;  // 1 ms fixed, 0.2 ms for objects: 10 setups at most
+  auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
+  PlannerState state;
+  const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+  auto plan = scheduler->plan(s, viewer, noPolygonCap(), state);
+  ASSERT_TRUE(plan.ok());
+  EXPECT_FALSE(plan->dropped.empty());
+  EXPECT_LE(modelledSeconds(s, *plan, viewer, tc.costs, standing()), 1.2e-3 * (1.0 + 1e-9));
+  // Every kept object is at least as visible (diameter / distance) as every dropped one.
+  auto visibility = [&](std::uint32_t object) {
+    for (const SceneNode& n : s.nodes)
+      if (n.kind == SceneNodeKind::kLeaf && n.object == object)
+        return n.bounds.radius /
+               std::max(glm::length(n.bounds.center - viewer.position) - n.bounds.radius, 0.1);
+    return 0.0;
+  };
+  double worstKept = kInf;
+  for (const ObjectDecision& d : plan->decisions)
+    if (d.action != ObjectAction::kRemove) worstKept = std::min(worstKept, visibility(d.object));
+  for (std::uint32_t o : plan->dropped) EXPECT_LE(visibility(o), worstKept * (1.0 + 1e-9));
+}
+
+TEST(TimeCriticalScheduler, StandingViewerKeepsItsLoadFromStepToStep) {
+  SchedulingScene s = scene(9, 100);
+  auto scheduler = makeTimeCriticalScheduler(standing(), {}).value();
+  PlannerState state;
+  Budget budget;
+  budget.maxTriangles = 20000.0;
+  const ViewerState first = viewerAt({0.0, 0.0, 100.0}, {0.0, 0.0, -1.0}, 0.0, 0);
+  auto a = scheduler->plan(s, first, budget, state);
+  ASSERT_TRUE(a.ok());
+  applyPlan(s, *a);
+  const ViewerState second = viewerAt({0.0, 0.0, 100.0}, {0.0, 0.0, -1.0}, 0.1, 1);
+  auto b = scheduler->plan(s, second, budget, state);
+  ASSERT_TRUE(b.ok());
+  EXPECT_LE(b->predictedTriangles, *budget.maxTriangles);
+  EXPECT_NEAR(b->predictedTriangles, a->predictedTriangles, 0.02 * a->predictedTriangles);
+}
+
+TEST(TimeCriticalScheduler, AcuityFavoursTheObjectInFocus) {
+  // Two identical objects at the same distance, one straight ahead and one
+  // 40 degrees off axis: the one in focus gets more triangles.
+  SceneBuilder b;
+  const int root = b.group(-1);
+  const double d = 20.0;
+  const double off = 40.0 * kPi / 180.0;
+  b.leaf(root, Sphere{{0.0, 0.0, -d}, 1.0}, {meshOption(1.0, 20.0, 200.0, 4000.0)});
+  b.leaf(root, Sphere{{d * std::sin(off), 0.0, -d * std::cos(off)}, 1.0},
+         {meshOption(1.0, 20.0, 200.0, 4000.0)});
+  SchedulingScene s = b.build();
+  SchedulerConfig config = standing();
+  config.maxViewDistance = 1000.0;
+  auto scheduler = makeTimeCriticalScheduler(config, {}).value();
+  PlannerState state;
+  Budget budget;
+  budget.maxTriangles = 3000.0;
+  ViewerState viewer = viewerAt({0.0, 0.0, 0.0}, {0.0, 0.0, -1.0});
+  viewer.horizontalFov = 2.0;
+  auto plan = scheduler->plan(s, viewer, budget, state);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  double focus = 0.0;
+  double side = 0.0;
+  for (const ObjectDecision& dec : plan->decisions)
+    (dec.object == 0 ? focus : side) = dec.triangles;
+  EXPECT_GT(focus, 1.5 * side);
+  EXPECT_LE(focus + side, 3000.0);
+}
+
+TEST(TimeCriticalScheduler, RegisteredByNameAndAlias) {
+  for (const char* name : {"active-set", "time-critical"}) {
+    auto made = makeScheduler(name, SchedulerOptions{});
+    ASSERT_TRUE(made.ok()) << made.status().toString();
+    EXPECT_STREQ((*made)->name(), "active-set");
+  }
+}
+
+TEST(TimeCriticalScheduler, RefusesBudgetsItCannotHonour) {
+  auto polygon = makeTimeCriticalScheduler(standing(), {}).value();
+  Budget none;
+  EXPECT_EQ(polygon->accepts(none).code(), ErrorCode::kUnsupported);
+  Budget link;
+  link.maxTriangles = 100.0;
+  link.maxLinkBytesPerSecond = 1e5;
+  EXPECT_EQ(polygon->accepts(link).code(), ErrorCode::kUnsupported);
+  Budget fixed;
+  fixed.maxTriangles = 100.0;
+  fixed.fixedAccuracy = 50.0;
+  EXPECT_EQ(polygon->accepts(fixed).code(), ErrorCode::kUnsupported);
+  TimeCriticalConfig tc;
+  tc.frameBudgetSeconds = 0.01;
+  auto frame = makeTimeCriticalScheduler(standing(), tc).value();
+  EXPECT_EQ(frame->accepts(link).code(), ErrorCode::kUnsupported);
+  EXPECT_TRUE(frame->accepts(noPolygonCap()).ok());
+}
+
+TEST(TimeCriticalScheduler, RejectsBadConfigs) {
+  std::vector<TimeCriticalConfig> bad(9);
+  bad[0].frameBudgetSeconds = 0.0;
+  bad[1].frameBudgetSeconds = std::numeric_limits<double>::quiet_NaN();
+  bad[2].costs.triangleSeconds = -1.0;
+  bad[3].reserveSeconds = -1.0;
+  bad[4].viewportWidth = 0.0;
+  bad[5].exponent = 0.0;
+  bad[6].objectImportance = {1.0, std::numeric_limits<double>::infinity()};
+  bad[7].maxIterations = 0;
+  bad[8].timeBoxSeconds = -1.0;
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    auto made = makeTimeCriticalScheduler(standing(), bad[i]);
+    ASSERT_FALSE(made.ok()) << i;
+    EXPECT_EQ(made.status().code(), ErrorCode::kInvalidArgument);
+  }
+}
+
+}  // namespace
+}  // namespace thinlod::backbone
