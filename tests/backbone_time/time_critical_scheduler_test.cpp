@@ -120,6 +120,47 @@ TEST(TimeCriticalScheduler, HoldsTheFrameTimeBudget) {
   EXPECT_GT(dropping, 0);  // the 2 ms budget cannot hold every floor: objects are dropped
 }
 
+// The daemon's way: the frame time in the Budget itself (--budget-frame-ms),
+// the constants from the frontend's calibration in the config.
+TEST(TimeCriticalScheduler, HoldsTheBudgetsFrameTimeField) {
+  const FrameCostConstants costs = llvmpipeLike();
+  SchedulerOptions options;
+  options.config = standing();
+  options.timeCritical.costs = costs;
+  auto scheduler = makeScheduler("active-set", options).value();
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    SchedulingScene s = scene(seed, 120);
+    PlannerState state;
+    Budget budget;
+    budget.maxFrameSeconds = 8e-3;
+    const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+    auto plan = scheduler->plan(s, viewer, budget, state);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    EXPECT_STREQ(plan->mode, "frame-time");
+    const double t = modelledSeconds(s, *plan, viewer, costs, standing());
+    EXPECT_LE(t, *budget.maxFrameSeconds * (1.0 + 1e-9)) << "seed " << seed;
+    EXPECT_GT(t, 0.5 * *budget.maxFrameSeconds);
+  }
+}
+
+TEST(TimeCriticalScheduler, OtherMethodsRefuseAFrameTimeBudget) {
+  Budget budget;
+  budget.maxFrameSeconds = 8e-3;
+  SchedulingScene s = scene(1, 20);
+  const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+  for (const SchedulerEntry& e : schedulerCatalogue()) {
+    if (std::string(e.name) == "active-set") continue;
+    auto scheduler = makeScheduler(e.name, SchedulerOptions{}).value();
+    PlannerState state;
+    auto plan = scheduler->plan(s, viewer, budget, state);
+    ASSERT_FALSE(plan.ok()) << e.name;
+    EXPECT_EQ(plan.status().code(), ErrorCode::kUnsupported) << e.name;
+    EXPECT_NE(plan.status().message().find("frame"), std::string::npos) << e.name;
+  }
+  budget.maxFrameSeconds = -1.0;
+  EXPECT_FALSE(validateBudget(budget).ok());
+}
+
 TEST(TimeCriticalScheduler, FrameBudgetWithABindingPolygonCapHoldsBoth) {
   const FrameCostConstants costs = llvmpipeLike();
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {

@@ -62,6 +62,7 @@ std::string idText(std::uint64_t id) { return std::to_string(id); }
 backbone::SchedulerOptions schedulerOptions(const CoreOptions& o) {
   backbone::SchedulerOptions options;
   options.config = o.config;
+  options.timeCritical = o.timeCritical;
   return options;
 }
 

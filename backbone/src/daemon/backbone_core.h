@@ -63,6 +63,7 @@ struct CoreOptions {
   std::string scheduler = "accuracy-curve";  // a name of backbone::schedulerCatalogue()
   backbone::SchedulerConfig config;
   backbone::Budget budget;
+  backbone::TimeCriticalConfig timeCritical;  // active-set: the frontend's frame costs
   std::uint32_t textureSize = 256;
   protocol::TextureCodec textureCodec = protocol::TextureCodec::kPng;
   double simpleImpostorRadii = 10.0;      // usable from this many bounding radii; 0: disabled

@@ -37,6 +37,8 @@ struct Settings {
   double budgetPolygons = 0.0;
   double budgetLink = 0.0;
   double accuracy = 0.0;
+  double budgetFrameMs = 0.0;
+  std::string frameCost;
   double maxSpeed = 0.1;
   double maxAngularSpeed = 1.0;
   double lifetime = 1.0;
@@ -71,6 +73,11 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "triangles the frontend may hold (0: no polygon budget)");
   runtime.addOption("budget-link", &s.budgetLink, "link budget in bytes/s (0: unlimited)");
   runtime.addOption("accuracy", &s.accuracy, "fixed target accuracy in rad^-1 (0: maximise)");
+  runtime.addOption("budget-frame-ms", &s.budgetFrameMs,
+                    "modelled frame time at the frontend in ms (0: none; --scheduler active-set)");
+  runtime.addOption("frame-cost", &s.frameCost,
+                    "the frontend's frame-cost constants (TOML written by bench_calibrate); "
+                    "required with --budget-frame-ms");
   runtime.addOption("max-speed", &s.maxSpeed, "viewer speed bound (m/s) for prediction");
   runtime.addOption("max-angular-speed", &s.maxAngularSpeed, "viewer turn rate bound (rad/s)");
   runtime.addOption("lifetime", &s.lifetime, "planned lifetime of a representation (s)");
@@ -119,9 +126,33 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
   if (s.budgetPolygons > 0.0) o.budget.maxTriangles = s.budgetPolygons;
   if (s.budgetLink > 0.0) o.budget.maxLinkBytesPerSecond = s.budgetLink;
   if (s.accuracy > 0.0) o.budget.fixedAccuracy = s.accuracy;
-  if (!o.budget.maxTriangles && !o.budget.maxLinkBytesPerSecond && !o.budget.fixedAccuracy)
+  if (s.budgetFrameMs > 0.0) {
+    o.budget.maxFrameSeconds = s.budgetFrameMs * 1e-3;
+    if (s.frameCost.empty())
+      return Status(thinlod::ErrorCode::kInvalidArgument,
+                    "--budget-frame-ms needs --frame-cost FILE (bench_calibrate --out FILE)");
+  }
+  if (!s.frameCost.empty()) {
+    std::ifstream in(s.frameCost);
+    if (!in)
+      return Status(thinlod::ErrorCode::kNotFound, "--frame-cost " + s.frameCost + ": cannot read");
+    constexpr std::size_t kMaxFrameCostBytes = 1 << 16;  // a few lines of TOML
+    std::string text(kMaxFrameCostBytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxFrameCostBytes)
+      return Status(thinlod::ErrorCode::kResourceExhausted,
+                    "--frame-cost " + s.frameCost + ": larger than 64 KiB");
+    thinlod::Result<thinlod::FrameCostConstants> costs = thinlod::parseFrameCostToml(text);
+    if (!costs.ok())
+      return Status(costs.status().code(),
+                    "--frame-cost " + s.frameCost + ": " + costs.status().message());
+    o.timeCritical.costs = *costs;
+  }
+  if (!o.budget.maxTriangles && !o.budget.maxLinkBytesPerSecond && !o.budget.fixedAccuracy &&
+      !o.budget.maxFrameSeconds)
     return Status(thinlod::ErrorCode::kInvalidArgument,
-                  "set --budget-polygons, --budget-link and/or --accuracy");
+                  "set --budget-polygons, --budget-link, --accuracy and/or --budget-frame-ms");
   if (s.textureSize < 8 || s.textureSize > 4096 || s.curvePoints < 2 || s.curvePoints > 4096)
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--texture-size must be 8..4096 and --curve-points 2..4096");

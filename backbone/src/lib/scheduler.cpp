@@ -46,7 +46,13 @@ Scheduler::~Scheduler() = default;
 
 const char* Scheduler::name() const { return method_->name(); }
 
-Status Scheduler::accepts(const Budget& budget) const { return method_->accepts(budget); }
+Status Scheduler::accepts(const Budget& budget) const {
+  if (budget.maxFrameSeconds && !method_->modelsFrameTime())
+    return Status(ErrorCode::kUnsupported, std::string(method_->name()) +
+                                               " has no frame-cost model: a frame-time budget "
+                                               "needs active-set");
+  return method_->accepts(budget);
+}
 
 Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& viewer,
                              const Budget& budget, PlannerState& outer) const {
@@ -54,7 +60,7 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
   THINLOD_RETURN_IF_ERROR(validateViewer(viewer));
   THINLOD_RETURN_IF_ERROR(validateBudget(budget));
   if (scene.nodes.empty()) return Status(ErrorCode::kInvalidArgument, "scheduling scene: no nodes");
-  THINLOD_RETURN_IF_ERROR(method_->accepts(budget));
+  THINLOD_RETURN_IF_ERROR(accepts(budget));
   PlannerStateImpl& state = outer.impl();
   beginStep(state, scene, config_, viewer);
 

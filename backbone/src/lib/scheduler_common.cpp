@@ -10,9 +10,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 Status validateBudget(const Budget& budget) {
-  if (!budget.maxTriangles && !budget.maxLinkBytesPerSecond && !budget.fixedAccuracy)
+  if (!budget.maxTriangles && !budget.maxLinkBytesPerSecond && !budget.fixedAccuracy &&
+      !budget.maxFrameSeconds)
     return Status(ErrorCode::kInvalidArgument,
-                  "Budget: set maxTriangles, maxLinkBytesPerSecond and/or fixedAccuracy");
+                  "Budget: set maxTriangles, maxLinkBytesPerSecond, fixedAccuracy and/or "
+                  "maxFrameSeconds");
+  if (budget.maxFrameSeconds &&
+      !(std::isfinite(*budget.maxFrameSeconds) && *budget.maxFrameSeconds > 0))
+    return Status(ErrorCode::kInvalidArgument, "Budget.maxFrameSeconds must be finite and > 0");
   if (budget.maxTriangles && !(std::isfinite(*budget.maxTriangles) && *budget.maxTriangles >= 0))
     return Status(ErrorCode::kInvalidArgument, "Budget.maxTriangles must be finite and >= 0");
   if (budget.maxLinkBytesPerSecond &&

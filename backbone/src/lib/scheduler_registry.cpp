@@ -39,10 +39,10 @@ const std::vector<CatalogueEntry>& entries() {
        }},
       {{"active-set", "time-critical",
         "Gobbetti-Bouvier 1999: per-object resolutions by an any-time active-set optimiser "
-        "under the polygon budget (frame-time budget: TimeCriticalConfig)",
+        "under the polygon or the frame-time budget",
         false},
        [](const SchedulerOptions& o) {
-         return makeTimeCriticalScheduler(o.config, TimeCriticalConfig{});
+         return makeTimeCriticalScheduler(o.config, o.timeCritical);
        }},
       {{"brute-force", "", "every combination of options (exponential; tests and benchmarks only)",
         true},

@@ -57,6 +57,9 @@ class SelectionMethod {
   // false: the method ignores budgets by definition (VRML97 static LOD) and
   // the frame does not cap it.
   virtual bool honoursBudgets() const { return true; }
+  // true: the method has a frame-cost model and takes Budget::maxFrameSeconds
+  // (the frame refuses a frame-time budget for the others).
+  virtual bool modelsFrameTime() const { return false; }
   virtual Result<Selection> select(const SelectionStep& step) const = 0;
 };
 

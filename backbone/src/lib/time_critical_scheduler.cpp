@@ -53,20 +53,24 @@ class TimeCriticalMethod final : public SelectionMethod {
  public:
   explicit TimeCriticalMethod(const TimeCriticalConfig& config) : config_(config) {}
   const char* name() const override { return "active-set"; }
+  bool modelsFrameTime() const override { return true; }
   Status accepts(const Budget& budget) const override {
     if (budget.maxLinkBytesPerSecond || budget.fixedAccuracy)
       return Status(ErrorCode::kUnsupported,
                     "active-set schedules a frame-time or polygon budget only (no link budget, "
                     "no fixed accuracy)");
-    if (!config_.frameBudgetSeconds && !budget.maxTriangles)
-      return Status(
-          ErrorCode::kUnsupported,
-          "active-set needs Budget.maxTriangles or TimeCriticalConfig.frameBudgetSeconds");
+    if (!frameBudget(budget) && !budget.maxTriangles)
+      return Status(ErrorCode::kUnsupported,
+                    "active-set needs a polygon budget or a frame-time budget");
     return Status::okStatus();
   }
   Result<Selection> select(const SelectionStep& step) const override;
 
  private:
+  // The budget's frame time first, else the config's (tests).
+  std::optional<double> frameBudget(const Budget& budget) const {
+    return budget.maxFrameSeconds ? budget.maxFrameSeconds : config_.frameBudgetSeconds;
+  }
   double acuity(const SelectionStep& step, const Sphere& bounds) const;
   TimeCriticalConfig config_;
 };
@@ -92,9 +96,10 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
   PlannerStateImpl& state = step.state;
   const VisibleTree tree = buildVisibleTree(scene, step.config, step.region, state, step.stats);
   Selection selection;
-  selection.mode = config_.frameBudgetSeconds ? "frame-time" : "polygon";
+  const std::optional<double> frameSeconds = frameBudget(step.budget);
+  selection.mode = frameSeconds ? "frame-time" : "polygon";
   std::vector<LeafSelection>& out = selection.leaves;
-  const bool frameMode = config_.frameBudgetSeconds.has_value();
+  const bool frameMode = frameSeconds.has_value();
   FrameCostConstants costs = config_.costs;
   if (!frameMode) {  // polygon budget: t_tri = 1, everything else 0
     costs = FrameCostConstants{};
@@ -166,8 +171,7 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
   // The budget for sum c_i r_i, and the objects it can hold at their floors.
   double available = 0.0;
   if (frameMode) {
-    available = *config_.frameBudgetSeconds - costs.initSeconds - costs.finalSeconds -
-                config_.reserveSeconds;
+    available = *frameSeconds - costs.initSeconds - costs.finalSeconds - config_.reserveSeconds;
   } else {
     available = step.hard.useTriangles ? step.hard.triangles : *step.budget.maxTriangles;
   }

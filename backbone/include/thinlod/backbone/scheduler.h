@@ -33,6 +33,7 @@
 #include "thinlod/backbone/allocation_schedulers.h"
 #include "thinlod/backbone/decision_row.h"
 #include "thinlod/backbone/pipeline.h"
+#include "thinlod/backbone/time_critical_config.h"
 
 namespace thinlod::backbone {
 
@@ -40,6 +41,10 @@ struct Budget {
   std::optional<double> maxTriangles;
   std::optional<double> maxLinkBytesPerSecond;
   std::optional<double> fixedAccuracy;  // rad^-1
+  // The modelled frame time at the frontend (seconds; Gobbetti-Bouvier). Only
+  // methods with a frame-cost model take it (active-set); others answer
+  // kUnsupported.
+  std::optional<double> maxFrameSeconds;
 };
 Status validateBudget(const Budget& budget);
 
@@ -214,6 +219,7 @@ struct SchedulerOptions {
   BruteForceConfig bruteForce;
   AslodSchedulerConfig aslod;
   SpanOfLevelChangedConfig spanOfLevelChanged;
+  TimeCriticalConfig timeCritical;
 };
 
 struct SchedulerEntry {

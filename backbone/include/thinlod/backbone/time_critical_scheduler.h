@@ -15,11 +15,10 @@
 //   The leaf then gets the most accurate candidate with at most r_i * T_max
 //   triangles, so the modelled frame time (or the triangle count) stays
 //   within the budget.
-// - Budgets: frame-time mode when TimeCriticalConfig::frameBudgetSeconds is
-//   set; Budget::maxTriangles is then an extra polygon cap (exact: both
-//   constraints are parallel, the tighter binds; Budget has no frame-time
-//   field yet and validateBudget needs one budget, so pass a large cap).
-//   Otherwise polygon mode: Budget::maxTriangles is required. Link budgets
+// - Budgets: frame-time mode when Budget::maxFrameSeconds (or, for tests,
+//   TimeCriticalConfig::frameBudgetSeconds) is set; Budget::maxTriangles is
+//   then an extra polygon cap (exact: both constraints are parallel, the
+//   tighter binds). Otherwise polygon mode: Budget::maxTriangles is required. Link budgets
 //   and fixed accuracies are kUnsupported. When even the floors do not fit, the least visible
 //   objects are dropped (Plan::dropped) until they do.
 // - Warm start: the previous step's resolutions (kept in the PlannerState).
@@ -31,27 +30,9 @@
 #include <vector>
 
 #include "thinlod/backbone/scheduler.h"
-#include "thinlod/common/frame_cost.h"
+#include "thinlod/backbone/time_critical_config.h"
 
 namespace thinlod::backbone {
-
-struct TimeCriticalConfig {
-  std::optional<double> frameBudgetSeconds;  // set: frame-time mode
-  FrameCostConstants costs;                  // frame-time mode: the calibrated constants
-  double reserveSeconds = 0.0;   // fixed worst-case allowance for the system (paper 4.1)
-  double viewportWidth = 640.0;  // pixels, for N_pix
-  double viewportHeight = 480.0;
-  double exponent = 1.0;  // k of the degradation s_i w_i / r_i^k
-  // Reddy acuity from eccentricity and apparent speed; angles on screen are
-  // converted to visual degrees by this factor (physical field of view of
-  // the display / rendering field of view; 1 = the display fills the view).
-  bool useAcuity = true;
-  double visualDegreesPerViewDegree = 1.0;
-  std::vector<double> objectImportance;  // w_s by object index; missing entries are 1
-  int maxIterations = 10000;             // optimiser iteration cap per step
-  double timeBoxSeconds = 0.005;         // optimiser time box per step (any-time)
-};
-Status validateTimeCriticalConfig(const TimeCriticalConfig& config);
 
 // Registered as "active-set" (alias "time-critical") in the catalogue with a
 // default TimeCriticalConfig (polygon mode).

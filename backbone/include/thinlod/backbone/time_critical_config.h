@@ -1,0 +1,32 @@
+// Options of the time-critical (Gobbetti-Bouvier) scheduler, apart from its
+// factory so SchedulerOptions can hold them (time_critical_scheduler.h has
+// the contract).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "thinlod/common/frame_cost.h"
+#include "thinlod/common/status.h"
+
+namespace thinlod::backbone {
+
+struct TimeCriticalConfig {
+  std::optional<double> frameBudgetSeconds;  // set: frame-time mode
+  FrameCostConstants costs;                  // frame-time mode: the calibrated constants
+  double reserveSeconds = 0.0;   // fixed worst-case allowance for the system (paper 4.1)
+  double viewportWidth = 640.0;  // pixels, for N_pix
+  double viewportHeight = 480.0;
+  double exponent = 1.0;  // k of the degradation s_i w_i / r_i^k
+  // Reddy acuity from eccentricity and apparent speed; angles on screen are
+  // converted to visual degrees by this factor (physical field of view of
+  // the display / rendering field of view; 1 = the display fills the view).
+  bool useAcuity = true;
+  double visualDegreesPerViewDegree = 1.0;
+  std::vector<double> objectImportance;  // w_s by object index; missing entries are 1
+  int maxIterations = 10000;             // optimiser iteration cap per step
+  double timeBoxSeconds = 0.005;         // optimiser time box per step (any-time)
+};
+Status validateTimeCriticalConfig(const TimeCriticalConfig& config);
+
+}  // namespace thinlod::backbone
