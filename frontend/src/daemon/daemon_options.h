@@ -30,6 +30,8 @@ struct DaemonOptions {
   std::string framesDir;
   int dumpEvery = 10;
   bool noReference = false;
+  bool deferredReference = false;  // keep shown frames, score after the replay
+  std::int64_t deferredReferenceMaxMb = 4096;
   std::int64_t frames = 0;  // 0 = the whole trace
   std::string label;
   int connectTimeoutMs = 10000;
