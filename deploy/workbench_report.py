@@ -260,23 +260,20 @@ def write_page(out_dir, settings, metrics, metas, rows_by_run, plots):
             parts.append(f"<img class=\"plot\" alt=\"SNR per frame, {e(case)}\" "
                          f"src=\"{data_uri(plots[case])}\">")
         if frame is not None:
-            ref = os.path.join(run_dirs[0], "frames", f"reference_{frame:04d}.png")
-            parts.append(f"<p>Frame {frame}: what each scheduler showed, the full-quality "
-                         f"reference of the same pose, and their difference.</p>")
-            parts.append("<div class=\"row\"><figure><img alt=\"reference\" src=\""
-                         f"{data_uri(ref)}\"><figcaption>reference, frame {frame}</figcaption>"
-                         "</figure></div>")
+            parts.append(f"<p>Frame {frame} (the same pose in every run): what each scheduler "
+                         f"showed, the full-quality reference of that pose, their difference.</p>")
             for r, d in zip(runs, run_dirs):
                 row = next((x for x in rows_by_run[r["name"]] if x["frame"] == str(frame)), {})
                 caption = (f"{r['scheduler']}: SNR {e(row.get('snr_db', '-') or '-')} dB, "
                            f"{e(row.get('polygons', '-'))} triangles, "
-                           f"{e(row.get('missing_objects', '-') or '-')} objects missing")
+                           f"{e(row.get('missing_objects', '-') or '-')} visible objects missing")
                 figs = []
-                for kind in ("frame", "difference"):
+                for kind in ("frame", "reference", "difference"):
                     p = os.path.join(d, "frames", f"{kind}_{frame:04d}.png")
                     if os.path.exists(p):
-                        figs.append(f"<figure><img alt=\"{kind}\" src=\"{data_uri(p)}\">"
-                                    f"<figcaption>{e(r['name'])}: {kind}</figcaption></figure>")
+                        figs.append(f"<figure><img alt=\"{e(r['name'])} {kind}\" "
+                                    f"src=\"{data_uri(p)}\"><figcaption>{e(r['name'])}: {kind}"
+                                    f"</figcaption></figure>")
                 parts.append(f"<p>{caption}</p><div class=\"row\">{''.join(figs)}</div>")
         sections.append("\n".join(parts))
     run_settings = "".join(
@@ -306,6 +303,7 @@ The best median SNR of each case is highlighted.</p>
 {''.join(sections)}
 <h2>Settings of every run</h2>
 <table><tr><th>run</th><th>backbone</th><th>frontend</th><th>wall s</th></tr>{run_settings}</table>
+{IMAGE_CHECK}
 </body></html>
 """
     path = os.path.join(out_dir, "index.html")
@@ -313,6 +311,15 @@ The best median SNR of each case is highlighted.</p>
         f.write(page)
     return path
 
+
+# Reports every image that did not decode on the console, where the page test looks.
+IMAGE_CHECK = """<script>
+window.addEventListener("load", () => {
+  for (const img of document.images) {
+    if (!img.complete || img.naturalWidth === 0) console.error("image failed: " + img.alt);
+  }
+});
+</script>"""
 
 MODE_TEXT = {
     "live": "the frontend was paced at each trace's own timing and never waited; each shown frame "
