@@ -206,7 +206,7 @@ def plot_case(out_dir, case, runs):
     script = f"""
 set terminal pngcairo size 900,420 noenhanced
 set output '{png}'
-set title '{case}: SNR of each shown frame against its own pose (infinities at {lo:g} / {hi:g})'
+set title '{case}: SNR of each shown frame against its own pose (values beyond [{lo:g}, {hi:g}] and infinities drawn at the edges)'
 set xlabel 'frame'
 set ylabel 'SNR (dB)'
 set yrange [{lo}:{hi}]
