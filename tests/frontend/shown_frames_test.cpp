@@ -1,13 +1,13 @@
 // Live scoring (shown_frames.h): a shown frame is scored against the
 // reference of the pose it was drawn for, whatever it shows and whenever it
-// was shown; memory bound, visibility, completeness, blank frames.
+// was shown; memory bound, coverage, completeness, blank frames.
 #include "thinlod/frontend/shown_frames.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <glm/gtc/matrix_transform.hpp>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "thinlod/frontend/frame_metrics.h"
@@ -46,17 +46,18 @@ RgbaImage pictureOf(const Pose& pose) {
 
 class FakeReferences final : public ReferenceSource {
  public:
-  Result<double> render(const Pose& pose, RgbaImage& out, glm::mat4& viewProjection) override {
+  Result<double> render(const Pose& pose, RgbaImage& out,
+                        std::vector<std::uint32_t>& covered) override {
     if (failAtTime && pose.time == *failAtTime) return Status(ErrorCode::kInternal, "GL lost");
     asked.push_back(pose.time);
     out = uniform ? RgbaImage(kW, kH) : pictureOf(pose);
-    viewProjection = camera;
+    covered = coverage;
     return 7.5;
   }
   std::vector<double> asked;
   std::optional<double> failAtTime;
   bool uniform = false;
-  glm::mat4 camera{1.0f};
+  std::vector<std::uint32_t> coverage;  // empty: not measured
 };
 
 HeldObjects held(std::vector<std::uint64_t> ids) {
@@ -74,7 +75,7 @@ TEST(ShownFrames, AFrameShownLateIsScoredAgainstThePoseItWasDrawnFor) {
   // representations): scored against p2, it is not perfect.
   ASSERT_TRUE(log.record(2, p2, 260 * kMs, pictureOf(p1), nullptr));
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {});
+  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok()) << scores.status().toString();
   ASSERT_EQ(scores->size(), 3u);
   EXPECT_EQ(references.asked, (std::vector<double>{0.0, 0.1, 0.2}));
@@ -102,7 +103,7 @@ TEST(ShownFrames, TheSinkSeesEachShownFrameWithItsOwnReference) {
     EXPECT_EQ(score.frame, shown.frame);
     referenceIsOwnPose.push_back(reference.pixels == pictureOf(shown.pose).pixels);
   };
-  ASSERT_TRUE(scoreShownFrames(log.frames(), references, {}, sink).ok());
+  ASSERT_TRUE(scoreShownFrames(log.frames(), references, {}, 16, sink).ok());
   EXPECT_EQ(frames, (std::vector<std::uint64_t>{7, 8}));
   EXPECT_EQ(referenceIsOwnPose, (std::vector<bool>{true, true}));
 }
@@ -127,7 +128,7 @@ TEST(ShownFrames, AReferenceFailureNamesTheFrame) {
   log.record(5, poseAt(0.3, 1.0f), 0, pictureOf(poseAt(0.3, 1.0f)), nullptr);
   FakeReferences references;
   references.failAtTime = 0.3;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {});
+  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_FALSE(scores.ok());
   EXPECT_EQ(scores.status().code(), ErrorCode::kInternal);
   EXPECT_NE(scores.status().message().find("shown frame 5"), std::string::npos)
@@ -138,7 +139,7 @@ TEST(ShownFrames, AShownFrameOfADifferentSizeIsAnError) {
   ShownFrameLog log(std::size_t{1} << 20);
   log.record(3, poseAt(0.0, 1.0f), 0, RgbaImage(kW + 1, kH), nullptr);
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {});
+  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_FALSE(scores.ok());
   EXPECT_EQ(scores.status().code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(scores.status().message().find("frame 3"), std::string::npos);
@@ -148,53 +149,71 @@ TEST(ShownFrames, AUniformFrameIsBlankOnlyWhenTheReferenceIsNot) {
   ShownFrameLog log(std::size_t{1} << 20);
   log.record(0, poseAt(0.0, 1.0f), 0, RgbaImage(kW, kH), nullptr);  // all black
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {});
+  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok());
   EXPECT_TRUE((*scores)[0].blank);
   EXPECT_TRUE(std::isinf((*scores)[0].snrDb) && (*scores)[0].snrDb < 0);
   references.uniform = true;  // nothing in view: a black frame is right
-  scores = scoreShownFrames(log.frames(), references, {});
+  scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok());
   EXPECT_FALSE((*scores)[0].blank);
   EXPECT_EQ((*scores)[0].snrDb, 0.0);
 }
 
-glm::mat4 lookingDownMinusZ() {
-  const glm::mat4 view =
-      glm::lookAt(glm::vec3(0.0f), glm::vec3(0.0f, 0.0f, -1.0f), glm::vec3(0.0f, 1.0f, 0.0f));
-  return glm::perspective(glm::radians(60.0f), 4.0f / 3.0f, 0.1f, 100.0f) * view;
+TEST(ShownFrames, CoverageColoursRoundTripThroughAnRgba8Image) {
+  const std::vector<std::size_t> indices = {0, 1, 254, 255, 256, 70000};
+  RgbaImage ids(8, 1);  // pixel 7 stays background
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    const glm::vec4 c = coverageColor(indices[k]);
+    for (int channel = 0; channel < 4; ++channel) {
+      // What an RGBA8 target stores for a float colour.
+      ids.at(static_cast<int>(k), 0)[channel] =
+          static_cast<std::uint8_t>(std::lround(c[channel] * 255.0f));
+    }
+  }
+  ids.at(6, 0)[0] = 2;  // a second pixel of index 1
+  Result<std::vector<std::uint32_t>> covered = coverageFromIdImage(ids, 70001);
+  ASSERT_TRUE(covered.ok()) << covered.status().toString();
+  EXPECT_EQ((*covered)[0], 1u);
+  EXPECT_EQ((*covered)[1], 2u);
+  EXPECT_EQ((*covered)[254], 1u);
+  EXPECT_EQ((*covered)[255], 1u);
+  EXPECT_EQ((*covered)[256], 1u);
+  EXPECT_EQ((*covered)[70000], 1u);
+  EXPECT_EQ((*covered)[2], 0u);
+  // A colour naming no object is an error, not a silent miscount.
+  EXPECT_EQ(coverageFromIdImage(ids, 300).status().code(), ErrorCode::kInvalidArgument);
 }
 
-TEST(ShownFrames, BoxesOutsideOneClipPlaneAreNotVisible) {
-  const glm::mat4 vp = lookingDownMinusZ();
-  EXPECT_TRUE(boxMayBeVisible({-1, -1, -6}, {1, 1, -4}, vp));       // ahead
-  EXPECT_FALSE(boxMayBeVisible({-1, -1, 4}, {1, 1, 6}, vp));        // behind
-  EXPECT_FALSE(boxMayBeVisible({50, -1, -6}, {52, 1, -4}, vp));     // far right
-  EXPECT_FALSE(boxMayBeVisible({-1, -1, -300}, {1, 1, -200}, vp));  // beyond the far plane
-  EXPECT_TRUE(boxMayBeVisible({-100, -1, -6}, {100, 1, -4}, vp));   // spans the view
-  EXPECT_TRUE(boxMayBeVisible({-1, -1, -1}, {1, 1, 1}, vp));        // around the eye
-}
-
-TEST(ShownFrames, CompletenessCountsVisibleGroupsWithNothingHeld) {
-  const glm::mat4 vp = lookingDownMinusZ();
-  std::vector<ObjectExtent> objects = {
-      {1, 1, {-1, -1, -6}, {1, 1, -4}},   // visible, held
-      {2, 2, {2, -1, -10}, {3, 1, -9}},   // visible, not held
-      {3, 100, {-1, 2, -8}, {1, 3, -7}},  // LOD group 100, level 0: visible, not held
-      {4, 100, {-1, 2, -8}, {1, 3, -7}},  // LOD group 100, level 1: held
-      {5, 5, {-1, -1, 4}, {1, 1, 6}},     // behind: not visible, not held
+TEST(ShownFrames, CompletenessCountsCoveredGroupsWithNothingHeld) {
+  const std::vector<ObjectExtent> objects = {
+      {1, 1},    // 500 pixels, held
+      {2, 2},    // 40 pixels, not held
+      {3, 100},  // LOD group 100, level 0: 30 pixels, not held
+      {4, 100},  // LOD group 100, level 1: not drawn in the reference, held
+      {5, 5},    // hidden (0 pixels), not held
+      {6, 6},    // 10 pixels: below the threshold of 16
   };
-  const Completeness c = frameCompleteness(objects, {1, 4}, vp);
-  EXPECT_EQ(c.visibleGroups, 3u);
-  EXPECT_EQ(c.missingGroups, 1u);
-  const Completeness none = frameCompleteness(objects, {}, vp);
-  EXPECT_EQ(none.visibleGroups, 3u);
-  EXPECT_EQ(none.missingGroups, 3u);
+  const std::vector<std::uint32_t> covered = {500, 40, 30, 0, 0, 10};
+  Result<Completeness> c = frameCompleteness(objects, covered, {1, 4}, 16);
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ(c->visibleGroups, 3u);  // 1, 2, 100
+  EXPECT_EQ(c->missingGroups, 1u);  // 2
+  Result<Completeness> none = frameCompleteness(objects, covered, {}, 16);
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->missingGroups, 3u);
+  Result<Completeness> tiny = frameCompleteness(objects, covered, {}, 1);
+  ASSERT_TRUE(tiny.ok());
+  EXPECT_EQ(tiny->visibleGroups, 4u);  // the 10-pixel object counts too
+  EXPECT_EQ(frameCompleteness(objects, {1, 2}, {}, 16).status().code(),
+            ErrorCode::kInvalidArgument);
+
   ShownFrameLog log(std::size_t{1} << 20);
   log.record(0, poseAt(0.0, 1.0f), 0, pictureOf(poseAt(0.0, 1.0f)), held({1, 2, 4}));
   FakeReferences references;
-  references.camera = vp;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, objects);
+  references.coverage = covered;
+  Result<std::vector<ShownFrameScore>> scores =
+      scoreShownFrames(log.frames(), references, objects, 16);
   ASSERT_TRUE(scores.ok());
   EXPECT_EQ((*scores)[0].completeness.visibleGroups, 3u);
   EXPECT_EQ((*scores)[0].completeness.missingGroups, 0u);

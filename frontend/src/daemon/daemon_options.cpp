@@ -48,6 +48,9 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("deferred-reference-max-mb", &o->deferredReferenceMaxMb,
                     "memory for the kept frames, MiB (frames beyond it are not scored and are "
                     "counted as frames_not_kept)");
+  runtime.addOption("visible-min-pixels", &o->visibleMinPixels,
+                    "completeness: an object group counts as visible when it covers at least this "
+                    "many pixels of the reference (occlusion included)");
   runtime.addOption("frames", &o->frames,
                     "stop after N frames; 0 = the whole trace (or until the pose stream ends)");
   runtime.addOption("label", &o->label, "run name written into the summary");
@@ -89,6 +92,7 @@ Status validateOptions(const DaemonOptions& o) {
   if (o.deferredReferenceMaxMb < 1 || o.deferredReferenceMaxMb > (std::int64_t{1} << 30)) {
     return invalid("deferred-reference-max-mb", "outside 1..2^30");
   }
+  if (o.visibleMinPixels < 1) return invalid("visible-min-pixels", "must be at least 1");
   if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");
   if (o.frames < 0) return invalid("frames", "negative");
   if (o.connectTimeoutMs < 0) return invalid("connect-timeout-ms", "negative");

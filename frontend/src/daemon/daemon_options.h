@@ -32,7 +32,8 @@ struct DaemonOptions {
   bool noReference = false;
   bool deferredReference = false;  // keep shown frames, score after the replay
   std::int64_t deferredReferenceMaxMb = 4096;
-  std::int64_t frames = 0;  // 0 = the whole trace
+  int visibleMinPixels = 16;  // completeness: pixels an object group must cover
+  std::int64_t frames = 0;    // 0 = the whole trace
   std::string label;
   int connectTimeoutMs = 10000;
   protocol::TransportOptions transport;

@@ -23,6 +23,20 @@ Result<std::unique_ptr<GlFrameProducer>> GlFrameProducer::create(
   // Opaque first in scene order, blended ones after (sorted per frame).
   std::stable_partition(producer->reference_.begin(), producer->reference_.end(),
                         [](const ReferenceItem& item) { return !item.blended; });
+  if (!producer->extents_.empty()) {
+    for (const ReferenceItem& item : producer->reference_) {
+      if (item.extent >= producer->extents_.size()) {
+        return Status(ErrorCode::kInvalidArgument, "reference item names no object extent");
+      }
+      ReferenceObject flat;
+      flat.mesh = item.object.mesh;
+      flat.transform = item.object.transform;
+      flat.material.diffuse = coverageColor(item.extent);
+      flat.material.lit = false;
+      flat.material.doubleSided = item.object.material.doubleSided;
+      producer->coverageList_.push_back(std::move(flat));
+    }
+  }
 
   Result<std::unique_ptr<render::OffscreenContext>> context =
       render::createOffscreenContext(options.backend, options.width, options.height);
@@ -85,10 +99,10 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   return produced;
 }
 
-Result<double> GlFrameProducer::renderReference(const Pose& pose, glm::mat4& viewProjection) {
+Result<double> GlFrameProducer::renderReference(const Pose& pose,
+                                                std::vector<std::uint32_t>& covered) {
   Result<render::Camera> camera = cameraFromPose(pose, options_.width, options_.height);
   if (!camera.ok()) return camera.status();
-  viewProjection = camera->projection * camera->view;
   drawList_.clear();
   for (const ReferenceItem& item : reference_) drawList_.push_back(item.object);
   const auto firstBlended =
@@ -109,6 +123,18 @@ Result<double> GlFrameProducer::renderReference(const Pose& pose, glm::mat4& vie
   Result<ReferenceReport> report =
       referenceRenderer_->render(drawList_, *camera, lighting_, referenceFrame_);
   if (!report.ok()) return report.status();
+  covered.clear();
+  if (!coverageList_.empty()) {
+    // Which objects the reference shows, and how much of each (depth-tested,
+    // so occluded objects cover nothing). Not included in the reference's time.
+    Result<ReferenceReport> ids =
+        referenceRenderer_->render(coverageList_, *camera, lighting_, coverageFrame_);
+    if (!ids.ok()) return ids.status();
+    Result<std::vector<std::uint32_t>> counts =
+        coverageFromIdImage(coverageFrame_, extents_.size());
+    if (!counts.ok()) return counts.status();
+    covered = std::move(counts).value();
+  }
   return report->renderMs;
 }
 
@@ -128,8 +154,7 @@ HeldObjects GlFrameProducer::heldNow() {
 }
 
 Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& pose) {
-  glm::mat4 viewProjection(1.0f);
-  Result<double> renderMs = renderReference(pose, viewProjection);
+  Result<double> renderMs = renderReference(pose, covered_);
   if (!renderMs.ok()) {
     return Status(renderMs.status().code(),
                   "reference frame " + std::to_string(frame) + ": " + renderMs.status().message());
@@ -140,9 +165,13 @@ Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& p
   quality.snrDb = comparison->snrDb;
   quality.psnrDb = comparison->psnrDb;
   quality.referenceMs = *renderMs;
-  const Completeness completeness = frameCompleteness(extents_, *heldNow(), viewProjection);
-  quality.visibleObjects = static_cast<long>(completeness.visibleGroups);
-  quality.missingObjects = static_cast<long>(completeness.missingGroups);
+  if (!covered_.empty()) {
+    Result<Completeness> completeness =
+        frameCompleteness(extents_, covered_, *heldNow(), options_.visibleMinPixels);
+    if (!completeness.ok()) return completeness.status();
+    quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
+    quality.missingObjects = static_cast<long>(completeness->missingGroups);
+  }
   // Uniform shown frame, non-uniform reference (as scoreShownFrames defines it).
   Result<FrameComparison> referenceAlone = compareFrames(referenceFrame_, referenceFrame_);
   quality.blank =
@@ -158,8 +187,9 @@ bool GlFrameProducer::keepShown(std::uint64_t frame, const Pose& pose, std::int6
 class GlFrameProducer::References final : public ReferenceSource {
  public:
   explicit References(GlFrameProducer& producer) : producer_(producer) {}
-  Result<double> render(const Pose& pose, RgbaImage& out, glm::mat4& viewProjection) override {
-    Result<double> ms = producer_.renderReference(pose, viewProjection);
+  Result<double> render(const Pose& pose, RgbaImage& out,
+                        std::vector<std::uint32_t>& covered) override {
+    Result<double> ms = producer_.renderReference(pose, covered);
     if (ms.ok()) out = producer_.referenceFrame_;
     return ms;
   }
@@ -177,7 +207,7 @@ Result<std::vector<KeptFrameQuality>> GlFrameProducer::scoreKept() {
     scoredSink_(shown.frame);
   };
   Result<std::vector<ShownFrameScore>> scores =
-      scoreShownFrames(kept_.frames(), references, extents_, sink);
+      scoreShownFrames(kept_.frames(), references, extents_, options_.visibleMinPixels, sink);
   if (!scores.ok()) return scores.status();
   std::vector<KeptFrameQuality> out;
   out.reserve(scores->size());
@@ -187,8 +217,10 @@ Result<std::vector<KeptFrameQuality>> GlFrameProducer::scoreKept() {
     kept.quality.snrDb = score.snrDb;
     kept.quality.psnrDb = score.psnrDb;
     kept.quality.referenceMs = score.referenceMs;
-    kept.quality.visibleObjects = static_cast<long>(score.completeness.visibleGroups);
-    kept.quality.missingObjects = static_cast<long>(score.completeness.missingGroups);
+    if (!extents_.empty()) {
+      kept.quality.visibleObjects = static_cast<long>(score.completeness.visibleGroups);
+      kept.quality.missingObjects = static_cast<long>(score.completeness.missingGroups);
+    }
     kept.quality.blank = score.blank ? 1 : 0;
     out.push_back(kept);
   }

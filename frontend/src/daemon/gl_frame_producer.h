@@ -29,6 +29,8 @@ struct GlProducerOptions {
   render::Backend backend = render::Backend::kAuto;
   std::size_t uploadBytesPerFrame = FrontendRendererOptions{}.uploadBytesPerFrame;
   std::size_t maxKeptBytes = std::size_t{4} << 30;  // deferred measurement: pixels kept
+  std::uint32_t visibleMinPixels =
+      16;  // completeness: an object group covering fewer is not visible
 };
 
 class GlFrameProducer final : public FrameProducer {
@@ -60,8 +62,9 @@ class GlFrameProducer final : public FrameProducer {
  private:
   GlFrameProducer() : kept_(0) {}
   class References;
-  // The full-quality frame of `pose` into referenceFrame_.
-  Result<double> renderReference(const Pose& pose, glm::mat4& viewProjection);
+  // The full-quality frame of `pose` into referenceFrame_ and, with extents,
+  // the pixels each object covers in it (a flat-colour id pass) into `covered`.
+  Result<double> renderReference(const Pose& pose, std::vector<std::uint32_t>& covered);
   HeldObjects heldNow();
 
   GlProducerOptions options_;
@@ -69,6 +72,9 @@ class GlFrameProducer final : public FrameProducer {
   std::vector<ReferenceItem> reference_;
   std::vector<ReferenceObject> drawList_;  // reused each measure()
   std::vector<ObjectExtent> extents_;
+  std::vector<ReferenceObject> coverageList_;  // the reference in coverage colours, unlit
+  RgbaImage coverageFrame_;
+  std::vector<std::uint32_t> covered_;
   ShownFrameLog kept_;
   HeldObjects held_;
   std::uint64_t heldPlan_ = 0;

@@ -223,6 +223,7 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
                                       : static_cast<std::size_t>(options.maxUploadBytesPerFrame);
   const render::Lighting lighting = scene ? scene->lighting : render::Lighting{};
   glOptions.maxKeptBytes = static_cast<std::size_t>(options.deferredReferenceMaxMb) << 20;
+  glOptions.visibleMinPixels = static_cast<std::uint32_t>(options.visibleMinPixels);
   std::vector<ReferenceItem> reference;
   std::vector<ObjectExtent> extents;
   if (scene && !options.noReference) {

@@ -48,8 +48,6 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     extent.id = object.id;
     extent.group =
         outermostLod >= 0 ? lodGroupBase + static_cast<std::uint64_t>(outermostLod) : object.id;
-    extent.worldMin = object.worldBounds.min;
-    extent.worldMax = object.worldBounds.max;
     loaded.extents.push_back(extent);
     if (laterLevel) {
       ++loaded.laterLodLevelObjects;
@@ -66,6 +64,7 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     item.object.transform = object.objectToWorld;
     item.worldCentre = object.worldBounds.center();
     item.blended = material.alphaMode == render::AlphaMode::kBlend;
+    item.extent = loaded.extents.size() - 1;
     loaded.referenceTriangles += object.fullMesh != nullptr ? object.fullMesh->triangleCount() : 0;
     loaded.reference.push_back(std::move(item));
   }

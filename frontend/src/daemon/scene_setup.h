@@ -30,6 +30,7 @@ struct ReferenceItem {
   ReferenceObject object;
   glm::vec3 worldCentre{0.0f};  // for back-to-front order of blended materials
   bool blended = false;
+  std::size_t extent = 0;  // index into LoadedScene::extents (coverage colour)
 };
 
 struct LoadedScene {

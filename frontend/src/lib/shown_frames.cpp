@@ -1,8 +1,8 @@
 #include "thinlod/frontend/shown_frames.h"
 
 #include <algorithm>
-#include <glm/vec4.hpp>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 
@@ -22,37 +22,56 @@ bool uniformRgb(const RgbaImage& image) {
 
 }  // namespace
 
-bool boxMayBeVisible(const glm::vec3& lo, const glm::vec3& hi, const glm::mat4& viewProjection) {
-  // Per clip plane (-w <= x, y, z <= w), count the corners outside it.
-  int outside[6] = {0, 0, 0, 0, 0, 0};
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::vec4 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y,
-                      (corner & 4) ? hi.z : lo.z, 1.0f);
-    const glm::vec4 c = viewProjection * p;
-    outside[0] += c.x < -c.w;
-    outside[1] += c.x > c.w;
-    outside[2] += c.y < -c.w;
-    outside[3] += c.y > c.w;
-    outside[4] += c.z < -c.w;
-    outside[5] += c.z > c.w;
-  }
-  return std::none_of(std::begin(outside), std::end(outside), [](int n) { return n == 8; });
+glm::vec4 coverageColor(std::size_t index) {
+  const std::size_t id = index + 1;
+  return glm::vec4(static_cast<float>(id & 0xff) / 255.0f,
+                   static_cast<float>((id >> 8) & 0xff) / 255.0f,
+                   static_cast<float>((id >> 16) & 0xff) / 255.0f, 1.0f);
 }
 
-Completeness frameCompleteness(const std::vector<ObjectExtent>& objects,
-                               const std::vector<std::uint64_t>& held,
-                               const glm::mat4& viewProjection) {
-  std::unordered_set<std::uint64_t> visible;
+Result<std::vector<std::uint32_t>> coverageFromIdImage(const RgbaImage& ids,
+                                                       std::size_t objectCount) {
+  if (!ids.consistent()) {
+    return Status(ErrorCode::kInvalidArgument, "coverageFromIdImage: inconsistent image");
+  }
+  std::vector<std::uint32_t> covered(objectCount, 0);
+  for (std::size_t i = 0; i + 3 < ids.pixels.size(); i += 4) {
+    const std::size_t id = std::size_t{ids.pixels[i]} | (std::size_t{ids.pixels[i + 1]} << 8) |
+                           (std::size_t{ids.pixels[i + 2]} << 16);
+    if (id == 0) continue;
+    if (id > objectCount) {
+      return Status(ErrorCode::kInvalidArgument, "coverageFromIdImage: colour " +
+                                                     std::to_string(id) + " names no object (" +
+                                                     std::to_string(objectCount) + " objects)");
+    }
+    ++covered[id - 1];
+  }
+  return covered;
+}
+
+Result<Completeness> frameCompleteness(const std::vector<ObjectExtent>& objects,
+                                       const std::vector<std::uint32_t>& covered,
+                                       const std::vector<std::uint64_t>& held,
+                                       std::uint32_t minPixels) {
+  if (covered.size() != objects.size()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "frameCompleteness: " + std::to_string(covered.size()) + " coverage counts for " +
+                      std::to_string(objects.size()) + " objects");
+  }
+  std::unordered_map<std::uint64_t, std::uint64_t> pixels;  // group -> covered pixels
   std::unordered_set<std::uint64_t> shown;
-  for (const ObjectExtent& object : objects) {
-    if (std::binary_search(held.begin(), held.end(), object.id)) shown.insert(object.group);
-    if (boxMayBeVisible(object.worldMin, object.worldMax, viewProjection)) {
-      visible.insert(object.group);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    pixels[objects[k].group] += covered[k];
+    if (std::binary_search(held.begin(), held.end(), objects[k].id)) {
+      shown.insert(objects[k].group);
     }
   }
   Completeness result;
-  result.visibleGroups = visible.size();
-  for (std::uint64_t group : visible) result.missingGroups += shown.count(group) == 0;
+  for (const auto& [group, count] : pixels) {
+    if (count < std::max<std::uint32_t>(minPixels, 1)) continue;
+    ++result.visibleGroups;
+    result.missingGroups += shown.count(group) == 0;
+  }
   return result;
 }
 
@@ -70,15 +89,17 @@ bool ShownFrameLog::record(std::uint64_t frame, const Pose& pose, std::int64_t s
 Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
                                                       ReferenceSource& references,
                                                       const std::vector<ObjectExtent>& objects,
+                                                      std::uint32_t minPixels,
                                                       const ScoredFrameSink& sink) {
   static const std::vector<std::uint64_t> kNothingHeld;
   std::vector<ShownFrameScore> scores;
   scores.reserve(frames.size());
   RgbaImage reference;
+  std::vector<std::uint32_t> covered;
   for (const ShownFrame& shown : frames) {
-    glm::mat4 viewProjection(1.0f);
+    covered.clear();
     // The reference of the pose this frame was drawn for.
-    Result<double> renderMs = references.render(shown.pose, reference, viewProjection);
+    Result<double> renderMs = references.render(shown.pose, reference, covered);
     if (!renderMs.ok()) {
       return Status(renderMs.status().code(), "reference of shown frame " +
                                                   std::to_string(shown.frame) + ": " +
@@ -95,8 +116,15 @@ Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFra
     score.psnrDb = comparison->psnrDb;
     score.referenceMs = *renderMs;
     score.blank = comparison->variance == 0.0 && !uniformRgb(reference);
-    score.completeness = frameCompleteness(
-        objects, shown.held != nullptr ? *shown.held : kNothingHeld, viewProjection);
+    if (!covered.empty()) {
+      Result<Completeness> completeness = frameCompleteness(
+          objects, covered, shown.held != nullptr ? *shown.held : kNothingHeld, minPixels);
+      if (!completeness.ok()) {
+        return Status(completeness.status().code(), "shown frame " + std::to_string(shown.frame) +
+                                                        ": " + completeness.status().message());
+      }
+      score.completeness = *completeness;
+    }
     if (sink) sink(shown, reference, score);
     scores.push_back(score);
   }

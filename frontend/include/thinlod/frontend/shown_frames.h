@@ -18,8 +18,10 @@
 // - ReferenceSource renders the full-quality frame of a pose (GL in the
 //   daemon, a fake in tests). scoreShownFrames() calls it once per kept
 //   frame, in frame order, and returns one ShownFrameScore per kept frame.
-// - Visibility is by world bounds against the pose's view volume (no
-//   occlusion); objects of one LOD share a group (any level shown = shown).
+// - Visibility is by coverage of the reference: an object group is visible
+//   when it covers at least minPixels pixels of the pose's reference (an id
+//   render: occlusion included); objects of one LOD share a group (any level
+//   held = shown).
 // - Errors: a ReferenceSource failure or frames of mismatched sizes end the
 //   scoring with that Status naming the frame.
 // - Pure: no GL, files or clocks.
@@ -28,8 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <glm/mat4x4.hpp>
-#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 #include <memory>
 #include <vector>
 
@@ -43,29 +44,33 @@ namespace thinlod::frontend {
 struct ObjectExtent {
   std::uint64_t id = 0;
   std::uint64_t group = 0;  // objects of one LOD share it; otherwise unique per object
-  glm::vec3 worldMin{0.0f};
-  glm::vec3 worldMax{0.0f};
 };
 
 // Ids the frontend held (drew) in a frame, sorted ascending. Shared between
 // frames until the held set changes.
 using HeldObjects = std::shared_ptr<const std::vector<std::uint64_t>>;
 
-// Whether the box [worldMin, worldMax] may be visible through `viewProjection`
-// (clip space = viewProjection * world): false only when all 8 corners lie
-// outside one clip plane (conservative: no occlusion, boxes near a frustum
-// corner may count as visible).
-bool boxMayBeVisible(const glm::vec3& worldMin, const glm::vec3& worldMax,
-                     const glm::mat4& viewProjection);
+// The flat colour object `index` is drawn with in a coverage (id) render of
+// the reference: index + 1 in the RGB bytes (R low byte), alpha 1; black (0)
+// is the background. Exact in RGBA8: each component is k / 255.
+glm::vec4 coverageColor(std::size_t index);
+// Pixels per object of a coverage render (objectCount entries). A colour
+// naming no object (> objectCount) is kInvalidArgument.
+Result<std::vector<std::uint32_t>> coverageFromIdImage(const RgbaImage& ids,
+                                                       std::size_t objectCount);
 
 struct Completeness {
-  std::size_t visibleGroups = 0;  // groups with an object in the view volume
+  std::size_t visibleGroups = 0;  // groups covering at least minPixels of the reference
   std::size_t missingGroups = 0;  // of those, groups with no object held
 };
-// `held` sorted ascending (as HeldObjects); `objects` in any order.
-Completeness frameCompleteness(const std::vector<ObjectExtent>& objects,
-                               const std::vector<std::uint64_t>& held,
-                               const glm::mat4& viewProjection);
+// `covered[k]` = pixels of objects[k] in the reference (occlusion included);
+// a group is visible when its objects cover at least `minPixels` together.
+// `held` sorted ascending (as HeldObjects). covered.size() must equal
+// objects.size() (else kInvalidArgument).
+Result<Completeness> frameCompleteness(const std::vector<ObjectExtent>& objects,
+                                       const std::vector<std::uint32_t>& covered,
+                                       const std::vector<std::uint64_t>& held,
+                                       std::uint32_t minPixels);
 
 struct ShownFrame {
   std::uint64_t frame = 0;
@@ -97,9 +102,11 @@ class ReferenceSource {
  public:
   virtual ~ReferenceSource() = default;
   // Renders the full-quality frame for `pose` into `out` (same size as the
-  // shown frames); returns its render time in ms. `viewProjection` receives
-  // the camera used, for the completeness check.
-  virtual Result<double> render(const Pose& pose, RgbaImage& out, glm::mat4& viewProjection) = 0;
+  // shown frames) and the pixels each object covers in it into `covered`
+  // (one entry per ObjectExtent, or empty when not measured); returns the
+  // render time in ms.
+  virtual Result<double> render(const Pose& pose, RgbaImage& out,
+                                std::vector<std::uint32_t>& covered) = 0;
 };
 
 struct ShownFrameScore {
@@ -117,9 +124,11 @@ struct ShownFrameScore {
 using ScoredFrameSink =
     std::function<void(const ShownFrame&, const RgbaImage& reference, const ShownFrameScore&)>;
 
+// Completeness is left at zero when the source returns no coverage.
 Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
                                                       ReferenceSource& references,
                                                       const std::vector<ObjectExtent>& objects,
+                                                      std::uint32_t minPixels,
                                                       const ScoredFrameSink& sink = {});
 
 // |a - b| per RGB channel, alpha 255 (for difference images). Sizes must match
