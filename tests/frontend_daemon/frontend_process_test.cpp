@@ -403,6 +403,7 @@ TEST(FrontendProcess, DeferredReferenceScoresEveryShownFrameLikeTheInlineReferen
                                      "160",
                                      "--height",
                                      "120"};
+    args.push_back("--completeness");
     if (deferred) args.push_back("--deferred-reference");
     FrontendProcess process(args, out + "/frontend.log");
     const int exitCode = process.waitExit([] { std::this_thread::sleep_for(10ms); });

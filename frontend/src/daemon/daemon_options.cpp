@@ -48,6 +48,10 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("deferred-reference-max-mb", &o->deferredReferenceMaxMb,
                     "memory for the kept frames, MiB (frames beyond it are not scored and are "
                     "counted as frames_not_kept)");
+  runtime.addOption("completeness", &o->completeness,
+                    "also render the reference in flat per-object colours to count the objects "
+                    "it shows and those the frontend holds nothing of (visible_objects, "
+                    "missing_objects); costs a second reference pass per measured frame");
   runtime.addOption("visible-min-pixels", &o->visibleMinPixels,
                     "completeness: an object group counts as visible when it covers at least this "
                     "many pixels of the reference (occlusion included)");
@@ -91,6 +95,9 @@ Status validateOptions(const DaemonOptions& o) {
   }
   if (o.deferredReferenceMaxMb < 1 || o.deferredReferenceMaxMb > (std::int64_t{1} << 30)) {
     return invalid("deferred-reference-max-mb", "outside 1..2^30");
+  }
+  if (o.completeness && o.noReference) {
+    return invalid("completeness", "needs the reference (drop --no-reference)");
   }
   if (o.visibleMinPixels < 1) return invalid("visible-min-pixels", "must be at least 1");
   if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");

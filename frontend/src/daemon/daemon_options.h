@@ -32,6 +32,7 @@ struct DaemonOptions {
   bool noReference = false;
   bool deferredReference = false;  // keep shown frames, score after the replay
   std::int64_t deferredReferenceMaxMb = 4096;
+  bool completeness = false;  // coverage pass: visible / missing objects per frame
   int visibleMinPixels = 16;  // completeness: pixels an object group must cover
   std::int64_t frames = 0;    // 0 = the whole trace
   std::string label;

@@ -228,7 +228,8 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   std::vector<ObjectExtent> extents;
   if (scene && !options.noReference) {
     reference = scene->reference;
-    extents = scene->extents;
+    // Without extents the producer renders no coverage pass.
+    if (options.completeness) extents = scene->extents;
   }
   Result<std::unique_ptr<GlFrameProducer>> producer =
       GlFrameProducer::create(glOptions, lighting, std::move(reference), std::move(extents));
