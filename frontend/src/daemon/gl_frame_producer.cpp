@@ -23,6 +23,12 @@ Result<std::unique_ptr<GlFrameProducer>> GlFrameProducer::create(
   // Opaque first in scene order, blended ones after (sorted per frame).
   std::stable_partition(producer->reference_.begin(), producer->reference_.end(),
                         [](const ReferenceItem& item) { return !item.blended; });
+  if (producer->extents_.size() > kMaxCoverageObjects) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "completeness: " + std::to_string(producer->extents_.size()) +
+                      " objects exceed the coverage colours (" +
+                      std::to_string(kMaxCoverageObjects) + ")");
+  }
   if (!producer->extents_.empty()) {
     for (const ReferenceItem& item : producer->reference_) {
       if (item.extent >= producer->extents_.size()) {

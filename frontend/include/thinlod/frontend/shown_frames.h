@@ -53,6 +53,8 @@ using HeldObjects = std::shared_ptr<const std::vector<std::uint64_t>>;
 // The flat colour object `index` is drawn with in a coverage (id) render of
 // the reference: index + 1 in the RGB bytes (R low byte), alpha 1; black (0)
 // is the background. Exact in RGBA8: each component is k / 255.
+// Distinct for index < kMaxCoverageObjects (2^24 - 1); callers check.
+constexpr std::size_t kMaxCoverageObjects = (std::size_t{1} << 24) - 1;
 glm::vec4 coverageColor(std::size_t index);
 // Pixels per object of a coverage render (objectCount entries). A colour
 // naming no object (> objectCount) is kInvalidArgument.
