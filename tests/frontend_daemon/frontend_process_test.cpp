@@ -368,6 +368,85 @@ TEST(FrontendProcess, WithoutABackboneItStillRendersEveryFrameAndExitsZero) {
   fs::remove_all(dir);
 }
 
+TEST(FrontendProcess, DeferredReferenceScoresEveryShownFrameLikeTheInlineReference) {
+  // No backbone: every frame is empty, so each shown frame is blank against its
+  // reference. The deferred run (references after the replay) must give the same
+  // per-frame SNR, completeness and reference images as the inline run.
+  const std::string dir = makeTempDir();
+  const std::string trace = writeTrace(dir, 5, 0.02);
+  struct Run {
+    std::vector<std::map<std::string, std::string>> rows;
+    std::string summary;
+  };
+  const auto run = [&](const std::string& name, bool deferred) {
+    const std::string out = dir + "/" + name;
+    fs::create_directories(out);
+    std::vector<std::string> args = {"--backbone.address",
+                                     "tcp://127.0.0.1:1",
+                                     "--trace",
+                                     trace,
+                                     "--scene",
+                                     kScene,
+                                     "--models-dir",
+                                     kModels,
+                                     "--connect-timeout-ms",
+                                     "0",
+                                     "--csv",
+                                     out + "/frames.csv",
+                                     "--summary-json",
+                                     out + "/summary.json",
+                                     "--frames-dir",
+                                     out + "/frames",
+                                     "--dump-every",
+                                     "2",
+                                     "--width",
+                                     "160",
+                                     "--height",
+                                     "120"};
+    args.push_back("--completeness");
+    if (deferred) args.push_back("--deferred-reference");
+    FrontendProcess process(args, out + "/frontend.log");
+    const int exitCode = process.waitExit([] { std::this_thread::sleep_for(10ms); });
+    EXPECT_EQ(exitCode, 0) << readFile(out + "/frontend.log");
+    Run result;
+    std::vector<std::string> header;
+    result.rows = readCsv(out + "/frames.csv", &header);
+    result.summary = readFile(out + "/summary.json");
+    return result;
+  };
+  const Run inlineRun = run("inline", false);
+  const Run deferredRun = run("deferred", true);
+  ASSERT_EQ(inlineRun.rows.size(), 5u);
+  ASSERT_EQ(deferredRun.rows.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    const auto& a = inlineRun.rows[i];
+    const auto& b = deferredRun.rows[i];
+    EXPECT_EQ(b.at("frame"), std::to_string(i));
+    EXPECT_EQ(b.at("snr_db"), "-inf");  // an empty frame against a non-empty reference
+    EXPECT_EQ(b.at("blank"), "1");
+    EXPECT_GE(numberOf(b.at("visible_objects")), 1.0);
+    EXPECT_EQ(b.at("missing_objects"), b.at("visible_objects"));  // nothing held
+    for (const char* column :
+         {"snr_db", "psnr_db", "visible_objects", "missing_objects", "blank"}) {
+      EXPECT_EQ(a.at(column), b.at(column)) << column << " of frame " << i;
+    }
+    EXPECT_FALSE(b.at("shown_at_ms").empty());
+  }
+  EXPECT_NE(inlineRun.summary.find("\"reference_mode\": \"inline\""), std::string::npos);
+  EXPECT_NE(deferredRun.summary.find("\"reference_mode\": \"deferred\""), std::string::npos)
+      << deferredRun.summary;
+  for (const char* kind : {"frame", "reference", "difference"}) {
+    for (int frame : {0, 2, 4}) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "/%s_%04d.png", kind, frame);
+      const std::string deferredPng = readFile(dir + "/deferred/frames" + name);
+      EXPECT_FALSE(deferredPng.empty()) << name;
+      EXPECT_EQ(deferredPng, readFile(dir + "/inline/frames" + name)) << name;  // byte-identical
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(FrontendProcess, SigtermEndsTheReplayEarlyAndStillWritesTheOutputs) {
   const std::string dir = makeTempDir();
   const std::string csv = dir + "/frames.csv";

@@ -547,6 +547,149 @@ TEST_F(ReplayLoopTest, LiveStreamSkipsPosesOvertakenBeforeAFrameTakesThem) {
   EXPECT_DOUBLE_EQ(result.records[2].poseToFrameMs, 45.0);
 }
 
+// Deferred measurement: frames kept during the replay, scored after it.
+class DeferringProducer final : public FrameProducer {
+ public:
+  explicit DeferringProducer(FakeClock& clock) : clock_(clock) {}
+  Status submit(SceneBatch batch) override { return scene.enqueue(std::move(batch)); }
+  Result<ProducedFrame> renderFrame(std::uint64_t, const Pose&) override {
+    renderStartNs.push_back(clock_.now);
+    for (const PendingUpload& upload : scene.planUploads(~std::size_t{0})) {
+      EXPECT_TRUE(scene.markUploaded(upload.key).ok());
+    }
+    const CommitResult committed = scene.commitReady();
+    clock_.now += renderNs.empty() ? 5 * kMs : renderNs[renderStartNs.size() - 1];
+    ProducedFrame produced;
+    produced.triangles = scene.polygons();
+    produced.appliedPlan = scene.lastAppliedPlan();
+    produced.committedBatches = committed.plans.size();
+    return produced;
+  }
+  Result<FrameQuality> measure(std::uint64_t frame, const Pose&) override {
+    ADD_FAILURE() << "inline measure of frame " << frame << " in deferred mode";
+    return FrameQuality{};
+  }
+  bool keepShown(std::uint64_t frame, const Pose& pose, std::int64_t shownAtNs) override {
+    kept.push_back({frame, pose.time, shownAtNs});
+    return true;
+  }
+  Result<std::vector<KeptFrameQuality>> scoreKept() override {
+    ++scoreCalls;
+    scoredAtFrames = renderStartNs.size();
+    // The score of a frame is a function of the pose it was kept with (what
+    // the real producer does: the reference of that pose), here 100 x time.
+    std::vector<KeptFrameQuality> out;
+    for (const Kept& k : kept) {
+      KeptFrameQuality q;
+      q.frame = k.frame;
+      q.quality.snrDb = 100.0 * k.poseTime;
+      q.quality.psnrDb = 40.0;
+      q.quality.referenceMs = 80.0;
+      q.quality.visibleObjects = 2;
+      q.quality.missingObjects = k.frame == 0 ? 1 : 0;
+      q.quality.blank = 0;
+      out.push_back(q);
+    }
+    return out;
+  }
+  struct Kept {
+    std::uint64_t frame;
+    double poseTime;
+    std::int64_t shownAtNs;
+  };
+  FrontendScene scene;
+  std::vector<std::int64_t> renderNs;  // per frame; default 5 ms
+  std::vector<std::int64_t> renderStartNs;
+  std::vector<Kept> kept;
+  int scoreCalls = 0;
+  std::size_t scoredAtFrames = 0;
+
+ private:
+  FakeClock& clock_;
+};
+
+class ScoreObserver final : public ReplayObserver {
+ public:
+  void onFrame(const FrameRecord& record, const FrameExtras& extras) override {
+    pendingDuringReplay.push_back(extras.scorePending);
+    snrDuringReplay.push_back(record.snrDb);
+  }
+  void onFrameScored(const FrameRecord& record, const FrameExtras& extras) override {
+    scoredFrames.push_back(record.frame);
+    scoredSnr.push_back(record.snrDb);
+    missing.push_back(extras.missingObjects);
+  }
+  std::vector<bool> pendingDuringReplay;
+  std::vector<double> snrDuringReplay;
+  std::vector<std::uint64_t> scoredFrames;
+  std::vector<double> scoredSnr;
+  std::vector<long> missing;
+};
+
+TEST_F(ReplayLoopTest, DeferredScoringKeepsEachFrameWithThePoseItWasDrawnForEvenWhenLate) {
+  DeferringProducer deferring(clock);
+  ScoreObserver scores;
+  options.deferMeasure = true;
+  options.rate = 10.0;  // 100 ms slots
+  // Frame 1 takes 250 ms: frame 2 starts late (at 350 ms, after its slot at
+  // 200 ms and after pose 3's slot at 300 ms).
+  deferring.renderNs = {5 * kMs, 250 * kMs, 5 * kMs, 5 * kMs};
+  const std::int64_t start = clock.now;
+  ReplayResult result = runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link, deferring,
+                                  scores, [] { return false; });
+  ASSERT_TRUE(result.status.ok()) << result.status.toString();
+  ASSERT_EQ(result.records.size(), 4u);
+  ASSERT_EQ(deferring.kept.size(), 4u);
+  EXPECT_EQ(deferring.renderStartNs[2] - start, 350 * kMs);  // late: no pose skipped
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(deferring.kept[i].frame, i);
+    // Kept with the pose it was drawn for, not the pose due when it was shown.
+    EXPECT_DOUBLE_EQ(deferring.kept[i].poseTime, 0.1 * static_cast<double>(i));
+    EXPECT_DOUBLE_EQ(result.records[i].snrDb, 100.0 * 0.1 * static_cast<double>(i));
+    EXPECT_EQ(result.extras[i].missingObjects, i == 0 ? 1 : 0);
+    EXPECT_DOUBLE_EQ(result.extras[i].referenceMs, 80.0);
+  }
+  EXPECT_EQ(deferring.kept[2].shownAtNs - start, 355 * kMs);
+  EXPECT_DOUBLE_EQ(result.extras[2].shownAtMs, 355.0);
+  // Scored once, after the last frame; nothing scored during the replay.
+  EXPECT_EQ(deferring.scoreCalls, 1);
+  EXPECT_EQ(deferring.scoredAtFrames, 4u);
+  EXPECT_EQ(scores.pendingDuringReplay, (std::vector<bool>{true, true, true, true}));
+  for (double snr : scores.snrDuringReplay) EXPECT_TRUE(std::isnan(snr));
+  EXPECT_EQ(scores.scoredFrames, (std::vector<std::uint64_t>{0, 1, 2, 3}));
+  EXPECT_DOUBLE_EQ(scores.scoredSnr[3], 30.0);
+  // The reference never delays the client: frames 0 and 1 start on their slots.
+  EXPECT_EQ(deferring.renderStartNs[0] - start, 0);
+  EXPECT_EQ(deferring.renderStartNs[1] - start, 100 * kMs);
+  for (const FrameRecord& record : result.records) EXPECT_LE(record.poseToFrameMs, 250.0);
+}
+
+TEST_F(ReplayLoopTest, DeferredScoringScoresTheFramesKeptBeforeAStop) {
+  DeferringProducer deferring(clock);
+  ScoreObserver scores;
+  options.deferMeasure = true;
+  options.rate = 10.0;
+  ReplayResult result = runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link, deferring,
+                                  scores, [&] { return deferring.renderStartNs.size() >= 2; });
+  EXPECT_TRUE(result.interrupted);
+  ASSERT_EQ(result.records.size(), 2u);
+  EXPECT_EQ(deferring.scoreCalls, 1);
+  EXPECT_EQ(scores.scoredFrames.size(), result.records.size());
+  for (std::size_t i = 0; i < result.records.size(); ++i) {
+    EXPECT_DOUBLE_EQ(result.records[i].snrDb, 10.0 * static_cast<double>(i));
+  }
+}
+
+TEST_F(ReplayLoopTest, AFrameThatCannotBeKeptIsCountedAndStaysUnscored) {
+  // SceneProducer keeps nothing (FrameProducer's default keepShown).
+  options.deferMeasure = true;
+  options.rate = -1.0;
+  ReplayResult result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  EXPECT_EQ(result.framesNotKept, 2u);
+  for (const FrameRecord& record : result.records) EXPECT_TRUE(std::isnan(record.snrDb));
+}
+
 TEST_F(ReplayLoopTest, EmptyTraceIsAnError) {
   ReplayResult result = run(Trace{});
   EXPECT_EQ(result.status.code(), ErrorCode::kInvalidArgument);

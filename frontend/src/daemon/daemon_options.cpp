@@ -41,6 +41,20 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("dump-every", &o->dumpEvery, "dump every Nth frame (with --frames-dir)");
   runtime.addOption("no-reference", &o->noReference,
                     "skip the full-quality reference and SNR (pure latency runs)");
+  runtime.addOption("deferred-reference", &o->deferredReference,
+                    "live scoring: keep every shown frame with the pose it was drawn for and "
+                    "render the references and SNR after the replay, so the reference never "
+                    "delays the client (frames.csv and the PNG dumps are written then)");
+  runtime.addOption("deferred-reference-max-mb", &o->deferredReferenceMaxMb,
+                    "memory for the kept frames, MiB (frames beyond it are not scored and are "
+                    "counted as frames_not_kept)");
+  runtime.addOption("completeness", &o->completeness,
+                    "also render the reference in flat per-object colours to count the objects "
+                    "it shows and those the frontend holds nothing of (visible_objects, "
+                    "missing_objects); costs a second reference pass per measured frame");
+  runtime.addOption("visible-min-pixels", &o->visibleMinPixels,
+                    "completeness: an object group counts as visible when it covers at least this "
+                    "many pixels of the reference (occlusion included)");
   runtime.addOption("frames", &o->frames,
                     "stop after N frames; 0 = the whole trace (or until the pose stream ends)");
   runtime.addOption("label", &o->label, "run name written into the summary");
@@ -76,6 +90,16 @@ Status validateOptions(const DaemonOptions& o) {
   }
   if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
   if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");
+  if (o.deferredReference && o.noReference) {
+    return invalid("deferred-reference", "needs the reference (drop --no-reference)");
+  }
+  if (o.deferredReferenceMaxMb < 1 || o.deferredReferenceMaxMb > (std::int64_t{1} << 30)) {
+    return invalid("deferred-reference-max-mb", "outside 1..2^30");
+  }
+  if (o.completeness && o.noReference) {
+    return invalid("completeness", "needs the reference (drop --no-reference)");
+  }
+  if (o.visibleMinPixels < 1) return invalid("visible-min-pixels", "must be at least 1");
   if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");
   if (o.frames < 0) return invalid("frames", "negative");
   if (o.connectTimeoutMs < 0) return invalid("connect-timeout-ms", "negative");

@@ -30,7 +30,11 @@ struct DaemonOptions {
   std::string framesDir;
   int dumpEvery = 10;
   bool noReference = false;
-  std::int64_t frames = 0;  // 0 = the whole trace
+  bool deferredReference = false;  // keep shown frames, score after the replay
+  std::int64_t deferredReferenceMaxMb = 4096;
+  bool completeness = false;  // coverage pass: visible / missing objects per frame
+  int visibleMinPixels = 16;  // completeness: pixels an object group must cover
+  std::int64_t frames = 0;    // 0 = the whole trace
   std::string label;
   int connectTimeoutMs = 10000;
   protocol::TransportOptions transport;

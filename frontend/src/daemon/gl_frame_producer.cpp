@@ -13,14 +13,36 @@ namespace thinlod::frontend::daemon {
 
 Result<std::unique_ptr<GlFrameProducer>> GlFrameProducer::create(
     const GlProducerOptions& options, const render::Lighting& lighting,
-    std::vector<ReferenceItem> reference) {
+    std::vector<ReferenceItem> reference, std::vector<ObjectExtent> extents) {
   std::unique_ptr<GlFrameProducer> producer(new GlFrameProducer());
   producer->options_ = options;
+  producer->extents_ = std::move(extents);
+  producer->kept_ = ShownFrameLog(options.maxKeptBytes);
   producer->lighting_ = lighting;
   producer->reference_ = std::move(reference);
   // Opaque first in scene order, blended ones after (sorted per frame).
   std::stable_partition(producer->reference_.begin(), producer->reference_.end(),
                         [](const ReferenceItem& item) { return !item.blended; });
+  if (producer->extents_.size() > kMaxCoverageObjects) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "completeness: " + std::to_string(producer->extents_.size()) +
+                      " objects exceed the coverage colours (" +
+                      std::to_string(kMaxCoverageObjects) + ")");
+  }
+  if (!producer->extents_.empty()) {
+    for (const ReferenceItem& item : producer->reference_) {
+      if (item.extent >= producer->extents_.size()) {
+        return Status(ErrorCode::kInvalidArgument, "reference item names no object extent");
+      }
+      ReferenceObject flat;
+      flat.mesh = item.object.mesh;
+      flat.transform = item.object.transform;
+      flat.material.diffuse = coverageColor(item.extent);
+      flat.material.lit = false;
+      flat.material.doubleSided = item.object.material.doubleSided;
+      producer->coverageList_.push_back(std::move(flat));
+    }
+  }
 
   Result<std::unique_ptr<render::OffscreenContext>> context =
       render::createOffscreenContext(options.backend, options.width, options.height);
@@ -84,7 +106,8 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   return produced;
 }
 
-Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& pose) {
+Result<double> GlFrameProducer::renderReference(const Pose& pose,
+                                                std::vector<std::uint32_t>& covered) {
   Result<render::Camera> camera = cameraFromPose(pose, options_.width, options_.height);
   if (!camera.ok()) return camera.status();
   drawList_.clear();
@@ -106,17 +129,111 @@ Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& p
   }
   Result<ReferenceReport> report =
       referenceRenderer_->render(drawList_, *camera, lighting_, referenceFrame_);
-  if (!report.ok()) {
-    return Status(report.status().code(),
-                  "reference frame " + std::to_string(frame) + ": " + report.status().message());
+  if (!report.ok()) return report.status();
+  covered.clear();
+  if (!coverageList_.empty()) {
+    // Which objects the reference shows, and how much of each (depth-tested,
+    // so occluded objects cover nothing). Not included in the reference's time.
+    Result<ReferenceReport> ids =
+        referenceRenderer_->render(coverageList_, *camera, lighting_, coverageFrame_);
+    if (!ids.ok()) return ids.status();
+    Result<std::vector<std::uint32_t>> counts =
+        coverageFromIdImage(coverageFrame_, extents_.size());
+    if (!counts.ok()) return counts.status();
+    covered = std::move(counts).value();
+  }
+  return report->renderMs;
+}
+
+HeldObjects GlFrameProducer::heldNow() {
+  const FrontendScene& scene = renderer_->scene();
+  // Every commit applies a plan, so (plan, count) changes whenever the held set does.
+  if (held_ == nullptr || scene.lastAppliedPlan() != heldPlan_ ||
+      scene.objects().size() != heldCount_) {
+    auto ids = std::make_shared<std::vector<std::uint64_t>>();
+    ids->reserve(scene.objects().size());
+    for (const auto& [id, object] : scene.objects()) ids->push_back(id);  // map: ascending
+    held_ = std::move(ids);
+    heldPlan_ = scene.lastAppliedPlan();
+    heldCount_ = scene.objects().size();
+  }
+  return held_;
+}
+
+Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& pose) {
+  Result<double> renderMs = renderReference(pose, covered_);
+  if (!renderMs.ok()) {
+    return Status(renderMs.status().code(),
+                  "reference frame " + std::to_string(frame) + ": " + renderMs.status().message());
   }
   Result<FrameComparison> comparison = compareFrames(frame_, referenceFrame_);
   if (!comparison.ok()) return comparison.status();
   FrameQuality quality;
   quality.snrDb = comparison->snrDb;
   quality.psnrDb = comparison->psnrDb;
-  quality.referenceMs = report->renderMs;
+  quality.referenceMs = *renderMs;
+  if (!covered_.empty()) {
+    Result<Completeness> completeness =
+        frameCompleteness(extents_, covered_, *heldNow(), options_.visibleMinPixels);
+    if (!completeness.ok()) return completeness.status();
+    quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
+    quality.missingObjects = static_cast<long>(completeness->missingGroups);
+  }
+  // Uniform shown frame, non-uniform reference (as scoreShownFrames defines it).
+  Result<FrameComparison> referenceAlone = compareFrames(referenceFrame_, referenceFrame_);
+  quality.blank =
+      comparison->variance == 0.0 && referenceAlone.ok() && referenceAlone->variance > 0.0;
   return quality;
+}
+
+bool GlFrameProducer::keepShown(std::uint64_t frame, const Pose& pose, std::int64_t shownAtNs) {
+  return kept_.record(frame, pose, shownAtNs, frame_, heldNow());
+}
+
+// The reference renderer as a ReferenceSource for scoreShownFrames.
+class GlFrameProducer::References final : public ReferenceSource {
+ public:
+  explicit References(GlFrameProducer& producer) : producer_(producer) {}
+  Result<double> render(const Pose& pose, RgbaImage& out,
+                        std::vector<std::uint32_t>& covered) override {
+    Result<double> ms = producer_.renderReference(pose, covered);
+    if (ms.ok()) out = producer_.referenceFrame_;
+    return ms;
+  }
+
+ private:
+  GlFrameProducer& producer_;
+};
+
+Result<std::vector<KeptFrameQuality>> GlFrameProducer::scoreKept() {
+  References references(*this);
+  const ScoredFrameSink sink = [this](const ShownFrame& shown, const RgbaImage&,
+                                      const ShownFrameScore&) {
+    if (!scoredSink_) return;
+    frame_ = shown.image;  // referenceFrame_ already holds its reference
+    scoredSink_(shown.frame);
+  };
+  Result<std::vector<ShownFrameScore>> scores =
+      scoreShownFrames(kept_.frames(), references, extents_, options_.visibleMinPixels, sink);
+  if (!scores.ok()) return scores.status();
+  std::vector<KeptFrameQuality> out;
+  out.reserve(scores->size());
+  for (const ShownFrameScore& score : *scores) {
+    KeptFrameQuality kept;
+    kept.frame = score.frame;
+    kept.quality.snrDb = score.snrDb;
+    kept.quality.psnrDb = score.psnrDb;
+    kept.quality.referenceMs = score.referenceMs;
+    if (!extents_.empty()) {
+      kept.quality.visibleObjects = static_cast<long>(score.completeness.visibleGroups);
+      kept.quality.missingObjects = static_cast<long>(score.completeness.missingGroups);
+    }
+    kept.quality.blank = score.blank ? 1 : 0;
+    out.push_back(kept);
+  }
+  keptPeakBytes_ = kept_.bytes();
+  kept_ = ShownFrameLog(0);  // the images are no longer needed
+  return out;
 }
 
 std::string GlFrameProducer::describe() const {

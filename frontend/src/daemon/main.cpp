@@ -83,14 +83,19 @@ class DaemonObserver final : public ReplayObserver {
       spdlog::info("event=progress frame={} polygons={} snr_db={:.2f} render_ms={:.2f} plan={}",
                    record.frame, record.polygons, record.snrDb, record.renderMs, record.plan);
     }
-    if (csv_ != nullptr && outputError_.ok()) {
-      const Status written = csv_->append(record, extras);
-      if (!written.ok()) {
-        outputError_ = written;
-        spdlog::error("event=csv_failed error=\"{}\"", written.toString());
-      }
-    }
+    // Deferred scoring: the row and the dumps come with the score (onFrameScored).
+    if (extras.scorePending) return;
+    writeRow(record, extras);
     if (!options_.framesDir.empty() && record.frame % options_.dumpEvery == 0) dump(record.frame);
+  }
+
+  void onFrameScored(const FrameRecord& record, const FrameExtras& extras) override {
+    writeRow(record, extras);
+  }
+
+  // Deferred scoring: called while the kept frame and its reference are in the producer.
+  void onKeptFrameScored(std::uint64_t frame) {
+    if (!options_.framesDir.empty() && frame % options_.dumpEvery == 0) dump(frame);
   }
 
   void onUpdateRejected(const protocol::SceneUpdate& update, const Status& why) override {
@@ -114,11 +119,24 @@ class DaemonObserver final : public ReplayObserver {
   const Status& outputError() const { return outputError_; }
 
  private:
+  void writeRow(const FrameRecord& record, const FrameExtras& extras) {
+    if (csv_ == nullptr || !outputError_.ok()) return;
+    const Status written = csv_->append(record, extras);
+    if (!written.ok()) {
+      outputError_ = written;
+      spdlog::error("event=csv_failed error=\"{}\"", written.toString());
+    }
+  }
+
   void dump(std::uint64_t frame) {
     Status written = writePng(dumpPath(options_.framesDir, "frame", frame), producer_.frame());
     if (written.ok() && !options_.noReference) {
       written =
           writePng(dumpPath(options_.framesDir, "reference", frame), producer_.referenceFrame());
+      Result<RgbaImage> difference = differenceImage(producer_.frame(), producer_.referenceFrame());
+      if (written.ok() && difference.ok()) {
+        written = writePng(dumpPath(options_.framesDir, "difference", frame), *difference);
+      }
     }
     if (!written.ok()) spdlog::warn("event=dump_failed error=\"{}\"", written.toString());
   }
@@ -177,6 +195,12 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     spdlog::info("event=scene_loaded path={} objects={} reference_triangles={} lights={}",
                  options.scenePath, scene->objects.size(), scene->referenceTriangles,
                  scene->lighting.lights.size());
+    if (scene->laterLodLevelObjects > 0) {
+      spdlog::info(
+          "event=reference_lod note=\"objects of later LOD levels left out of the "
+          "reference\" count={}",
+          scene->laterLodLevelObjects);
+    }
     if (scene->droppedLights > 0) {
       spdlog::warn("event=lights_dropped count={}", scene->droppedLights);
     }
@@ -198,10 +222,17 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
                                       ? std::numeric_limits<std::size_t>::max()
                                       : static_cast<std::size_t>(options.maxUploadBytesPerFrame);
   const render::Lighting lighting = scene ? scene->lighting : render::Lighting{};
+  glOptions.maxKeptBytes = static_cast<std::size_t>(options.deferredReferenceMaxMb) << 20;
+  glOptions.visibleMinPixels = static_cast<std::uint32_t>(options.visibleMinPixels);
   std::vector<ReferenceItem> reference;
-  if (scene && !options.noReference) reference = scene->reference;
+  std::vector<ObjectExtent> extents;
+  if (scene && !options.noReference) {
+    reference = scene->reference;
+    // Without extents the producer renders no coverage pass.
+    if (options.completeness) extents = scene->extents;
+  }
   Result<std::unique_ptr<GlFrameProducer>> producer =
-      GlFrameProducer::create(glOptions, lighting, std::move(reference));
+      GlFrameProducer::create(glOptions, lighting, std::move(reference), std::move(extents));
   if (!producer.ok()) {
     spdlog::error("event=gl_failed error=\"{}\"", producer.status().toString());
     return 1;
@@ -250,9 +281,9 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   }
   spdlog::info(
       "event=ready address={} connected={} trace={} poses={} pose_stream={} lockstep={} "
-      "reference={}",
+      "reference={} deferred_reference={}",
       options.backboneAddress, connected, options.tracePath, trace.poses.size(),
-      options.poseStreamPath, options.lockstep, !options.noReference);
+      options.poseStreamPath, options.lockstep, !options.noReference, options.deferredReference);
 
   ReplayOptions replay;
   replay.lockstep = options.lockstep;
@@ -260,11 +291,14 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   replay.rate = options.rate;
   replay.maxFrames = static_cast<std::size_t>(options.frames);
   replay.measure = !options.noReference;
+  replay.deferMeasure = options.deferredReference;
   replay.viewportWidth = static_cast<std::uint32_t>(options.width);
   replay.viewportHeight = static_cast<std::uint32_t>(options.height);
   if (scene) replay.conversion.meshColors = &scene->meshColors;
 
   DaemonObserver observer(csv.get(), **producer, options);
+  (*producer)->setScoredSink(
+      [&observer](std::uint64_t frame) { observer.onKeptFrameScored(frame); });
   ReplayResult result = runReplay(*source, replay, clock, **link, **producer, observer, stop);
 
   int exitCode = 0;
@@ -283,6 +317,8 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   info.lockstep = options.lockstep;
   info.rate = options.rate;
   info.reference = !options.noReference;
+  info.deferredReference = options.deferredReference && !options.noReference;
+  info.keptBytes = (*producer)->keptBytes();
   info.connectedAtStart = connected;
   info.referenceTriangles = scene && !options.noReference ? scene->referenceTriangles : 0;
   if (!result.status.ok()) {

@@ -46,7 +46,8 @@ std::string withoutNewline(std::string line) {
 
 std::string daemonCsvHeader() {
   return withoutNewline(frameCsvHeader()) +
-         ",reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout\n";
+         ",reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,shown_at_ms,"
+         "visible_objects,missing_objects,blank\n";
 }
 
 std::string daemonCsvRow(const FrameRecord& record, const FrameExtras& extras) {
@@ -55,7 +56,13 @@ std::string daemonCsvRow(const FrameRecord& record, const FrameExtras& extras) {
   row += ',' + number(extras.waitMs, "%.4f");
   row += ',' + std::to_string(extras.updatesReceived);
   row += ',' + std::to_string(extras.updatesRejected);
-  row += extras.lockstepTimedOut ? ",1\n" : ",0\n";
+  row += extras.lockstepTimedOut ? ",1" : ",0";
+  row += ',' + number(extras.shownAtMs, "%.4f");
+  const auto count = [](long value) { return value < 0 ? std::string() : std::to_string(value); };
+  row += ',' + count(extras.visibleObjects);
+  row += ',' + count(extras.missingObjects);
+  row += ',' + count(extras.blank);
+  row += '\n';
   return row;
 }
 
@@ -110,6 +117,13 @@ std::string runSummaryJson(const ReplayResult& result, const RunInfo& info) {
   json["lockstep"] = info.lockstep;
   json["rate"] = info.rate;
   json["reference"] = info.reference;
+  // inline: each frame measured as it is drawn; deferred: shown frames kept and
+  // scored after the replay (live runs); none: no SNR.
+  json["reference_mode"] = !info.reference          ? "none"
+                           : info.deferredReference ? "deferred"
+                                                    : "inline";
+  json["frames_not_kept"] = result.framesNotKept;
+  json["kept_bytes"] = info.keptBytes;
   json["reference_triangles"] = info.referenceTriangles;
   json["connected_at_start"] = info.connectedAtStart;
   json["interrupted"] = result.interrupted;

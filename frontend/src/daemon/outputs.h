@@ -17,7 +17,8 @@
 namespace thinlod::frontend::daemon {
 
 // Extra columns after the library's: reference_ms, wait_ms, updates_received,
-// updates_rejected, lockstep_timeout (0/1).
+// updates_rejected, lockstep_timeout (0/1), shown_at_ms, visible_objects,
+// missing_objects, blank (0/1; the last three empty when not measured).
 std::string daemonCsvHeader();
 std::string daemonCsvRow(const FrameRecord& record, const FrameExtras& extras);
 
@@ -48,6 +49,8 @@ struct RunInfo {
   bool lockstep = false;
   double rate = 0.0;
   bool reference = true;
+  bool deferredReference = false;
+  std::size_t keptBytes = 0;  // deferred: pixels held for scoring at the end
   bool connectedAtStart = false;
   std::size_t referenceTriangles = 0;
   std::string error;  // empty when the replay ended normally

@@ -110,15 +110,19 @@ class Replay {
       FrameRecord record = recordOf(i, pose, *produced, frameDoneNs);
       if (fresh) record.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
 
-      if (options_.measure) {
+      if (!firstSampledNs_) firstSampledNs_ = sampledNs;
+      extras_.shownAtMs = (frameDoneNs - *firstSampledNs_) / kNsPerMs;
+      if (options_.measure && options_.deferMeasure) {
+        // The image and the pose it was drawn for; scored after the replay.
+        extras_.scorePending = true;
+        if (!producer_.keepShown(i, pose, frameDoneNs)) ++result_.framesNotKept;
+      } else if (options_.measure) {
         Result<FrameQuality> quality = producer_.measure(i, pose);
         if (!quality.ok()) {
           result_.status = quality.status();
           break;
         }
-        record.snrDb = quality->snrDb;
-        record.psnrDb = quality->psnrDb;
-        extras_.referenceMs = quality->referenceMs;
+        applyQuality(record, extras_, *quality);
       }
       const std::uint64_t bytesNow = link_.bytesReceived();
       record.linkBytes = bytesNow - bytesBefore;
@@ -129,10 +133,39 @@ class Replay {
       observer_.onFrame(record, extras_);
     }
     result_.posesSkipped = source_.skipped();
+    if (options_.measure && options_.deferMeasure) scoreDeferred();
     return std::move(result_);
   }
 
  private:
+  static void applyQuality(FrameRecord& record, FrameExtras& extras, const FrameQuality& quality) {
+    record.snrDb = quality.snrDb;
+    record.psnrDb = quality.psnrDb;
+    extras.referenceMs = quality.referenceMs;
+    extras.visibleObjects = quality.visibleObjects;
+    extras.missingObjects = quality.missingObjects;
+    extras.blank = quality.blank;
+  }
+
+  // Deferred measurement: every kept frame scored against its own pose's
+  // reference, merged into its record by frame number.
+  void scoreDeferred() {
+    Result<std::vector<KeptFrameQuality>> scores = producer_.scoreKept();
+    if (!scores.ok()) {
+      if (result_.status.ok()) result_.status = scores.status();
+    } else {
+      for (const KeptFrameQuality& kept : *scores) {
+        // Records are numbered 0, 1, ... in order, so the frame is the index.
+        if (kept.frame >= result_.records.size()) continue;
+        applyQuality(result_.records[kept.frame], result_.extras[kept.frame], kept.quality);
+      }
+    }
+    for (std::size_t k = 0; k < result_.records.size(); ++k) {
+      result_.extras[k].scorePending = false;
+      observer_.onFrameScored(result_.records[k], result_.extras[k]);
+    }
+  }
+
   // Polls the link in slices until `done()`, the deadline, or a stop request.
   template <typename Done>
   void waitUntil(std::int64_t deadlineNs, Done done) {
@@ -250,6 +283,7 @@ class Replay {
   // Plans of updates refused or dropped since the last FrameStats.
   std::vector<std::uint64_t> refusedPlans_;
   double targetAccuracy_ = FrameRecord::kMissing;
+  std::optional<std::int64_t> firstSampledNs_;  // frame 0's pose
   FrameExtras extras_;
   ReplayResult result_;
 };

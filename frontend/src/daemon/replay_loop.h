@@ -11,6 +11,14 @@
 //   every update in arrival order (a bad update is rejected whole); render
 //   the frame; then measure it against the reference; emit a FrameRecord and
 //   send FrameStats.
+// - Deferred measurement (measure && deferMeasure, the live workbench mode):
+//   instead of rendering the reference inline, the frame just shown is kept
+//   with the pose it was drawn for (FrameProducer::keepShown) and nothing
+//   else delays the client. After the last frame (also after a stop),
+//   FrameProducer::scoreKept scores every kept frame against the reference of
+//   its own pose; the scores are merged into the records and
+//   ReplayObserver::onFrameScored is called once per record, in frame order.
+//   Meanwhile onFrame sees FrameExtras::scorePending = true.
 // - Waiting is always link.poll(timeout, source.wakeFd()) in slices of at
 //   most pollSlice, then source.refresh(), so updates and poses keep flowing
 //   (a pose is stamped when it is read) and a stop request ends the wait
@@ -99,6 +107,16 @@ struct FrameQuality {
   double snrDb = FrameRecord::kMissing;
   double psnrDb = FrameRecord::kMissing;
   double referenceMs = FrameRecord::kMissing;
+  // Completeness (shown_frames.h): -1 = not measured.
+  long visibleObjects = -1;  // object groups in the view volume
+  long missingObjects = -1;  // of those, groups the frontend held nothing of
+  int blank = -1;            // 1: the shown frame is uniform, the reference is not
+};
+
+// A kept frame's score (deferred measurement).
+struct KeptFrameQuality {
+  std::uint64_t frame = 0;
+  FrameQuality quality;
 };
 
 // Renders the frontend frame and its reference.
@@ -109,6 +127,17 @@ class FrameProducer {
   virtual Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose& pose) = 0;
   // Compares the frame just rendered with the full-quality frame of `pose`.
   virtual Result<FrameQuality> measure(std::uint64_t frame, const Pose& pose) = 0;
+  // Deferred measurement: keeps the frame just rendered with the pose it was
+  // drawn for and the clock time it was shown. false: not kept (memory bound,
+  // or a producer that cannot defer).
+  virtual bool keepShown(std::uint64_t /*frame*/, const Pose& /*pose*/,
+                         std::int64_t /*shownAtNs*/) {
+    return false;
+  }
+  // Scores every kept frame against the reference of its own pose.
+  virtual Result<std::vector<KeptFrameQuality>> scoreKept() {
+    return std::vector<KeptFrameQuality>{};
+  }
 };
 
 // Per-frame values beyond FrameRecord (extra CSV columns).
@@ -117,8 +146,13 @@ struct FrameExtras {
   double waitMs = 0.0;  // after sending the pose, waiting for the update (lockstep) or polling
   bool poseSent = false;
   bool lockstepTimedOut = false;
-  std::size_t updatesReceived = 0;  // this frame
-  std::size_t updatesRejected = 0;  // this frame
+  std::size_t updatesReceived = 0;           // this frame
+  std::size_t updatesRejected = 0;           // this frame
+  double shownAtMs = FrameRecord::kMissing;  // readback done, ms after frame 0's pose was sampled
+  long visibleObjects = -1;                  // FrameQuality's, -1 = not measured
+  long missingObjects = -1;
+  int blank = -1;
+  bool scorePending = false;  // deferred measurement: scored after the replay
 };
 
 // Hooks for logs and outputs; every method has a no-op default.
@@ -126,6 +160,8 @@ class ReplayObserver {
  public:
   virtual ~ReplayObserver() = default;
   virtual void onFrame(const FrameRecord&, const FrameExtras&) {}
+  // Deferred measurement only: each record again once scored, in frame order.
+  virtual void onFrameScored(const FrameRecord&, const FrameExtras&) {}
   virtual void onUpdateRejected(const protocol::SceneUpdate&, const Status&) {}
   virtual void onLockstepTimeout(std::uint64_t /*frame*/, double /*waitedMs*/) {}
   virtual void onUploadDropped(std::uint64_t /*frame*/, const std::string& /*error*/) {}
@@ -138,6 +174,7 @@ struct ReplayOptions {
   double rate = 0.0;          // see the pacing rule above
   std::size_t maxFrames = 0;  // 0: every pose of the trace
   bool measure = true;        // false: no reference, SNR/PSNR missing
+  bool deferMeasure = false;  // with measure: keep shown frames, score after the replay
   std::uint32_t viewportWidth = 0;
   std::uint32_t viewportHeight = 0;
   std::chrono::milliseconds pollSlice{50};
@@ -154,8 +191,9 @@ struct ReplayResult {
   std::size_t posesNotSent = 0;  // link down at the time
   std::size_t posesSkipped = 0;  // a stream's poses overtaken by newer ones before a frame
   std::size_t framesRedrawingAPose = 0;
-  bool interrupted = false;  // stopRequested() ended it early
-  Status status;             // why it ended early with an error
+  std::size_t framesNotKept = 0;  // deferred measurement: over the memory bound, never scored
+  bool interrupted = false;       // stopRequested() ended it early
+  Status status;                  // why it ended early with an error
 };
 
 ReplayResult runReplay(PoseSource& source, const ReplayOptions& options, Clock& clock,

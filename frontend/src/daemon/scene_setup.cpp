@@ -21,7 +21,40 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
   }
   loaded.objects = std::move(objects).value();
   loaded.lighting = scene::sceneLighting(*loaded.scene, &loaded.droppedLights);
+  // Position of each instance among its parent's children (pre-order lists
+  // a parent's children in order), to tell an LOD's first level from the others.
+  const std::vector<scene::NodeInstance> instances = scene::flattenInstances(*loaded.scene);
+  std::vector<std::size_t> childIndex(instances.size(), 0);
+  std::vector<std::size_t> childrenSeen(instances.size(), 0);
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    if (instances[i].parent >= 0) {
+      childIndex[i] = childrenSeen[static_cast<std::size_t>(instances[i].parent)]++;
+    }
+  }
+  // Groups of LOD objects are numbered above every object id.
+  const std::uint64_t lodGroupBase = std::uint64_t{1} << 40;
   for (const scene::SceneObject& object : loaded.objects) {
+    bool laterLevel = false;
+    int outermostLod = -1;
+    for (int node = object.instance; node >= 0 && instances[node].parent >= 0;
+         node = instances[node].parent) {
+      const int parent = instances[node].parent;
+      if (instances[parent].node->kind == scene::NodeKind::kLod) {
+        outermostLod = parent;
+        if (childIndex[node] != 0) laterLevel = true;
+      }
+    }
+    ObjectExtent extent;
+    extent.id = object.id;
+    extent.group =
+        outermostLod >= 0 ? lodGroupBase + static_cast<std::uint64_t>(outermostLod) : object.id;
+    loaded.extents.push_back(extent);
+    if (laterLevel) {
+      ++loaded.laterLodLevelObjects;
+      const render::Material material = scene::shapeMaterial(*object.shape);
+      loaded.meshColors[object.id] = material.diffuse;
+      continue;
+    }
     const render::Material material = scene::shapeMaterial(*object.shape);
     loaded.meshColors[object.id] = material.diffuse;
     if (!material.lit) ++loaded.unlitObjects;
@@ -31,6 +64,7 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     item.object.transform = object.objectToWorld;
     item.worldCentre = object.worldBounds.center();
     item.blended = material.alphaMode == render::AlphaMode::kBlend;
+    item.extent = loaded.extents.size() - 1;
     loaded.referenceTriangles += object.fullMesh != nullptr ? object.fullMesh->triangleCount() : 0;
     loaded.reference.push_back(std::move(item));
   }

@@ -2,6 +2,11 @@
 // every daemon numbers them (scene::collectSceneObjects), the full-quality
 // reference objects (full meshes, scene materials, object -> world), the
 // scene's lights, and each object's colour for the meshes the backbone sends.
+// An LOD's full quality is its first level: objects reached through a later
+// level of any LOD are not drawn in the reference (the paper's Figure 10
+// pattern USEs the same Shape in every level, which would otherwise be drawn
+// once per level), and all objects under one outermost LOD form one group
+// for the completeness check (ObjectExtent::group).
 // Reads files (the scene and its meshes); errors name the path.
 #pragma once
 
@@ -16,6 +21,7 @@
 #include "thinlod/common/scene_objects.h"
 #include "thinlod/common/status.h"
 #include "thinlod/frontend/reference_renderer.h"
+#include "thinlod/frontend/shown_frames.h"
 #include "wire_conversion.h"
 
 namespace thinlod::frontend::daemon {
@@ -24,6 +30,7 @@ struct ReferenceItem {
   ReferenceObject object;
   glm::vec3 worldCentre{0.0f};  // for back-to-front order of blended materials
   bool blended = false;
+  std::size_t extent = 0;  // index into LoadedScene::extents (coverage colour)
 };
 
 struct LoadedScene {
@@ -35,6 +42,8 @@ struct LoadedScene {
   std::size_t unlitObjects = 0;  // objects without a Material (drawn lit by the frontend)
   std::vector<ReferenceItem> reference;
   std::size_t referenceTriangles = 0;
+  std::size_t laterLodLevelObjects = 0;  // left out of the reference
+  std::vector<ObjectExtent> extents;     // every object, for completeness
 };
 
 Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::string& modelsDir);

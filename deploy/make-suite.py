@@ -1,0 +1,361 @@
+#!/usr/bin/env python3
+"""Writes the workbench's scene suite into deploy/data (docs/results/workbench.md):
+
+  gallery.wrl          a museum hall: 31 objects of very different sizes (a 1.8 m bunny, a horse,
+                       the Nefertiti bust: 69k-100k triangles each; a 0.15 m Suzanne), DEF/USE
+                       instancing (pedestals, columns, a pair of teapots), two LOD nodes with
+                       imposter levels in the pattern of the paper's Figure 10, a flat object
+                       (woody.obj, z = 0 for every vertex) and a 2 cm thin painting, primitives.
+  city.wrl             a city grid: 1,024 buildings and 256 kiosks (1,280 Box instances, 8
+                       DEF'd shapes USEd), 320 m across: culling and reuse matter.
+  paper-walk.trace     the paper's flight path through paper-room.wrl, 120 poses over 11.9 s
+                       (0.1 s apart) instead of 72 s, so a live run takes 12 s.
+  gallery-tour.trace   a walk down the hall at about 0.6 m/s, looking left and right, 12 s.
+  gallery-fast.trace   a fast walk (1.3 m/s) with sudden turns (90-180 degrees in 0.2-0.3 s), 10 s.
+  city-walk.trace      a walk along an avenue at 1.4 m/s with a turn at a crossing, 12 s.
+
+Model sizes are read from the model files in --models-dir (default ../shared/models), so the
+scale factors written into the scenes are exact; the scenes name the models by file name only
+(the daemons find them through --models-dir). Deterministic: fixed seeds, no time stamps.
+
+Usage: deploy/make-suite.py [--models-dir DIR] [--out DIR]
+"""
+import argparse
+import importlib.util
+import math
+import os
+import random
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def model_bounds(path):
+    """Axis-aligned bounds (lo, hi) of an OBJ or binary/ASCII PLY file's vertices."""
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+
+    def extend(p):
+        for k in range(3):
+            lo[k] = min(lo[k], p[k])
+            hi[k] = max(hi[k], p[k])
+
+    if path.endswith(".obj"):
+        with open(path, errors="replace") as f:
+            for line in f:
+                if line.startswith("v "):
+                    extend([float(x) for x in line.split()[1:4]])
+        return lo, hi
+    with open(path, "rb") as f:
+        fmt, count, props = None, 0, []
+        in_vertex = False
+        while True:
+            line = f.readline().decode("ascii", "replace").strip()
+            if line.startswith("format"):
+                fmt = line.split()[1]
+            elif line.startswith("element"):
+                in_vertex = line.split()[1] == "vertex"
+                if in_vertex:
+                    count = int(line.split()[2])
+            elif line.startswith("property") and in_vertex:
+                props.append(line.split()[1])
+            elif line == "end_header":
+                break
+        sizes = {"float": 4, "float32": 4, "double": 8, "float64": 8}
+        if fmt == "ascii":
+            for _ in range(count):
+                extend([float(x) for x in f.readline().split()[:3]])
+            return lo, hi
+        if fmt != "binary_little_endian" or any(p not in sizes for p in props):
+            raise SystemExit(f"make-suite: {path}: unsupported PLY layout {fmt} {props}")
+        codes = "".join("f" if sizes[p] == 4 else "d" for p in props)
+        stride = struct.calcsize("<" + codes)
+        data = f.read(count * stride)
+        for i in range(count):
+            extend(struct.unpack_from("<" + codes, data, i * stride)[:3])
+    return lo, hi
+
+
+def fmt(*values):
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def material(rgb):
+    return f"appearance Appearance {{ material Material {{ diffuseColor {fmt(*rgb)} }} }}"
+
+
+class Gallery:
+    """A hall x in [0, 20], z in [0, 10] (metres, y up); objects along both long walls."""
+
+    # name: (file, up axis of the model, height in the hall (m), colour)
+    MODELS = {
+        "bunny": ("stanford-bunny.obj", "y", 1.8, (0.85, 0.8, 0.7)),
+        "horse": ("horse.ply", "z", 1.1, (0.55, 0.4, 0.3)),
+        "nefertiti": ("nefertiti.obj", "z", 0.55, (0.8, 0.65, 0.4)),
+        "cow": ("cow.obj", "y", 0.3, (0.8, 0.75, 0.65)),
+        "spot": ("spot.obj", "y", 0.35, (0.9, 0.55, 0.3)),
+        "teapot": ("teapot.obj", "y", 0.22, (0.3, 0.55, 0.8)),
+        "suzanne": ("suzanne.obj", "y", 0.15, (0.7, 0.3, 0.6)),
+        "cheburashka": ("cheburashka.obj", "y", 0.35, (0.6, 0.45, 0.3)),
+        "fandisk": ("fandisk.obj", "y", 0.3, (0.6, 0.6, 0.65)),
+        "woody": ("woody.obj", "y", 1.0, (0.8, 0.5, 0.25)),
+    }
+
+    def __init__(self, models_dir):
+        self.models_dir = models_dir
+        self.parts = []
+        self.objects = 0
+
+    def fitted(self, name, base, yaw_deg, shape_def=None, use=None):
+        """Transform nest placing model `name` with its bottom centre at `base`, turned by
+        `yaw_deg` about +y; the Shape is DEF'd as `shape_def` (default the capitalised name),
+        or `USE use` of an earlier one. Returns the VRML text and the Shape's DEF name."""
+        file, up, height, rgb = self.MODELS[name]
+        lo, hi = model_bounds(os.path.join(self.models_dir, file))
+        centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+        if up == "y":
+            bottom = (centre[0], lo[1], centre[2])
+            fix = "0 0 1 0"
+            extent = hi[1] - lo[1]
+        else:  # z up: rotate -90 degrees about x, (x, y, z) -> (x, z, -y)
+            bottom = (centre[0], centre[1], lo[2])
+            fix = "1 0 0 -1.5708"
+            extent = hi[2] - lo[2]
+        scale = height / extent
+        shape_def = shape_def or name.capitalize()
+        shape = (f"USE {use}" if use else
+                 f"DEF {shape_def} Shape {{ {material(rgb)} geometry Inline {{ url \"{file}\" }} }}")
+        text = (f"Transform {{ translation {fmt(*base)} rotation 0 1 0 {math.radians(yaw_deg):.6g}\n"
+                f"  children Transform {{ rotation {fix} scale {fmt(scale, scale, scale)}\n"
+                f"    children Transform {{ translation {fmt(*[-c for c in bottom])}\n"
+                f"      children {shape} }} }} }}")
+        return text, shape_def
+
+    def add(self, comment, text, objects):
+        self.parts.append(f"# {comment}\n{text}\n")
+        self.objects += objects
+
+    def lod_statue(self, name, base, yaw_deg, far):
+        """The paper's Figure 10: level 0 the Shape, level 1 a SimpleImposter of it (only
+        beyond `far` metres), level 2 a MeshedImposter of it, everywhere."""
+        statue, shape = self.fitted(name, (0, 0, 0), 0)
+        self.add(f"{name}: LOD with imposter levels (Figure 10 pattern)",
+                 f"Transform {{ translation {fmt(*base)} rotation 0 1 0 {math.radians(yaw_deg):.6g}\n"
+                 f"  children LOD {{\n"
+                 f"    level [\n      {statue}\n"
+                 f"      SimpleImposter {{ children [ USE {shape} ] }}\n"
+                 f"      MeshedImposter {{ children [ USE {shape} ] }}\n    ]\n"
+                 f"    range [ ConicRange {{}}, ConicRange {{ distance {far:g} 1000 }}, ConicRange {{}} ]\n"
+                 f"  }} }}", 3)
+
+    def on_pedestal(self, name, x, z, yaw_deg, shape_def=None, use=None):
+        pedestal = ("DEF Pedestal Shape { " + material((0.45, 0.45, 0.5)) +
+                    " geometry Box { size 0.6 1 0.6 } }") if not self.pedestals else "USE Pedestal"
+        self.add(f"pedestal ({'USE' if self.pedestals else 'DEF'})",
+                 f"Transform {{ translation {fmt(x, 0.5, z)} children {pedestal} }}", 1)
+        self.pedestals += 1
+        text, shape = self.fitted(name, (x, 1.0, z), yaw_deg, shape_def, use)
+        self.add(f"{name} on its pedestal" + (f" (USE {use})" if use else ""), text, 1)
+        return shape
+
+    def write(self, path):
+        self.pedestals = 0
+        self.lod_statue("bunny", (4.0, 0.0, 8.3), 200, 6)
+        self.add("plinth of the horse", "Transform { translation 10 0.25 8.3 children Shape { " +
+                 material((0.4, 0.4, 0.45)) + " geometry Box { size 2.2 0.5 1.2 } } }", 1)
+        self.lod_statue("horse", (10.0, 0.5, 8.3), 90, 6)
+        for name, x, z in (("cow", 6.5, 1.7), ("suzanne", 9.0, 1.7), ("spot", 11.5, 1.7),
+                           ("cheburashka", 14.0, 1.7), ("fandisk", 1.5, 8.3),
+                           ("nefertiti", 16.0, 8.3), ("teapot", 3.5, 1.7)):
+            self.on_pedestal(name, x, z, 180 if z > 5 else 20)
+        # The teapot's twin shares its Shape (and mesh) through USE, placed on its own.
+        self.on_pedestal("teapot", 17.5, 1.7, -30, use="Teapot")
+        woody, _ = self.fitted("woody", (19.9, 1.0, 5.0), -90)
+        self.add("woody.obj: a flat gingerbread man (every z = 0) on the end wall, facing -x",
+                 woody, 1)
+        self.add("a painting 2 cm thin on the back wall",
+                 "Transform { translation 10 1.9 9.95 children Shape { " +
+                 material((0.75, 0.2, 0.15)) + " geometry Box { size 2.4 1.4 0.02 } } }", 1)
+        for i, x in enumerate((2.5, 7.5, 12.5, 17.5)):
+            column = ("DEF Column Shape { " + material((0.85, 0.85, 0.8)) +
+                      " geometry Cylinder { radius 0.25 height 3 } }") if i == 0 else "USE Column"
+            self.add(f"column {i} ({'DEF' if i == 0 else 'USE'})",
+                     f"Transform {{ translation {fmt(x, 1.5, 5.0 + (1.2 if i % 2 else -1.2))} "
+                     f"children {column} }}", 1)
+        self.add("a sculpture of primitives: a cone with a sphere on top",
+                 "Transform { translation 13 0.6 5 children [\n"
+                 "  Shape { " + material((0.2, 0.6, 0.35)) +
+                 " geometry Cone { bottomRadius 0.45 height 1.2 } }\n"
+                 "  Transform { translation 0 0.85 0 children Shape { " +
+                 material((0.9, 0.8, 0.2)) + " geometry Sphere { radius 0.3 } } } ] }", 2)
+        body = "".join(self.parts)
+        with open(path, "w") as f:
+            f.write("#VRML V2.0 utf8\n")
+            f.write("# Workbench gallery (made by deploy/make-suite.py; do not edit by hand).\n")
+            f.write(f"# A hall x [0, 20], z [0, 10] m, y up; {self.objects} drawable objects.\n")
+            f.write("# Models are named by file name and found through --models-dir.\n\n")
+            f.write('Viewpoint { description "entrance" position 0.5 1.6 5 '
+                    'orientation 0 1 0 -1.5708 fieldOfView 0.9 }\n')
+            f.write("DirectionalLight { direction 0.3 -1.0 -0.5 intensity 0.9 ambientIntensity 0.3 }\n\n")
+            f.write(body)
+        return self.objects
+
+
+def write_city(path, seed=12):
+    """1,024 buildings on a 32 x 32 grid of 10 m blocks and 256 kiosks along the avenues."""
+    rng = random.Random(seed)
+    colours = [(0.6, 0.6, 0.65), (0.7, 0.55, 0.45), (0.45, 0.5, 0.6), (0.75, 0.7, 0.6)]
+    lines = ["#VRML V2.0 utf8",
+             "# Workbench city (made by deploy/make-suite.py; do not edit by hand).",
+             "# 32 x 32 blocks of 10 m (x, z in [-160, 160]), streets 4 m wide at x, z = 10 k;",
+             "# 1,024 buildings (4 DEF'd unit boxes USEd with their own scale) and 256 kiosks.",
+             'Viewpoint { description "avenue" position 0 1.7 150 fieldOfView 0.9 }',
+             "DirectionalLight { direction 0.4 -1.0 -0.3 intensity 0.9 ambientIntensity 0.3 }"]
+    count = 0
+    defined = set()
+    for i in range(32):
+        for j in range(32):
+            x = -155 + 10 * i
+            z = -155 + 10 * j
+            k = (i * 7 + j * 3) % 4
+            h = rng.choice((4, 6, 9, 12, 18, 25)) * (0.8 + 0.4 * rng.random())
+            w, d = 6 * (0.8 + 0.2 * rng.random()), 6 * (0.8 + 0.2 * rng.random())
+            shape = (f"USE Building{k}" if k in defined else
+                     f"DEF Building{k} Shape {{ {material(colours[k])} geometry Box {{ size 1 1 1 }} }}")
+            defined.add(k)
+            lines.append(f"Transform {{ translation {fmt(x, h / 2, z)} scale {fmt(w, h, d)} "
+                         f"children {shape} }}")
+            count += 1
+    kiosk_colours = [(0.2, 0.6, 0.3), (0.8, 0.3, 0.2), (0.9, 0.8, 0.3), (0.3, 0.4, 0.8)]
+    kiosks = 0
+    for a in range(16):
+        for b in range(16):
+            x = -160 + 20 * a + 10 + (1.5 if b % 2 else -1.5)
+            z = -155 + 20 * b
+            k = (a + b) % 4
+            shape = (f"USE Kiosk{k}" if ("kiosk", k) in defined else
+                     f"DEF Kiosk{k} Shape {{ {material(kiosk_colours[k])} geometry Box {{ size 1.2 2.2 1.2 }} }}")
+            defined.add(("kiosk", k))
+            lines.append(f"Transform {{ translation {fmt(x, 1.1, z)} children {shape} }}")
+            kiosks += 1
+    # The first DEF of each building kind must come before its USEs.
+    text = "\n".join(lines) + "\n"
+    for k in range(4):
+        d = text.find(f"DEF Building{k} ")
+        u = text.find(f"USE Building{k}")
+        assert d != -1 and (u == -1 or d < u), f"Building{k}"
+        d = text.find(f"DEF Kiosk{k} ")
+        u = text.find(f"USE Kiosk{k}")
+        assert d != -1 and (u == -1 or d < u), f"Kiosk{k}"
+    with open(path, "w") as f:
+        f.write(text)
+    return count + kiosks
+
+
+def write_trace(path, title, poses, fov_deg):
+    """poses: [(t, eye, target)]."""
+    with open(path, "w") as f:
+        f.write("# thinlod-trace 1\n")
+        f.write(f"# {title} (made by deploy/make-suite.py)\n")
+        f.write("# time_s  px py pz  lookat tx ty tz  fov_deg\n")
+        for t, e, g in poses:
+            f.write(f"{t:.3f} {fmt(*e)} lookat {fmt(*g)} {fov_deg:g}\n")
+
+
+def max_speed(poses):
+    return max(math.dist(a[1], b[1]) / (b[0] - a[0]) for a, b in zip(poses, poses[1:]))
+
+
+def along(points, speed, dt, heading_of):
+    """Walks the polyline `points` (x, y, z) at `speed` m/s, a pose every `dt` s; the look
+    direction at time t is heading_of(t, position, segment direction) -> target."""
+    seg_lengths = [math.dist(a, b) for a, b in zip(points, points[1:])]
+    total = sum(seg_lengths)
+    poses, t = [], 0.0
+    while t * speed <= total + 1e-9:
+        s, k = t * speed, 0
+        while k < len(seg_lengths) - 1 and s > seg_lengths[k]:
+            s -= seg_lengths[k]
+            k += 1
+        a, b = points[k], points[k + 1]
+        u = min(s / seg_lengths[k], 1.0)
+        p = tuple(a[i] + (b[i] - a[i]) * u for i in range(3))
+        direction = tuple((b[i] - a[i]) / seg_lengths[k] for i in range(3))
+        poses.append((round(t, 6), p, heading_of(t, p, direction)))
+        t += dt
+    return poses
+
+
+def yaw_target(p, yaw_deg, down=0.25):
+    """A look-at target 1 m from p at yaw (0 = +x, 90 = -z, counter-clockwise seen from +y)."""
+    a = math.radians(yaw_deg)
+    return (p[0] + math.cos(a), p[1] - down, p[2] - math.sin(a))
+
+
+def smoothstep(x):
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def yaw_schedule(keys):
+    """keys: [(t, yaw_deg)]; yaw holds between keys and turns in the key's duration."""
+    def yaw(t):
+        value = keys[0][1]
+        for start, duration, target in keys[1:]:
+            if t >= start:
+                value = value + (target - value) * smoothstep((t - start) / duration)
+        return value
+    return yaw
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--models-dir", default=os.path.join(HERE, "..", "..", "shared", "models"))
+    parser.add_argument("--out", default=os.path.join(HERE, "data"))
+    args = parser.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+
+    objects = Gallery(args.models_dir).write(os.path.join(args.out, "gallery.wrl"))
+    instances = write_city(os.path.join(args.out, "city.wrl"))
+
+    # The paper's flight, same key frames and spline, 0.1 s per pose.
+    spec = importlib.util.spec_from_file_location("paper", os.path.join(HERE, "make-paper-trace.py"))
+    paper = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(paper)
+    frames = 120
+    scale = (paper.FRAMES - 1) / (frames - 1)
+    walk = [(0.1 * i, paper.spline(1, i * scale), paper.spline(2, i * scale)) for i in range(frames)]
+    write_trace(os.path.join(args.out, "paper-walk.trace"),
+                f"the paper's flight through paper-room.wrl, {frames} poses 0.1 s apart "
+                f"(max {max_speed(walk):.2f} m/s)", walk, paper.FOV_DEG)
+
+    # Gallery tour: down the aisle (z = 5) at 0.6 m/s, turning the head to each side.
+    tour_points = [(0.5, 1.6, 5.0), (7.7, 1.6, 5.0)]
+    look = yaw_schedule([(0, 0), (1.0, 2.0, 60), (4.0, 2.5, -60), (7.5, 2.5, 45), (10.5, 1.5, 0)])
+    tour = along(tour_points, 0.6, 0.1, lambda t, p, d: yaw_target(p, look(t)))[:120]
+    write_trace(os.path.join(args.out, "gallery-tour.trace"),
+                f"gallery tour at 0.6 m/s, {len(tour)} poses", tour, 60)
+
+    # Fast walk: 1.3 m/s along the aisle and back, with sudden turns.
+    fast_points = [(0.5, 1.6, 5.0), (12.0, 1.6, 5.0), (12.0, 1.6, 3.0), (4.0, 1.6, 3.0)]
+    snap = yaw_schedule([(0, 0), (1.5, 0.2, 90), (2.5, 0.25, -90), (4.0, 0.2, 0),
+                         (6.0, 0.3, 180), (7.5, 0.2, 90), (8.5, 0.25, 200)])
+    fast = along(fast_points, 1.3, 1 / 15, lambda t, p, d: yaw_target(p, snap(t), 0.15))[:150]
+    write_trace(os.path.join(args.out, "gallery-fast.trace"),
+                f"fast walk through the gallery at 1.3 m/s with sudden turns, {len(fast)} poses",
+                fast, 60)
+
+    # City: along the avenue x = 0 (a street) at 1.4 m/s, turning right at the crossing z = 140.
+    city_points = [(0.0, 1.7, 150.0), (0.0, 1.7, 140.0), (10.0, 1.7, 140.0)]
+    heading = yaw_schedule([(0, 90), (7.0, 1.2, 0)])
+    city = along(city_points, 1.4, 0.1, lambda t, p, d: yaw_target(p, heading(t), 0.05))[:120]
+    write_trace(os.path.join(args.out, "city-walk.trace"),
+                f"city walk at 1.4 m/s with a turn at a crossing, {len(city)} poses", city, 60)
+
+    print(f"make-suite: gallery {objects} objects, city {instances} instances; traces: "
+          f"paper-walk {len(walk)} ({max_speed(walk):.2f} m/s), gallery-tour {len(tour)} "
+          f"({max_speed(tour):.2f} m/s), gallery-fast {len(fast)} ({max_speed(fast):.2f} m/s), "
+          f"city-walk {len(city)} ({max_speed(city):.2f} m/s)")
+
+
+if __name__ == "__main__":
+    main()
