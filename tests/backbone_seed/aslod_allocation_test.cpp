@@ -9,6 +9,8 @@
 #include <numeric>
 #include <random>
 
+#include "active_set_optimiser.h"
+
 namespace thinlod::backbone {
 namespace {
 
@@ -275,6 +277,59 @@ TEST(AslodAllocation, RandomScenesNeverExceedTheBudget) {
   }
   EXPECT_GT(feasible, 700);
   EXPECT_GT(exhausted, 50);
+}
+
+}  // namespace
+}  // namespace thinlod::backbone
+
+// The cross-check between the two seed implementations (issue: "equal to the
+// Gobbetti-Bouvier closed form when alpha = k + 1 and no bound is active").
+// Gobbetti-Bouvier minimises sum a_i / r_i^k under sum c_i r_i <= P. With
+// r_i = p_i / H (H triangles at full resolution, c_i = H) and a_i = w_i / H^k
+// the objective is sum w_i / p_i^k, whose optimum under sum p_i = P is
+// p_i = P w_i^(1/(k+1)) / sum_j w_j^(1/(k+1)): ASLOD with alpha = k + 1.
+
+namespace thinlod::backbone {
+namespace {
+
+TEST(AslodCrossCheck, EqualsTheActiveSetOptimumWhenAlphaIsKPlusOneAndNoBoundBinds) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> area(1e-4, 1.0);
+  constexpr double kFull = 1e6;  // H: no upper bound is reached
+  constexpr double kBudget = 5000.0;
+  for (double k : {1.0, 2.0, 3.0}) {
+    for (int trial = 0; trial < 5; ++trial) {
+      std::vector<AslodObject> objects(50);
+      ResolutionProblem problem;
+      problem.exponent = k;
+      problem.budget = kBudget;
+      for (AslodObject& o : objects) {
+        o.weight = area(rng);
+        o.minTriangles = 0.0;
+        o.maxTriangles = kFull;
+        ResolutionVariable v;
+        v.weight = o.weight / std::pow(kFull, k);
+        v.cost = kFull;
+        v.minResolution = 1e-12;  // no lower bound binds either
+        problem.variables.push_back(v);
+      }
+      AslodConfig config;
+      config.alpha = k + 1.0;
+      auto aslod = allocateAslod(objects, kBudget, config);
+      ASSERT_TRUE(aslod.ok()) << aslod.status().toString();
+      auto optimum = solveResolutionsActiveSet(problem, ActiveSetOptions{});
+      ASSERT_TRUE(optimum.ok()) << optimum.status().toString();
+      ASSERT_EQ(optimum->outcome, ResolutionOutcome::kOptimal);
+      for (std::size_t i = 0; i < objects.size(); ++i) {
+        const double optimal = optimum->resolution[i] * kFull;
+        // ASLOD's unrounded share is the closed form; its counts are whole
+        // triangles (largest remainder), so within one of it.
+        EXPECT_NEAR(aslod->paperShare[i], optimal, 1e-6 * kBudget) << "k " << k << " object " << i;
+        EXPECT_LE(std::abs(double(aslod->triangles[i]) - optimal), 1.0 + 1e-6)
+            << "k " << k << " object " << i;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -117,9 +117,7 @@ class AslodMethod final : public SelectionMethod {
   explicit AslodMethod(const AslodSchedulerConfig& config) : config_(config) {}
   const char* name() const override { return "aslod"; }
   Status accepts(const Budget& budget) const override {
-    if (!budget.maxTriangles)
-      return Status(ErrorCode::kUnsupported, "aslod needs Budget.maxTriangles");
-    return Status::okStatus();
+    return requirePolygonBudget(name(), budget);
   }
   Result<Selection> select(const SelectionStep& step) const override;
 
@@ -258,9 +256,7 @@ class SpanOfLevelChangedMethod final : public SelectionMethod {
   explicit SpanOfLevelChangedMethod(const SpanOfLevelChangedConfig& config) : config_(config) {}
   const char* name() const override { return "span-of-level-changed"; }
   Status accepts(const Budget& budget) const override {
-    if (!budget.maxTriangles)
-      return Status(ErrorCode::kUnsupported, "span-of-level-changed needs Budget.maxTriangles");
-    return Status::okStatus();
+    return requirePolygonBudget(name(), budget);
   }
   Result<Selection> select(const SelectionStep& step) const override;
 

@@ -13,19 +13,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
-                        std::vector<LeafSelection>& out) {
-  const VisibleNode& n = tree.nodes[k];
-  if (n.kind == SceneNodeKind::kLeaf) {
-    LeafSelection s;
-    s.node = n.sceneNode;
-    s.object = scene.nodes[n.sceneNode].object;
-    out.push_back(s);
-  } else if (n.kind == SceneNodeKind::kGroup) {
-    for (std::uint32_t c : n.children) reportUnrenderable(tree, scene, c, out);
-  }
-}
-
 // ---------------------------------------------------------------- VRML97
 
 class VrmlStaticMethod final : public SelectionMethod {
@@ -107,9 +94,7 @@ class GreedyMethod final : public SelectionMethod {
   explicit GreedyMethod(const GreedyConfig& greedy) : greedy_(greedy) {}
   const char* name() const override { return "greedy-fs93"; }
   Status accepts(const Budget& budget) const override {
-    if (!budget.maxTriangles)
-      return Status(ErrorCode::kUnsupported, "greedy-fs93 needs Budget.maxTriangles");
-    return Status::okStatus();
+    return requirePolygonBudget(name(), budget);
   }
   Result<Selection> select(const SelectionStep& step) const override;
 

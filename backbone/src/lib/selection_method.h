@@ -14,6 +14,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "joint_solver.h"
@@ -40,6 +41,13 @@ struct Selection {
   std::optional<double> targetAccuracy;
   const char* mode = nullptr;  // nullptr: modeName(budget)
 };
+
+// The accepts() of a method that schedules a polygon budget only.
+inline Status requirePolygonBudget(const char* method, const Budget& budget) {
+  if (!budget.maxTriangles)
+    return Status(ErrorCode::kUnsupported, std::string(method) + " needs Budget.maxTriangles");
+  return Status::okStatus();
+}
 
 class SelectionMethod {
  public:

@@ -27,19 +27,6 @@ struct Item {
   double visibility = 0.0;    // diameter / distance, for dropping
 };
 
-void unrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
-                  std::vector<LeafSelection>& out) {
-  const VisibleNode& n = tree.nodes[k];
-  if (n.kind == SceneNodeKind::kLeaf) {
-    LeafSelection s;
-    s.node = n.sceneNode;
-    s.object = scene.nodes[n.sceneNode].object;
-    out.push_back(s);
-  } else if (n.kind == SceneNodeKind::kGroup) {
-    for (std::uint32_t c : n.children) unrenderable(tree, scene, c, out);
-  }
-}
-
 // Triangles a candidate costs at its lowest and at its highest accuracy.
 double lowestTriangles(const LeafCandidate& c) {
   if (c.source != CandidateSource::kNew) return c.fixedTriangles;
@@ -124,7 +111,7 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
       continue;
     }
     if (n.candidates.empty()) {
-      unrenderable(tree, scene, k, out);
+      reportUnrenderable(tree, scene, k, out);
       continue;
     }
     Item item;

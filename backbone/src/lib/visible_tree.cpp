@@ -73,4 +73,17 @@ VisibleTree buildVisibleTree(const SchedulingScene& scene, const SchedulerConfig
   return tree;
 }
 
+void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
+                        std::vector<LeafSelection>& out) {
+  const VisibleNode& n = tree.nodes[k];
+  if (n.kind == SceneNodeKind::kLeaf) {
+    LeafSelection s;
+    s.node = n.sceneNode;
+    s.object = scene.nodes[n.sceneNode].object;
+    out.push_back(s);
+  } else if (n.kind == SceneNodeKind::kGroup) {
+    for (std::uint32_t c : n.children) reportUnrenderable(tree, scene, c, out);
+  }
+}
+
 }  // namespace thinlod::backbone

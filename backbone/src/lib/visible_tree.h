@@ -28,4 +28,9 @@ VisibleTree buildVisibleTree(const SchedulingScene& scene, const SchedulerConfig
                              const PredictedRegion& region, const PlannerStateImpl& state,
                              PlanStats& stats);
 
+// Every leaf below tree node k as an unrendered LeafSelection (a subtree
+// that renders nothing), groups recursively, LODs not descended.
+void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
+                        std::vector<LeafSelection>& out);
+
 }  // namespace thinlod::backbone
