@@ -30,31 +30,23 @@ using thinlod::backbone_daemon::PoseOutcome;
 namespace protocol = thinlod::protocol;
 using Clock = std::chrono::steady_clock;
 
+// The shell's own settings; everything the core is configured with is bound
+// straight to `core` (one default each: CoreOptions / SchedulerConfig).
 struct Settings {
+  CoreOptions core;
   std::string scene;
   std::string modelsDir;
-  std::string scheduler = "accuracy-curve";
   double budgetPolygons = 0.0;
   double budgetLink = 0.0;
   double accuracy = 0.0;
   double budgetFrameMs = 0.0;
   std::string frameCost;
-  double maxSpeed = 0.1;
-  double maxAngularSpeed = 1.0;
-  double lifetime = 1.0;
-  double linkDelay = 0.05;
-  double generationDelay = 0.1;
-  double minimalDistance = 0.1;
   int syncWaitMs = 0;
   double curveTimeoutS = 60.0;
-  int curvePoints = 32;
-  int textureSize = 256;
-  std::string textureCodec = "png";
-  double simpleImpostorRadii = 10.0;
-  double meshedImpostorRadii = 4.0;
-  double meshedImpostorTriangles = 64.0;
-  bool polygonCap = true;
-  double linkBurst = 0.0;
+  // Range-checked and converted into `core` by coreOptions(); defaults from it.
+  int curvePoints = CoreOptions{}.curvePoints;
+  int textureSize = static_cast<int>(CoreOptions{}.textureSize);
+  std::string textureCodec = thinlod::textureCodecName(CoreOptions{}.textureCodec);
   std::string decisionsCsv;
   std::string readyFile;
   std::string frontendAddress = protocol::kDefaultFrontendAddress;
@@ -67,7 +59,7 @@ struct Settings {
 void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("scene", &s.scene, "scene file (required)");
   runtime.addOption("models-dir", &s.modelsDir, "where the scene's mesh files are looked up first");
-  runtime.addOption("scheduler", &s.scheduler,
+  runtime.addOption("scheduler", &s.core.scheduler,
                     "selection method, by name or alias:\n" + thinlod::backbone::schedulerHelp());
   runtime.addOption("budget-polygons", &s.budgetPolygons,
                     "triangles the frontend may hold (0: no polygon budget)");
@@ -78,12 +70,14 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("frame-cost", &s.frameCost,
                     "the frontend's frame-cost constants (TOML written by bench_calibrate); "
                     "required with --budget-frame-ms");
-  runtime.addOption("max-speed", &s.maxSpeed, "viewer speed bound (m/s) for prediction");
-  runtime.addOption("max-angular-speed", &s.maxAngularSpeed, "viewer turn rate bound (rad/s)");
-  runtime.addOption("lifetime", &s.lifetime, "planned lifetime of a representation (s)");
-  runtime.addOption("link-delay", &s.linkDelay, "backbone -> frontend delay (s)");
-  runtime.addOption("generation-delay", &s.generationDelay, "simplifier generation delay (s)");
-  runtime.addOption("minimal-distance", &s.minimalDistance,
+  thinlod::backbone::SchedulerConfig& config = s.core.config;
+  runtime.addOption("max-speed", &config.maxSpeed, "viewer speed bound (m/s) for prediction");
+  runtime.addOption("max-angular-speed", &config.maxAngularSpeed, "viewer turn rate bound (rad/s)");
+  runtime.addOption("lifetime", &config.plannedLifetime,
+                    "planned lifetime of a representation (s)");
+  runtime.addOption("link-delay", &config.linkDelay, "backbone -> frontend delay (s)");
+  runtime.addOption("generation-delay", &config.generationDelay, "simplifier generation delay (s)");
+  runtime.addOption("minimal-distance", &config.minimalDistance,
                     "lower clamp of the viewer-object distance (m)");
   runtime.addOption("sync-wait-ms", &s.syncWaitMs,
                     "wait this long for a plan's simplifier results, then re-plan once (0: live)");
@@ -92,15 +86,15 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("curve-points", &s.curvePoints, "curve samples asked for per mesh");
   runtime.addOption("texture-size", &s.textureSize, "impostor texture size (pixels per side)");
   runtime.addOption("texture-codec", &s.textureCodec, "impostor textures: png | jpeg | zstd | raw");
-  runtime.addOption("simple-impostor-radii", &s.simpleImpostorRadii,
+  runtime.addOption("simple-impostor-radii", &s.core.simpleImpostorRadii,
                     "simple impostors from this many bounding radii away (0: none)");
-  runtime.addOption("meshed-impostor-radii", &s.meshedImpostorRadii,
+  runtime.addOption("meshed-impostor-radii", &s.core.meshedImpostorRadii,
                     "meshed impostors from this many bounding radii away (0: none)");
-  runtime.addOption("meshed-impostor-triangles", &s.meshedImpostorTriangles,
+  runtime.addOption("meshed-impostor-triangles", &s.core.meshedImpostorTriangles,
                     "triangles of a meshed impostor until the first one is measured");
-  runtime.addOption("frontend-polygon-cap", &s.polygonCap,
+  runtime.addOption("frontend-polygon-cap", &s.core.hardPolygonCap,
                     "never let the frontend hold more than --budget-polygons (=false to allow)");
-  runtime.addOption("link-burst", &s.linkBurst,
+  runtime.addOption("link-burst", &s.core.linkBurstBytes,
                     "link shaper burst in bytes (0: max(budget-link * lifetime, 64 KiB))");
   runtime.addOption("decisions-csv", &s.decisionsCsv, "write one decision row per pose here");
   runtime.addOption("ready-file", &s.readyFile,
@@ -115,14 +109,7 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
 }
 
 thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
-  CoreOptions o;
-  o.scheduler = s.scheduler;
-  o.config.maxSpeed = s.maxSpeed;
-  o.config.maxAngularSpeed = s.maxAngularSpeed;
-  o.config.plannedLifetime = s.lifetime;
-  o.config.linkDelay = s.linkDelay;
-  o.config.generationDelay = s.generationDelay;
-  o.config.minimalDistance = s.minimalDistance;
+  CoreOptions o = s.core;
   if (s.budgetPolygons > 0.0) o.budget.maxTriangles = s.budgetPolygons;
   if (s.budgetLink > 0.0) o.budget.maxLinkBytesPerSecond = s.budgetLink;
   if (s.accuracy > 0.0) o.budget.fixedAccuracy = s.accuracy;
@@ -170,11 +157,6 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--texture-codec '" + s.textureCodec + "': expected png, jpeg, zstd or raw");
   }
-  o.simpleImpostorRadii = s.simpleImpostorRadii;
-  o.meshedImpostorRadii = s.meshedImpostorRadii;
-  o.meshedImpostorTriangles = s.meshedImpostorTriangles;
-  o.hardPolygonCap = s.polygonCap;
-  o.linkBurstBytes = s.linkBurst;
   if (s.syncWaitMs < 0 || !(s.curveTimeoutS >= 0.0) || s.attemptTimeoutMs <= 0 || s.maxAttempts < 1)
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--sync-wait-ms and --curve-timeout-s must be >= 0, the simplifier attempt "

@@ -41,7 +41,7 @@ struct ViewerState {
 
 struct SchedulerConfig {
   // Prediction (paper 4.1 uses 0.1 m/s in a small room and ~1 s lifetime).
-  double maxSpeed = 1.0;         // m/s
+  double maxSpeed = 0.1;         // m/s (the paper's walking viewer; the daemon's --max-speed)
   double maxAngularSpeed = 1.0;  // rad/s
   double plannedLifetime = 1.0;  // s; also the link accounting window
   double linkDelay = 0.05;       // s
