@@ -133,10 +133,13 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   }
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
-  if (size > options.limits.maxBytes) {
+  const bool imported = isImportedSceneExtension(path);
+  const std::uint64_t maxBytes =
+      imported ? options.importLimits.maxFileBytes : std::uint64_t{options.limits.maxBytes};
+  if (size > maxBytes) {
     return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
                                                      " bytes exceed the limit of " +
-                                                     std::to_string(options.limits.maxBytes));
+                                                     std::to_string(maxBytes));
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
@@ -145,9 +148,12 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   if (static_cast<std::uintmax_t>(in.gcount()) != size) {
     return Status(ErrorCode::kIoError, path + ": short read");
   }
-  Result<Scene> scene = parseScene(text, path, options.limits);
+  Result<Scene> scene =
+      imported ? importScene(path, options.importLimits) : parseScene(text, path, options.limits);
   if (!scene.ok()) return scene.status();
-  THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  if (!imported) {
+    THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  }
   scene->fingerprint = sceneFingerprint(text, *scene);
   return scene;
 }
