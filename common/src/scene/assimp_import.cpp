@@ -1,19 +1,22 @@
 // Assimp edge of the scene module (contract in scene_import.h). Assimp types
 // stay in this file; everything it hands back is checked before use.
 #include <assimp/DefaultIOSystem.h>
-#include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <exception>
 #include <filesystem>
-#include <map>
-#include <set>
+#include <fstream>
 #include <glm/geometric.hpp>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
 
 #include "thinlod/common/scene_import.h"
 
@@ -105,15 +108,153 @@ struct TreeCensus {
   std::vector<bool> meshUsed;
 };
 
+// glTF pre-check, before Assimp sees the file. Assimp trusts a .glb header's
+// declared length and allocates it (a 22-byte file declaring 4 GiB took 4 GB
+// of memory), and it drops faces whose indices are out of range with only a
+// log line. So: the .glb header and chunks must fit the file, and the
+// triangles the JSON declares are counted here, to be compared with what
+// Assimp returns.
+struct GltfDeclared {
+  std::uint64_t triangles = 0;  // mode-4 primitives
+  bool onlyTriangleLists = true;
+};
+
+Result<std::string> readBounded(const std::string& path, std::uint64_t size) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uint64_t>(in.gcount()) != size) {
+    return Status(ErrorCode::kIoError, path + ": short read");
+  }
+  return bytes;
+}
+
+std::uint32_t le32(const std::string& b, std::size_t at) {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 2])) << 16 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
+}
+
+Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
+                                  const ImportLimits& limits) {
+  Result<std::string> bytes = readBounded(path, size);
+  if (!bytes.ok()) return bytes.status();
+  std::string json;
+  if (lowerExtension(path) == ".glb") {
+    const std::string& b = *bytes;
+    if (b.size() < 20 || b.compare(0, 4, "glTF") != 0) {
+      return Status(ErrorCode::kParseError, path + ": not a binary glTF (no 'glTF' header)");
+    }
+    if (le32(b, 4) != 2) {
+      return Status(ErrorCode::kUnsupported,
+                    path + ": binary glTF version " + std::to_string(le32(b, 4)) + " (only 2)");
+    }
+    if (le32(b, 8) != b.size()) {
+      return Status(ErrorCode::kParseError, path + ": header declares " +
+                                                std::to_string(le32(b, 8)) + " bytes, file has " +
+                                                std::to_string(b.size()));
+    }
+    // Every chunk (8-byte header + data) must lie inside the file.
+    for (std::size_t at = 12; at < b.size();) {
+      if (b.size() - at < 8)
+        return Status(ErrorCode::kParseError, path + ": truncated chunk header");
+      const std::uint64_t length = le32(b, at);
+      if (length > b.size() - at - 8) {
+        return Status(ErrorCode::kParseError, path + ": chunk at byte " + std::to_string(at) +
+                                                  " declares " + std::to_string(length) +
+                                                  " bytes past the end of the file");
+      }
+      if (at == 12) {
+        if (le32(b, at + 4) != 0x4E4F534Au) {
+          return Status(ErrorCode::kParseError, path + ": first chunk is not JSON");
+        }
+        json = b.substr(at + 8, static_cast<std::size_t>(length));
+      }
+      at += 8 + static_cast<std::size_t>(length);
+    }
+  } else {
+    json = std::move(*bytes);
+  }
+  const nlohmann::json doc = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded() || !doc.is_object()) {
+    return Status(ErrorCode::kParseError, path + ": not valid glTF JSON");
+  }
+  GltfDeclared declared;
+  const auto accessors = doc.find("accessors");
+  auto accessorCount = [&](const nlohmann::json& index) -> std::optional<std::uint64_t> {
+    if (!index.is_number_unsigned() || accessors == doc.end() || !accessors->is_array()) {
+      return std::nullopt;
+    }
+    const std::uint64_t i = index.get<std::uint64_t>();
+    if (i >= accessors->size()) return std::nullopt;
+    const nlohmann::json& a = (*accessors)[static_cast<std::size_t>(i)];
+    if (!a.is_object() || !a.contains("count") || !a["count"].is_number_unsigned()) {
+      return std::nullopt;
+    }
+    return a["count"].get<std::uint64_t>();
+  };
+  const auto meshes = doc.find("meshes");
+  if (meshes == doc.end() || !meshes->is_array()) return declared;  // Assimp judges the rest
+  for (const nlohmann::json& mesh : *meshes) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) {
+      continue;
+    }
+    for (const nlohmann::json& primitive : mesh["primitives"]) {
+      if (!primitive.is_object()) continue;
+      const nlohmann::json mode = primitive.value("mode", nlohmann::json(4));
+      if (!mode.is_number_unsigned() || mode.get<std::uint64_t>() != 4) {
+        declared.onlyTriangleLists = false;
+        continue;
+      }
+      std::optional<std::uint64_t> count;
+      if (primitive.contains("indices")) {
+        count = accessorCount(primitive["indices"]);
+      } else if (primitive.contains("attributes") && primitive["attributes"].is_object() &&
+                 primitive["attributes"].contains("POSITION")) {
+        count = accessorCount(primitive["attributes"]["POSITION"]);
+      }
+      if (!count) {
+        declared.onlyTriangleLists = false;  // malformed: Assimp's checks decide
+        continue;
+      }
+      declared.triangles += *count / 3;
+      if (declared.triangles > limits.maxTriangles) {
+        return Status(ErrorCode::kResourceExhausted, path + ": the meshes declare more than " +
+                                                         std::to_string(limits.maxTriangles) +
+                                                         " triangles");
+      }
+    }
+  }
+  return declared;
+}
+
 class Converter {
  public:
-  Converter(const std::string& path, const aiScene& ai, const ImportLimits& limits)
-      : path_(path), ai_(ai), limits_(limits) {}
+  Converter(const std::string& path, const aiScene& ai, const ImportLimits& limits,
+            std::optional<GltfDeclared> declared)
+      : path_(path), ai_(ai), limits_(limits), declared_(declared) {}
 
   Result<Scene> run() {
     if (ai_.mRootNode == nullptr) return fail(ErrorCode::kInvalidArgument, "no root node");
     if (ai_.mNumMeshes > 0 && ai_.mMeshes == nullptr) {
       return fail(ErrorCode::kInternal, "mesh table missing");
+    }
+    if (declared_ && declared_->onlyTriangleLists) {
+      std::uint64_t returned = 0;
+      for (unsigned i = 0; i < ai_.mNumMeshes; ++i) {
+        if (ai_.mMeshes[i] != nullptr &&
+            (ai_.mMeshes[i]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {
+          returned += ai_.mMeshes[i]->mNumFaces;
+        }
+      }
+      if (returned < declared_->triangles) {
+        return fail(ErrorCode::kInvalidArgument,
+                    std::to_string(declared_->triangles - returned) + " of " +
+                        std::to_string(declared_->triangles) +
+                        " declared triangles were dropped (indices out of range or bad data)");
+      }
     }
     TreeCensus census;
     census.meshUsed.assign(ai_.mNumMeshes, false);
@@ -173,8 +314,8 @@ class Converter {
       const unsigned m = node.mMeshes[i];
       if (m >= ai_.mNumMeshes || ai_.mMeshes[m] == nullptr) {
         return fail(ErrorCode::kInvalidArgument, "node '" + std::string(node.mName.C_Str()) +
-                                                     "' names mesh " + std::to_string(m) +
-                                                     " of " + std::to_string(ai_.mNumMeshes));
+                                                     "' names mesh " + std::to_string(m) + " of " +
+                                                     std::to_string(ai_.mNumMeshes));
       }
       const aiMesh& mesh = *ai_.mMeshes[m];
       if ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;  // dropped
@@ -213,8 +354,8 @@ class Converter {
     transform->scale = glm::vec3(scaling.x, scaling.y, scaling.z);
     const float axisLength = std::sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
     if (std::isfinite(angle) && std::isfinite(axisLength) && axisLength > 1e-6f) {
-      transform->rotation = glm::vec4(axis.x / axisLength, axis.y / axisLength,
-                                      axis.z / axisLength, static_cast<float>(angle));
+      transform->rotation = glm::vec4(axis.x / axisLength, axis.y / axisLength, axis.z / axisLength,
+                                      static_cast<float>(angle));
     }
     // The decomposition is exact only for T * R * S; a shear or projective
     // row does not survive it, and TransformNode cannot hold one.
@@ -258,9 +399,9 @@ class Converter {
 
   Result<NodePtr> convertShape(unsigned meshIndex) {
     const aiMesh& src = *ai_.mMeshes[meshIndex];
-    const std::string what = path_ + ": mesh " + std::to_string(meshIndex) +
-                             (src.mName.length > 0 ? " '" + std::string(src.mName.C_Str()) + "'"
-                                                   : std::string());
+    const std::string what =
+        path_ + ": mesh " + std::to_string(meshIndex) +
+        (src.mName.length > 0 ? " '" + std::string(src.mName.C_Str()) + "'" : std::string());
     if (src.mNumVertices > 0 && src.mVertices == nullptr) {
       return Status(ErrorCode::kInvalidArgument, what + ": no positions");
     }
@@ -313,8 +454,8 @@ class Converter {
       const aiFace& face = src.mFaces[f];
       if (face.mNumIndices != 3) continue;  // a point or line left in a mixed mesh
       if (face.mIndices == nullptr) {
-        return Status(ErrorCode::kInvalidArgument, what + ": face " + std::to_string(f) +
-                                                       " has no indices");
+        return Status(ErrorCode::kInvalidArgument,
+                      what + ": face " + std::to_string(f) + " has no indices");
       }
       for (unsigned k = 0; k < 3; ++k) mesh->indices.push_back(face.mIndices[k]);
     }
@@ -383,6 +524,7 @@ class Converter {
   std::string path_;
   const aiScene& ai_;
   ImportLimits limits_;
+  std::optional<GltfDeclared> declared_;
   Scene scene_;
   std::uint32_t nextId_ = 1;
   std::map<unsigned, NodePtr> shapes_;  // by Assimp mesh index: one Shape per mesh
@@ -421,6 +563,13 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
                                                      std::to_string(limits.maxFileBytes));
   }
   try {
+    std::optional<GltfDeclared> declared;
+    const std::string ext = lowerExtension(path);
+    if (ext == ".gltf" || ext == ".glb") {
+      Result<GltfDeclared> checked = precheckGltf(path, size, limits);
+      if (!checked.ok()) return checked.status();
+      declared = *checked;
+    }
     Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
     auto* io = new BoundedIOSystem(limits);
     importer.SetIOHandler(io);  // the importer owns it
@@ -439,7 +588,7 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
                     path + ": " + formatName(lowerExtension(path)) + " import failed: " +
                         (why.empty() ? std::string("unknown Assimp error") : why));
     }
-    Result<Scene> scene = Converter(path, *ai, limits).run();
+    Result<Scene> scene = Converter(path, *ai, limits, declared).run();
     if (scene.ok()) scene->header = std::string("import ") + formatName(lowerExtension(path));
     return scene;
   } catch (const std::bad_alloc&) {
