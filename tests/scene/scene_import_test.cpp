@@ -387,5 +387,23 @@ TEST(SceneImport, LoadSceneFileDispatchesByExtensionAndFingerprintsTheFile) {
       << "the .bin geometry must be part of the fingerprint";
 }
 
+TEST(SceneImport, VrmlInlineOfAGltfFileIsFlattenedIntoOneMesh) {
+  Result<Scene> r = loadSceneFile(dataPath("inline_gltf.wrl"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  const IndexedMesh& mesh = *shapes[0]->geometry.mesh;
+  EXPECT_EQ(mesh.triangleCount(), 2u);  // both instances of the triangle
+  EXPECT_TRUE(mesh.validate("inlined").ok());
+  EXPECT_EQ(mesh.normals.size(), mesh.positions.size());
+  EXPECT_EQ(shapes[0]->appearance.material.diffuseColor, glm::vec3(1, 0, 0));
+  // transforms.gltf's world bounds (0,0,-5)..(10,2,0), moved up by 100.
+  const Bounds b = worldBounds(*r);
+  expectNear(b.min, glm::vec3(0, 100, -5), 1e-4f);
+  expectNear(b.max, glm::vec3(10, 102, 0), 1e-4f);
+  // The rotated, uniformly scaled instance keeps unit normals facing +z.
+  for (const glm::vec3& n : mesh.normals) expectNear(n, glm::vec3(0, 0, 1), 1e-5f);
+}
+
 }  // namespace
 }  // namespace thinlod::scene

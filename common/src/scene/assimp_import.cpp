@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -598,6 +600,59 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
   } catch (...) {
     return Status(ErrorCode::kInternal, path + ": import failed with an unknown exception");
   }
+}
+
+Result<LoadedMesh> importSceneAsMesh(const std::string& path, const ImportLimits& limits) {
+  Result<Scene> scene = importScene(path, limits);
+  if (!scene.ok()) return scene.status();
+  std::vector<std::pair<const IndexedMesh*, glm::mat4>> parts;
+  bool allUvs = true;
+  bool allColors = true;
+  bool anyMaterialOrTexture = false;
+  for (const NodeInstance& instance : flattenInstances(*scene)) {
+    const ShapeNode* shape = instance.node->as<ShapeNode>();
+    if (shape == nullptr || !shape->geometry.mesh) continue;
+    const IndexedMesh& mesh = *shape->geometry.mesh;
+    parts.emplace_back(&mesh, instance.contentToWorld);
+    allUvs &= !mesh.uvs.empty();
+    allColors &= !mesh.colors.empty();
+    anyMaterialOrTexture |= !shape->appearance.textureUrl.empty();
+  }
+  LoadedMesh out;
+  out.warnings = scene->warnings;
+  IndexedMesh& merged = out.mesh;
+  for (const auto& [mesh, toRoot] : parts) {
+    // The importer bounded the instance triangles (limits.maxTriangles) and
+    // vertices per distinct mesh; instancing can repeat vertices, so check
+    // the merged size against 32-bit indices before growing.
+    if (merged.positions.size() + mesh->positions.size() > 0xFFFFFFFFull) {
+      return Status(ErrorCode::kResourceExhausted, path + ": too many vertices to flatten");
+    }
+    const auto base = static_cast<std::uint32_t>(merged.positions.size());
+    const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(toRoot)));
+    const bool mirrored = glm::determinant(glm::mat3(toRoot)) < 0.0f;
+    for (const glm::vec3& p : mesh->positions)
+      merged.positions.emplace_back(toRoot * glm::vec4(p, 1.0f));
+    for (const glm::vec3& n : mesh->normals) {
+      const glm::vec3 mapped = normalMatrix * n;
+      const float length = glm::length(mapped);
+      merged.normals.push_back(length > 1e-20f ? mapped / length : n);
+    }
+    if (allUvs) merged.uvs.insert(merged.uvs.end(), mesh->uvs.begin(), mesh->uvs.end());
+    if (allColors)
+      merged.colors.insert(merged.colors.end(), mesh->colors.begin(), mesh->colors.end());
+    for (std::size_t i = 0; i + 2 < mesh->indices.size(); i += 3) {
+      merged.indices.push_back(base + mesh->indices[i]);
+      merged.indices.push_back(base + mesh->indices[mirrored ? i + 2 : i + 1]);
+      merged.indices.push_back(base + mesh->indices[mirrored ? i + 1 : i + 2]);
+    }
+  }
+  if (merged.normals.size() != merged.positions.size()) merged.computeNormals();
+  THINLOD_RETURN_IF_ERROR(merged.validate(path));
+  out.warnings.push_back(path + ": inlined as one mesh; its materials" +
+                         std::string(anyMaterialOrTexture ? " and textures" : "") +
+                         " are replaced by the Shape's Appearance");
+  return out;
 }
 
 }  // namespace thinlod::scene

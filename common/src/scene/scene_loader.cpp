@@ -86,9 +86,13 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
     std::vector<std::string> tried;
     for (const std::string& url : g.urls) {
       THINLOD_RETURN_IF_ERROR(checkUrl(url, where));
-      if (!isSupportedMeshExtension(url)) {
+      // .obj stays with the mesh loader; .gltf .glb .dae .fbx are imported
+      // and flattened (scene_import.h).
+      const bool flatten = !isSupportedMeshExtension(url) && isImportedSceneExtension(url);
+      if (!isSupportedMeshExtension(url) && !flatten) {
         return Status(ErrorCode::kUnsupported,
-                      where + ": url '" + url + "' is not a mesh file (obj, ply, off, stl)");
+                      where + ": url '" + url +
+                          "' is not a mesh file (obj, ply, off, stl, gltf, glb, dae, fbx)");
       }
       for (const std::string& dir : directories) {
         const std::string candidate = (fs::path(dir) / url).lexically_normal().string();
@@ -99,7 +103,8 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
         }
         auto cached = loaded.find(candidate);
         if (cached == loaded.end()) {
-          Result<LoadedMesh> mesh = loadMeshFile(candidate, options.meshOptions);
+          Result<LoadedMesh> mesh = flatten ? importSceneAsMesh(candidate, options.importLimits)
+                                            : loadMeshFile(candidate, options.meshOptions);
           if (!mesh.ok()) {
             return Status(mesh.status().code(), where + ": " + mesh.status().message());
           }

@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <string>
 
+#include "thinlod/common/mesh_io.h"
 #include "thinlod/common/scene.h"
 #include "thinlod/common/status.h"
 
@@ -56,5 +57,13 @@ bool isImportedSceneExtension(const std::string& path);
 // Imports the file as a Scene. Scene::fingerprint is left 0 (loadSceneFile
 // sets it); Scene::header names the format, e.g. "import glTF2".
 Result<Scene> importScene(const std::string& path, const ImportLimits& limits = {});
+
+// For `Inline { url "part.gltf" }` in a VRML scene: imports the file and
+// flattens it into one mesh in the file's root frame (every mesh instance
+// transformed, normals by the inverse transpose, winding flipped under a
+// mirroring transform). uvs / colours are kept only when every part has
+// them. The file's materials and textures are dropped (the VRML Shape's
+// Appearance applies), which a warning says.
+Result<LoadedMesh> importSceneAsMesh(const std::string& path, const ImportLimits& limits = {});
 
 }  // namespace thinlod::scene
