@@ -585,7 +585,12 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
       return Status(ErrorCode::kResourceExhausted, path + ": " + io->refusal());
     }
     if (ai == nullptr) {
-      const std::string why = importer.GetErrorString();
+      std::string why = importer.GetErrorString();
+      // SortByPType removed every point and line mesh: say it in our terms.
+      if (why.find("No meshes remaining") != std::string::npos) {
+        return Status(ErrorCode::kInvalidArgument,
+                      path + ": contains no triangles (point and line primitives are dropped)");
+      }
       return Status(ErrorCode::kParseError,
                     path + ": " + formatName(lowerExtension(path)) + " import failed: " +
                         (why.empty() ? std::string("unknown Assimp error") : why));

@@ -47,7 +47,7 @@ struct ImportLimits {
   std::uint64_t maxTriangles = 20'000'000;                 // summed over mesh instances
   std::uint64_t maxVertices = 20'000'000;                  // summed over distinct meshes
   std::size_t maxNodes = 1'000'000;                        // node instances in the tree
-  int maxDepth = 64;
+  int maxDepth = 256;  // skeletons nest deeply (a package Collada file: 65+)
 };
 
 // True for the extensions importScene() takes (case-insensitive):
