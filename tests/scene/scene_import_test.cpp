@@ -246,6 +246,12 @@ TEST(SceneImport, EngineHierarchyLoadsUnderTheTriangleLimitAndIsRefusedOverIt) {
   EXPECT_NE(over.status().message().find("2CylinderEngine.glb"), std::string::npos);
   tight.maxTriangles = triangles;
   EXPECT_TRUE(importScene(path, tight).ok()) << "the limit is inclusive";
+  // Far below: refused from the glTF JSON's accessor counts, before Assimp runs.
+  tight.maxTriangles = triangles / 2;
+  over = importScene(path, tight);
+  ASSERT_FALSE(over.ok());
+  EXPECT_EQ(over.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(over.status().message().find("declare"), std::string::npos) << over.status().toString();
 }
 
 TEST(SceneImport, FileSizeLimitsApplyToTheSceneAndToTheBuffersItOpens) {
