@@ -336,10 +336,26 @@ TEST(SceneImport, ObjNamingAMissingMaterialLoadsWithTheDefaultMaterial) {
 }
 
 TEST(SceneImport, OwnBrokenFilesAreRefusedCleanly) {
-  for (const char* file : {"empty.gltf", "empty.glb", "not_json.gltf", "truncated.glb",
-                           "huge_header.glb", "huge_count.gltf"}) {
+  for (const char* file :
+       {"empty.gltf", "empty.glb", "not_json.gltf", "huge_header.glb", "huge_count.gltf"}) {
     expectCleanRefusal(dataPath(file));
   }
+  // The package's BoxTextured.glb cut after every 97th byte (header,
+  // JSON chunk, BIN chunk): never a crash, always refused.
+  const std::string glb = packageFile("glTF2/BoxTextured-glTF-Binary/BoxTextured.glb");
+  ASSERT_TRUE(havePackageFile(glb));
+  std::ifstream in(glb, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  const std::string truncated = ::testing::TempDir() + "/thinlod_truncated.glb";
+  for (std::size_t length = 1; length < bytes.size(); length += 97) {
+    {
+      std::ofstream out(truncated, std::ios::binary | std::ios::trunc);
+      out.write(bytes.data(), static_cast<std::streamsize>(length));
+    }
+    expectCleanRefusal(truncated);
+  }
+  fs::remove(truncated);
 }
 
 TEST(SceneImport, EveryPackageFileOfAnImportedFormatLoadsOrFailsCleanly) {
