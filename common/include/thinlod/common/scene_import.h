@@ -3,8 +3,8 @@
 // (docs/scene-format.md, "Imported scenes").
 //
 // Contract:
-// - The file (and every file it pulls in: .bin buffers, .mtl libraries,
-//   images are not read) is untrusted. Every failure is a Status whose
+// - The file and every file it pulls in (.bin buffers, .mtl libraries;
+//   images are never read) are untrusted. Every failure is a Status whose
 //   message starts with the file's path and names the problem; no exception
 //   and no Assimp type crosses this interface, Assimp's own logging is never
 //   switched on.
@@ -13,7 +13,10 @@
 //   together against maxTotalBytes before it is read; after parsing, the
 //   triangles of every mesh instance (a mesh reached twice counts twice) are
 //   summed against maxTriangles and the node tree against maxNodes/maxDepth
-//   before any mesh is copied.
+//   before any mesh is copied. glTF is pre-checked before Assimp runs: a
+//   .glb header and chunks must fit the file, the JSON's declared triangles
+//   must fit maxTriangles, and a file whose triangles Assimp silently drops
+//   (out-of-range indices) is refused.
 // - Result: node hierarchy -> TransformNode (identity transforms -> Group),
 //   each Assimp mesh -> one ShapeNode with kMeshFile geometry (resolvedPath =
 //   the file, urls = {file name}) holding an IndexedMesh with positions,
