@@ -86,9 +86,13 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
     std::vector<std::string> tried;
     for (const std::string& url : g.urls) {
       THINLOD_RETURN_IF_ERROR(checkUrl(url, where));
-      if (!isSupportedMeshExtension(url)) {
+      // .obj stays with the mesh loader; .gltf .glb .dae .fbx are imported
+      // and flattened (scene_import.h).
+      const bool flatten = !isSupportedMeshExtension(url) && isImportedSceneExtension(url);
+      if (!isSupportedMeshExtension(url) && !flatten) {
         return Status(ErrorCode::kUnsupported,
-                      where + ": url '" + url + "' is not a mesh file (obj, ply, off, stl)");
+                      where + ": url '" + url +
+                          "' is not a mesh file (obj, ply, off, stl, gltf, glb, dae, fbx)");
       }
       for (const std::string& dir : directories) {
         const std::string candidate = (fs::path(dir) / url).lexically_normal().string();
@@ -99,7 +103,8 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
         }
         auto cached = loaded.find(candidate);
         if (cached == loaded.end()) {
-          Result<LoadedMesh> mesh = loadMeshFile(candidate, options.meshOptions);
+          Result<LoadedMesh> mesh = flatten ? importSceneAsMesh(candidate, options.importLimits)
+                                            : loadMeshFile(candidate, options.meshOptions);
           if (!mesh.ok()) {
             return Status(mesh.status().code(), where + ": " + mesh.status().message());
           }
@@ -133,10 +138,13 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   }
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
-  if (size > options.limits.maxBytes) {
+  const bool imported = isImportedSceneExtension(path);
+  const std::uint64_t maxBytes =
+      imported ? options.importLimits.maxFileBytes : std::uint64_t{options.limits.maxBytes};
+  if (size > maxBytes) {
     return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
                                                      " bytes exceed the limit of " +
-                                                     std::to_string(options.limits.maxBytes));
+                                                     std::to_string(maxBytes));
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
@@ -145,9 +153,12 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   if (static_cast<std::uintmax_t>(in.gcount()) != size) {
     return Status(ErrorCode::kIoError, path + ": short read");
   }
-  Result<Scene> scene = parseScene(text, path, options.limits);
+  Result<Scene> scene =
+      imported ? importScene(path, options.importLimits) : parseScene(text, path, options.limits);
   if (!scene.ok()) return scene.status();
-  THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  if (!imported) {
+    THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
+  }
   scene->fingerprint = sceneFingerprint(text, *scene);
   return scene;
 }

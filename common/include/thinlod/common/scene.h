@@ -71,6 +71,9 @@ struct Material {
 struct Appearance {
   bool hasMaterial = false;  // VRML: no material means unlit (emissive white)
   Material material;
+  // Base-colour texture as the file names it (imported scenes only,
+  // scene_import.h); recorded, not drawn yet. Empty when there is none.
+  std::string textureUrl;
 };
 
 enum class GeometryKind : std::uint8_t { kNone, kPrimitive, kMeshFile, kIndexedFaceSet };

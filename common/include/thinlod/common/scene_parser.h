@@ -24,6 +24,7 @@
 
 #include "thinlod/common/mesh_io.h"
 #include "thinlod/common/scene.h"
+#include "thinlod/common/scene_import.h"
 #include "thinlod/common/status.h"
 
 namespace thinlod::scene {
@@ -49,6 +50,7 @@ struct SceneLoadOptions {
   std::vector<std::string> meshSearchPaths;  // tried before the scene's directory
   ParseLimits limits;
   MeshLoadOptions meshOptions;
+  ImportLimits importLimits;  // .gltf .glb .dae .fbx .obj scene files (scene_import.h)
 };
 
 // Loads every mesh-file geometry in the scene (see the url rules above).
@@ -56,7 +58,10 @@ struct SceneLoadOptions {
 Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
                      const SceneLoadOptions& options);
 
-// Reads the file, parses it and resolves its meshes.
+// Reads the file, parses it and resolves its meshes. A path ending in
+// .gltf .glb .dae .fbx or .obj is imported instead (importScene(), limits from
+// options.importLimits); the fingerprint is then sceneFingerprint() of the
+// file's bytes and the imported meshes.
 Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& options = {});
 
 }  // namespace thinlod::scene

@@ -1,0 +1,431 @@
+// importScene() and loadSceneFile()'s dispatch to it: the Debian package
+// assimp-testmodels (installed by deploy/setup) plus hand-written files in
+// tests/data/import/. A missing package file FAILS the test, naming the package.
+#include "thinlod/common/scene_import.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/scene_parser.h"
+
+namespace thinlod::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kModels = "/usr/share/assimp/models";
+
+std::string packageFile(const std::string& relative) { return kModels + "/" + relative; }
+
+::testing::AssertionResult havePackageFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure()
+         << path << " is missing: install the Debian package assimp-testmodels (deploy/setup does)";
+}
+
+std::string dataPath(const std::string& file) {
+  return std::string(THINLOD_TEST_DATA_DIR) + "/import/" + file;
+}
+
+std::vector<const ShapeNode*> distinctShapes(const Scene& scene) {
+  std::vector<const ShapeNode*> shapes;
+  std::set<const Node*> seen;
+  for (const NodeInstance& instance : flattenInstances(scene)) {
+    const ShapeNode* shape = instance.node->as<ShapeNode>();
+    if (shape != nullptr && seen.insert(shape).second) shapes.push_back(shape);
+  }
+  return shapes;
+}
+
+std::uint64_t instanceTriangles(const Scene& scene) {
+  std::uint64_t triangles = 0;
+  for (const NodeInstance& instance : flattenInstances(scene)) {
+    const ShapeNode* shape = instance.node->as<ShapeNode>();
+    if (shape != nullptr && shape->geometry.mesh) {
+      triangles += shape->geometry.mesh->triangleCount();
+    }
+  }
+  return triangles;
+}
+
+Bounds worldBounds(const Scene& scene) {
+  Bounds all;
+  for (const NodeInstance& instance : flattenInstances(scene)) {
+    if (instance.node->kind != NodeKind::kShape || instance.worldBounds.empty) continue;
+    all.extend(instance.worldBounds.min);
+    all.extend(instance.worldBounds.max);
+  }
+  return all;
+}
+
+void expectNear(const glm::vec3& actual, const glm::vec3& expected, float tolerance) {
+  EXPECT_NEAR(actual.x, expected.x, tolerance);
+  EXPECT_NEAR(actual.y, expected.y, tolerance);
+  EXPECT_NEAR(actual.z, expected.z, tolerance);
+}
+
+// Every imported mesh obeys the IndexedMesh contract and ids are 1..nodeCount.
+void expectWellFormed(const Scene& scene) {
+  for (const ShapeNode* shape : distinctShapes(scene)) {
+    ASSERT_TRUE(shape->geometry.mesh);
+    const Status valid = shape->geometry.mesh->validate("imported");
+    EXPECT_TRUE(valid.ok()) << valid.toString();
+    EXPECT_EQ(shape->geometry.mesh->normals.size(), shape->geometry.mesh->positions.size());
+    EXPECT_TRUE(shape->appearance.hasMaterial);
+  }
+  std::set<std::uint32_t> ids;
+  std::set<const Node*> seen;
+  for (const NodeInstance& instance : flattenInstances(scene)) {
+    if (!seen.insert(instance.node).second) continue;
+    EXPECT_GE(instance.node->id, 1u);
+    EXPECT_LE(instance.node->id, scene.nodeCount);
+    EXPECT_TRUE(ids.insert(instance.node->id).second) << "duplicate id " << instance.node->id;
+  }
+  EXPECT_EQ(ids.size(), scene.nodeCount);
+}
+
+TEST(SceneImport, GltfBoxTexturedHasUvsAndRecordsTheTexturePath) {
+  const std::string path = packageFile("glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  EXPECT_EQ(r->header, "import glTF2");
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  const IndexedMesh& mesh = *shapes[0]->geometry.mesh;
+  EXPECT_EQ(mesh.triangleCount(), 12u);  // a box: 6 faces x 2
+  EXPECT_EQ(mesh.vertexCount(), 24u);    // 4 per face (split uvs/normals)
+  EXPECT_EQ(mesh.uvs.size(), mesh.vertexCount());
+  EXPECT_EQ(shapes[0]->appearance.textureUrl, "CesiumLogoFlat.png");
+  // The root node rotates -90 degrees about x: the unit box maps onto itself.
+  const Bounds b = worldBounds(*r);
+  expectNear(b.min, glm::vec3(-0.5f), 1e-5f);
+  expectNear(b.max, glm::vec3(0.5f), 1e-5f);
+  bool noted = false;
+  for (const std::string& w : r->warnings) noted |= w.find("not drawn") != std::string::npos;
+  EXPECT_TRUE(noted) << "the importer must say that textures are not drawn";
+}
+
+TEST(SceneImport, GltfBinaryAndEmbeddedBoxesMatchTheSeparateFiles) {
+  const std::string separate = packageFile("glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  const std::string binary = packageFile("glTF2/BoxTextured-glTF-Binary/BoxTextured.glb");
+  const std::string embedded = packageFile("glTF2/BoxTextured-glTF-Embedded/BoxTextured.gltf");
+  for (const std::string& p : {separate, binary, embedded}) ASSERT_TRUE(havePackageFile(p));
+  Result<Scene> a = importScene(separate);
+  Result<Scene> b = importScene(binary);
+  Result<Scene> c = importScene(embedded);
+  ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+  const IndexedMesh& ma = *distinctShapes(*a)[0]->geometry.mesh;
+  for (const Scene* other : {&*b, &*c}) {
+    const IndexedMesh& mo = *distinctShapes(*other)[0]->geometry.mesh;
+    EXPECT_EQ(mo.positions, ma.positions);
+    EXPECT_EQ(mo.indices, ma.indices);
+    EXPECT_EQ(mo.uvs, ma.uvs);
+  }
+  // Embedded images are named "*<index>" by Assimp; kept as written.
+  EXPECT_FALSE(distinctShapes(*b)[0]->appearance.textureUrl.empty());
+}
+
+TEST(SceneImport, NodeTransformsGiveKnownWorldBoundsAndSharedMeshesStayShared) {
+  // transforms.gltf: a triangle (0,0,0) (1,0,0) (0,1,0) under
+  // "parent" (translate 10,0,0, scale 2) / "child" (rotate 90 deg about z),
+  // and again under "second" (translate 0,0,-5).
+  Result<Scene> r = importScene(dataPath("transforms.gltf"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u) << "one glTF mesh is one shared Shape";
+  EXPECT_EQ(instanceTriangles(*r), 2u);
+  expectNear(shapes[0]->appearance.material.diffuseColor, glm::vec3(0.25f, 0.5f, 0.75f), 1e-6f);
+  std::vector<Bounds> perInstance;
+  for (const NodeInstance& instance : flattenInstances(*r)) {
+    if (instance.node->kind == NodeKind::kShape) perInstance.push_back(instance.worldBounds);
+  }
+  ASSERT_EQ(perInstance.size(), 2u);
+  // Rotated: (0,0,0) (0,1,0) (-1,0,0); scaled by 2 and moved by 10 in x.
+  expectNear(perInstance[0].min, glm::vec3(8, 0, 0), 1e-5f);
+  expectNear(perInstance[0].max, glm::vec3(10, 2, 0), 1e-5f);
+  expectNear(perInstance[1].min, glm::vec3(0, 0, -5), 1e-5f);
+  expectNear(perInstance[1].max, glm::vec3(1, 1, -5), 1e-5f);
+}
+
+TEST(SceneImport, ColladaDuckHasTrianglesAndItsMaterialColour) {
+  const std::string path = packageFile("Collada/duck.dae");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  EXPECT_EQ(r->header, "import Collada");
+  EXPECT_GT(instanceTriangles(*r), 0u);
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_FALSE(shapes.empty());
+  // duck.dae's material "blinn3": diffuse is the texture duckCM.tga; Assimp
+  // reports the diffuse colour as white alongside it.
+  EXPECT_EQ(shapes[0]->appearance.textureUrl, "./duckCM.tga");
+  EXPECT_FALSE(shapes[0]->geometry.mesh->uvs.empty());
+}
+
+TEST(SceneImport, ColladaCubeTakesItsDiffuseColour) {
+  const std::string path = packageFile("Collada/cube_triangulate.dae");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  EXPECT_EQ(shapes[0]->geometry.mesh->triangleCount(), 12u);
+  // <diffuse><color>0.137255 0.403922 0.870588 1</color> in the file.
+  expectNear(shapes[0]->appearance.material.diffuseColor,
+             glm::vec3(0.137255f, 0.403922f, 0.870588f), 1e-6f);
+}
+
+TEST(SceneImport, VertexColoursAreKept) {
+  for (const char* relative :
+       {"Collada/kwxport_test_vcolors.dae", "OBJ/cube_with_vertexcolors.obj"}) {
+    const std::string path = packageFile(relative);
+    ASSERT_TRUE(havePackageFile(path));
+    Result<Scene> r = importScene(path);
+    ASSERT_TRUE(r.ok()) << r.status().toString();
+    expectWellFormed(*r);
+    bool coloured = false;
+    for (const ShapeNode* shape : distinctShapes(*r)) {
+      const IndexedMesh& mesh = *shape->geometry.mesh;
+      coloured |= !mesh.colors.empty() && mesh.colors.size() == mesh.positions.size();
+    }
+    EXPECT_TRUE(coloured) << relative;
+  }
+}
+
+TEST(SceneImport, ObjWithMtlTakesTheMaterialColourAndTexturePath) {
+  Result<Scene> r = importScene(dataPath("colored_quad.obj"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  EXPECT_EQ(r->header, "import OBJ");
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  EXPECT_EQ(shapes[0]->geometry.mesh->triangleCount(), 2u);  // the quad, triangulated
+  EXPECT_EQ(shapes[0]->geometry.mesh->uvs.size(), 4u);
+  expectNear(shapes[0]->appearance.material.diffuseColor, glm::vec3(0.1f, 0.6f, 0.3f), 1e-6f);
+  EXPECT_EQ(shapes[0]->appearance.textureUrl, "quad_texture.png");
+  const Bounds b = worldBounds(*r);
+  expectNear(b.min, glm::vec3(1, 2, 3), 1e-6f);
+  expectNear(b.max, glm::vec3(4, 6, 3), 1e-6f);
+}
+
+TEST(SceneImport, PackageObjWithMtlLoads) {
+  const std::string path = packageFile("OBJ/spider.obj");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  EXPECT_GT(instanceTriangles(*r), 0u);
+}
+
+TEST(SceneImport, EngineHierarchyLoadsUnderTheTriangleLimitAndIsRefusedOverIt) {
+  const std::string path = packageFile("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  const std::uint64_t triangles = instanceTriangles(*r);
+  EXPECT_GT(triangles, 1000u);
+  EXPECT_GT(distinctShapes(*r).size(), 10u);
+
+  ImportLimits tight;
+  tight.maxTriangles = triangles - 1;
+  Result<Scene> over = importScene(path, tight);
+  ASSERT_FALSE(over.ok());
+  EXPECT_EQ(over.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(over.status().message().find("2CylinderEngine.glb"), std::string::npos);
+  tight.maxTriangles = triangles;
+  EXPECT_TRUE(importScene(path, tight).ok()) << "the limit is inclusive";
+  // Far below: refused from the glTF JSON's accessor counts, before Assimp runs.
+  tight.maxTriangles = triangles / 2;
+  over = importScene(path, tight);
+  ASSERT_FALSE(over.ok());
+  EXPECT_EQ(over.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(over.status().message().find("declare"), std::string::npos) << over.status().toString();
+}
+
+TEST(SceneImport, FileSizeLimitsApplyToTheSceneAndToTheBuffersItOpens) {
+  const std::string gltf = packageFile("glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  const std::string bin = packageFile("glTF2/BoxTextured-glTF/BoxTextured0.bin");
+  ASSERT_TRUE(havePackageFile(gltf));
+  ASSERT_TRUE(havePackageFile(bin));
+  ImportLimits limits;
+  limits.maxFileBytes = 10;
+  Result<Scene> r = importScene(gltf, limits);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(r.status().message().find("BoxTextured.gltf"), std::string::npos);
+  // The .gltf fits the total, the .bin it pulls in does not: refused when
+  // Assimp opens it, naming the .bin.
+  limits.maxFileBytes = 1 << 20;
+  limits.maxTotalBytes = fs::file_size(gltf) + fs::file_size(bin) - 1;
+  r = importScene(gltf, limits);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_NE(r.status().message().find("BoxTextured0.bin"), std::string::npos)
+      << r.status().toString();
+  limits.maxTotalBytes = fs::file_size(gltf) + fs::file_size(bin);
+  r = importScene(gltf, limits);
+  EXPECT_TRUE(r.ok()) << "the limit is inclusive: " << r.status().toString();
+}
+
+TEST(SceneImport, TreeDepthLimitIsEnforced) {
+  ImportLimits limits;
+  limits.maxDepth = 2;  // transforms.gltf: root -> parent -> child -> (shape)
+  Result<Scene> r = importScene(dataPath("transforms.gltf"), limits);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kResourceExhausted);
+}
+
+// Files that must be refused with a clean Status naming the file.
+void expectCleanRefusal(const std::string& path) {
+  SCOPED_TRACE(path);
+  Result<Scene> r = importScene(path);
+  ASSERT_FALSE(r.ok()) << "imported a broken file: " << r->nodeCount << " nodes";
+  EXPECT_NE(r.status().message().find(path), std::string::npos) << r.status().toString();
+  EXPECT_NE(r.status().code(), ErrorCode::kInternal) << r.status().toString();
+  // And through the daemons' entry point.
+  Result<Scene> loaded = loadSceneFile(path);
+  EXPECT_FALSE(loaded.ok());
+}
+
+TEST(SceneImport, PackageInvalidFilesAreRefusedCleanly) {
+  const std::vector<std::string> broken = {
+      "glTF2/IndexOutOfRange/IndexOutOfRange.gltf",
+      "glTF2/IndexOutOfRange/AllIndicesOutOfRange.gltf",
+      "glTF2/MissingBin/BoxTextured.gltf",
+      "glTF2/RecursiveNodes/RecursiveNodes.gltf",
+      "glTF2/SchemaFailures/sceneWrongType.gltf",
+      "glTF2/TestNoRootNode/SceneWithoutNodes.gltf",
+      "glTF2/TestNoRootNode/NoScene.gltf",
+      "glTF2/wrongTypes/badArray.gltf",
+      "glTF2/wrongTypes/badExtension.gltf",
+      "glTF2/wrongTypes/badNumber.gltf",
+      "glTF2/wrongTypes/badObject.gltf",
+      "glTF2/wrongTypes/badString.gltf",
+      "glTF2/wrongTypes/badUint.gltf",
+      "glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
+      "invalid/empty.obj",
+      "invalid/malformed.obj",
+  };
+  for (const std::string& relative : broken) {
+    ASSERT_TRUE(havePackageFile(packageFile(relative)));
+    expectCleanRefusal(packageFile(relative));
+  }
+}
+
+TEST(SceneImport, ObjNamingAMissingMaterialLoadsWithTheDefaultMaterial) {
+  // invalid/malformed2.obj "references a non-existent material": Assimp
+  // substitutes its default material; the geometry itself is valid.
+  const std::string path = packageFile("invalid/malformed2.obj");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = importScene(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  expectWellFormed(*r);
+  EXPECT_GT(instanceTriangles(*r), 0u);
+}
+
+TEST(SceneImport, OwnBrokenFilesAreRefusedCleanly) {
+  for (const char* file :
+       {"empty.gltf", "empty.glb", "not_json.gltf", "huge_header.glb", "huge_count.gltf"}) {
+    expectCleanRefusal(dataPath(file));
+  }
+  // The package's BoxTextured.glb cut after every 97th byte (header,
+  // JSON chunk, BIN chunk): never a crash, always refused.
+  const std::string glb = packageFile("glTF2/BoxTextured-glTF-Binary/BoxTextured.glb");
+  ASSERT_TRUE(havePackageFile(glb));
+  std::ifstream in(glb, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  const std::string truncated = ::testing::TempDir() + "/thinlod_truncated.glb";
+  for (std::size_t length = 1; length < bytes.size(); length += 97) {
+    {
+      std::ofstream out(truncated, std::ios::binary | std::ios::trunc);
+      out.write(bytes.data(), static_cast<std::streamsize>(length));
+    }
+    expectCleanRefusal(truncated);
+  }
+  fs::remove(truncated);
+}
+
+TEST(SceneImport, EveryPackageFileOfAnImportedFormatLoadsOrFailsCleanly) {
+  // The whole package, not a chosen list: no crash, and every result is
+  // either a well-formed scene or a Status naming the file.
+  std::error_code ec;
+  ASSERT_TRUE(fs::is_directory(kModels, ec))
+      << kModels << " is missing: install the Debian package assimp-testmodels";
+  int loaded = 0;
+  int refused = 0;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kModels)) {
+    if (!entry.is_regular_file() || !isImportedSceneExtension(entry.path().string())) continue;
+    const std::string path = entry.path().string();
+    SCOPED_TRACE(path);
+    Result<Scene> r = importScene(path);
+    if (r.ok()) {
+      ++loaded;
+      expectWellFormed(*r);
+    } else {
+      ++refused;
+      EXPECT_NE(r.status().message().find(path), std::string::npos) << r.status().toString();
+    }
+  }
+  EXPECT_GT(loaded, 50);
+  EXPECT_GT(refused, 10);
+  std::cout << "[ import ] package files: " << loaded << " loaded, " << refused << " refused\n";
+}
+
+TEST(SceneImport, LoadSceneFileDispatchesByExtensionAndFingerprintsTheFile) {
+  const std::string path = dataPath("transforms.gltf");
+  Result<Scene> r = loadSceneFile(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->header, "import glTF2");
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(r->fingerprint, sceneFingerprint(bytes, *r));
+  EXPECT_NE(r->fingerprint, 0u);
+  // Same bytes, same fingerprint; different geometry (the .bin of a
+  // separate-file glTF is not in the .gltf text), different fingerprint.
+  Result<Scene> again = loadSceneFile(path);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->fingerprint, r->fingerprint);
+  const std::string box = packageFile("glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  ASSERT_TRUE(havePackageFile(box));
+  Result<Scene> boxScene = loadSceneFile(box);
+  ASSERT_TRUE(boxScene.ok()) << boxScene.status().toString();
+  std::ifstream boxIn(box, std::ios::binary);
+  const std::string boxBytes((std::istreambuf_iterator<char>(boxIn)),
+                             std::istreambuf_iterator<char>());
+  EXPECT_NE(boxScene->fingerprint, sceneFingerprint(boxBytes, Scene{}))
+      << "the .bin geometry must be part of the fingerprint";
+}
+
+TEST(SceneImport, VrmlInlineOfAGltfFileIsFlattenedIntoOneMesh) {
+  Result<Scene> r = loadSceneFile(dataPath("inline_gltf.wrl"));
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  const IndexedMesh& mesh = *shapes[0]->geometry.mesh;
+  EXPECT_EQ(mesh.triangleCount(), 2u);  // both instances of the triangle
+  EXPECT_TRUE(mesh.validate("inlined").ok());
+  EXPECT_EQ(mesh.normals.size(), mesh.positions.size());
+  EXPECT_EQ(shapes[0]->appearance.material.diffuseColor, glm::vec3(1, 0, 0));
+  // transforms.gltf's world bounds (0,0,-5)..(10,2,0), moved up by 100.
+  const Bounds b = worldBounds(*r);
+  expectNear(b.min, glm::vec3(0, 100, -5), 1e-4f);
+  expectNear(b.max, glm::vec3(10, 102, 0), 1e-4f);
+  // The rotated, uniformly scaled instance keeps unit normals facing +z.
+  for (const glm::vec3& n : mesh.normals) expectNear(n, glm::vec3(0, 0, 1), 1e-5f);
+}
+
+}  // namespace
+}  // namespace thinlod::scene
