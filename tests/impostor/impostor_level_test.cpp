@@ -89,12 +89,12 @@ ImpostorFraming squareFraming(float quadSize, int texels, float nearDepth, float
   return f;
 }
 
-TEST(ImpostorLevel, ToleranceIsHalfTheNearestTexel) {
+TEST(ImpostorLevel, ToleranceIsTheNearestTexel) {
   // 2.56 m quad over 256 texels: 1 cm at the plane; the nearest point at
-  // 0.8 of the plane distance: 8 mm; half of it 4 mm.
+  // 0.8 of the plane distance: 8 mm.
   const ImpostorFraming f = squareFraming(2.56f, 256, 8.0f, 10.0f);
-  EXPECT_NEAR(impostorLevelTolerance(f), 0.004, 1e-7);
-  EXPECT_NEAR(impostorLevelTolerance(f, 1.0), 0.008, 1e-7);
+  EXPECT_NEAR(impostorLevelTolerance(f), 0.008, 1e-7);
+  EXPECT_NEAR(impostorLevelTolerance(f, 0.5), 0.004, 1e-7);
   EXPECT_EQ(impostorLevelTolerance(f, 0.0), 0.0);
   EXPECT_EQ(impostorLevelTolerance(f, std::nan("")), 0.0);
   EXPECT_EQ(impostorLevelTolerance(squareFraming(2.56f, 0, 8.0f, 10.0f)), 0.0);

@@ -1,6 +1,6 @@
 // SimplifierService: ImpostorRequest handling (service.h). Objects are drawn
-// in world space from the coarsest level whose error stays under half a
-// texel, then the quad / depth mesh and the texture are encoded.
+// in world space from the coarsest level whose error stays under one texel
+// (impostor_level.h), then the quad / depth mesh and the texture are encoded.
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -178,11 +178,11 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   }
   Result<ImpostorFraming> framing = frameImpostor(points, request.eye, base);
   if (!framing.ok()) return framing.status();
-  // Half the smallest texel footprint on the objects (impostor_level.h says
-  // why half); 0 when levels are switched off: every object at full resolution.
+  // The smallest texel footprint on the objects (impostor_level.h says why
+  // one texel); 0 when levels are switched off: every object at full resolution.
   const double allowedError = options.impostorFromLevels ? impostorLevelTolerance(*framing) : 0.0;
 
-  // --- The coarsest level of each object within half a texel. ---
+  // --- The coarsest level of each object within one texel. ---
   ImpostorScene impostorScene;
   impostorScene.lighting = loaded->lighting;
   double levelError = 0.0;  // world metres, largest over the objects
