@@ -3,7 +3,7 @@
 // in the same run. Not a test. Usage: bench_impostor [repetitions] [models dir]
 // Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra
 // Kinds: simple / meshed from the full mesh (the old path), simple-level /
-// meshed-level from the coarsest progressive-mesh level within half a texel
+// meshed-level from the coarsest progressive-mesh level within one texel
 // (impostor_level.h, what the service renders), with their difference to
 // the full-mesh capture of the same run in `extra`: max / mean absolute
 // RGBA difference, coverage-mismatch texels (of texels covered in either),

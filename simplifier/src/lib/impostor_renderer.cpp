@@ -51,8 +51,8 @@ void bleedColorIntoTransparent(RgbaImage& image, int pixels) {
   // row-dilated mask, later ones are the unfilled neighbours of the last
   // ring (any other unfilled texel still has no filled neighbour). Same
   // result as scanning the image every pass, at a cost that follows the
-  // silhouette's length (it was 0.5 ms per 256x256 impostor, see
-  // docs/results/core-benchmarks.md).
+  // silhouette's length (the full scans were about 0.26 ms per 256x256
+  // capture, docs/results/core-benchmarks.md).
   std::vector<unsigned char> dilated(n);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {

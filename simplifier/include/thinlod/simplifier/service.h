@@ -50,7 +50,7 @@ struct ServiceOptions {
   std::size_t maxCachedScenes = 4;           // least recently used scenes are dropped
   int maxPrimitiveTriangles = 65536;         // finest primitive tessellation served
   std::size_t meshedImpostorTriangles = 64;  // depth-mesh target (QEM) of meshed impostors
-  // Render impostors from the coarsest level within half a texel
+  // Render impostors from the coarsest level within one texel
   // (impostor_level.h); false: always the full meshes (the reference capture).
   bool impostorFromLevels = true;
   MeshCurveOptions curve = defaultCurveOptions();
