@@ -2,6 +2,14 @@
 // and bunny on each offscreen back-end, with an empty-frame baseline measured
 // in the same run. Not a test. Usage: bench_impostor [repetitions] [models dir]
 // Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra
+// Kinds: simple / meshed from the full mesh (the old path), simple-level /
+// meshed-level from the coarsest progressive-mesh level within one texel
+// (impostor_level.h, what the service renders), with their difference to
+// the full-mesh capture of the same run in `extra`: max / mean absolute
+// RGBA difference, coverage-mismatch texels (of texels covered in either),
+// and for meshed the displacement of depth-mesh vertices on the same texel.
+// The error curve is measured once per model (service curve options) and
+// cached in MeshCurveCache::defaultDirectory().
 // (cpu_ms: process CPU time per call, all llvmpipe threads included; less
 // sensitive than wall time to other processes competing for the 2 cores).
 #include <algorithm>
@@ -9,12 +17,19 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <glm/geometric.hpp>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "thinlod/common/mesh_io.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/simplifier/impostor.h"
+#include "thinlod/simplifier/impostor_level.h"
+#include "thinlod/simplifier/mesh_curve.h"
+#include "thinlod/simplifier/progressive_mesh.h"
+#include "thinlod/simplifier/service.h"
 
 using namespace thinlod;
 using namespace thinlod::simplifier;
@@ -57,12 +72,95 @@ Summary timeIt(int repetitions, F&& body) {
   return s;
 }
 
+// Depth-mesh vertices of `level` against those of `full` on the same texel
+// (matched by uv: each grid node sits on one texel).
+struct Displacement {
+  double max = 0.0, p99 = 0.0, mean = 0.0;
+  std::size_t matched = 0, vertices = 0;
+};
+Displacement vertexDisplacement(const IndexedMesh& full, const IndexedMesh& level, int size) {
+  auto texel = [size](const glm::vec2& uv) {
+    return std::make_pair(static_cast<int>(std::floor(uv.x * size)),
+                          static_cast<int>(std::floor(uv.y * size)));
+  };
+  std::map<std::pair<int, int>, glm::vec3> byTexel;
+  for (std::size_t i = 0; i < full.positions.size(); ++i) {
+    byTexel[texel(full.uvs[i])] = full.positions[i];
+  }
+  Displacement d;
+  d.vertices = level.positions.size();
+  std::vector<double> moved;
+  for (std::size_t i = 0; i < level.positions.size(); ++i) {
+    auto found = byTexel.find(texel(level.uvs[i]));
+    if (found == byTexel.end()) continue;
+    moved.push_back(glm::length(found->second - level.positions[i]));
+  }
+  d.matched = moved.size();
+  if (moved.empty()) return d;
+  std::sort(moved.begin(), moved.end());
+  d.max = moved.back();
+  d.p99 = moved[std::min(moved.size() - 1, moved.size() * 99 / 100)];
+  double sum = 0.0;
+  for (double e : moved) sum += e;
+  d.mean = sum / moved.size();
+  return d;
+}
+
+std::string differenceText(const RgbaImage& full, const RgbaImage& level) {
+  auto diff = compareImpostorTextures(full, level);
+  if (!diff.ok()) {
+    std::fprintf(stderr, "%s\n", diff.status().toString().c_str());
+    std::exit(1);
+  }
+  char text[160];
+  std::snprintf(text, sizeof text, "rgba_max=%d rgba_mean=%.3f coverage_mismatch=%zu/%zu",
+                diff->maxAbs, diff->meanAbs, diff->coverageMismatch, diff->coveredEither);
+  return text;
+}
+
+// The level the service would render `mesh` from at this framing.
+struct ChosenLevel {
+  std::shared_ptr<IndexedMesh> mesh;  // null: the full mesh
+  double error = 0.0;                 // credited world error
+  double tolerance = 0.0;
+};
+ChosenLevel chooseLevel(const IndexedMesh& mesh, const glm::vec3& eye) {
+  auto pm = ProgressiveMesh::build(mesh);
+  if (!pm.ok()) {
+    std::fprintf(stderr, "%s\n", pm.status().toString().c_str());
+    std::exit(1);
+  }
+  MeshCurveCache cache(MeshCurveCache::defaultDirectory());
+  const MeshCurveOptions curveOptions = ServiceOptions::defaultCurveOptions();
+  auto curves = cache.getOrMeasure(mesh, "bench_impostor qem default", *pm, curveOptions);
+  if (!curves.ok()) {
+    std::fprintf(stderr, "%s\n", curves.status().toString().c_str());
+    std::exit(1);
+  }
+  std::vector<glm::vec3> points(mesh.positions.begin(), mesh.positions.end());
+  auto framing = frameImpostor(points, eye, ImpostorOptions());
+  if (!framing.ok()) std::exit(1);
+  ChosenLevel chosen;
+  chosen.tolerance = impostorLevelTolerance(*framing);
+  const std::vector<double> credits =
+      creditedRelativeErrors(curves->levels, curveOptions.minRelativeError);
+  const double diameter = mesh.diameter();
+  const auto level = chooseImpostorLevel(credits, diameter, chosen.tolerance);
+  if (level) {
+    chosen.mesh =
+        std::make_shared<IndexedMesh>(pm->extract(curves->levels[*level].requestedTriangles));
+    chosen.error = credits[*level] * diameter;
+  }
+  return chosen;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const int repetitions = argc > 1 ? std::max(3, std::atoi(argv[1])) : 21;
   const std::string models = argc > 2 ? argv[2] : std::string(THINLOD_SHARED_DIR) + "/models";
   std::printf("backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra\n");
+  std::map<std::string, ChosenLevel> levels;  // per model, shared by the back-ends
   for (render::Backend backend : {render::Backend::kEgl, render::Backend::kOsMesa}) {
     auto context = render::createOffscreenContext(backend, 16, 16);
     if (!context.ok()) {
@@ -105,6 +203,14 @@ int main(int argc, char** argv) {
       });
       std::printf("%s,%s,%zu,clear+readback,256,%.3f,%.3f,%.3f,%.3f,,\n", name, file, triangles,
                   baseline.median, baseline.min, baseline.p90, baseline.cpu);
+      std::vector<float> depthScratch;
+      const Summary withDepth = timeIt(repetitions, [&] {
+        (void)(*baselineContextTarget)->clear(0, 0, 0, 0);
+        (void)(*baselineContextTarget)->readColor(scratch);
+        (void)(*baselineContextTarget)->readDepth(depthScratch);
+      });
+      std::printf("%s,%s,%zu,clear+readback+depth,256,%.3f,%.3f,%.3f,%.3f,,\n", name, file,
+                  triangles, withDepth.median, withDepth.min, withDepth.p90, withDepth.cpu);
 
       SimpleImpostor simple;
       const Summary s = timeIt(repetitions, [&] {
@@ -137,6 +243,46 @@ int main(int argc, char** argv) {
           name, file, triangles, m.median, m.min, m.p90, m.cpu, meshed.coverage,
           meshed.mesh.triangleCount(), t.renderMs, t.meshMs, meshed.validity.alpha(),
           meshed.meshDepthError);
+
+      // The same captures from the chosen level (GPU copy cached by the renderer).
+      if (levels.find(file) == levels.end()) levels[file] = chooseLevel(*part.mesh, eye);
+      const ChosenLevel& chosen = levels[file];
+      ImpostorScene levelScene = scene;
+      if (chosen.mesh) levelScene.parts[0].mesh = chosen.mesh;
+      const std::size_t levelTriangles = levelScene.parts[0].mesh->triangleCount();
+      SimpleImpostor simpleLevel;
+      const Summary sl = timeIt(repetitions, [&] {
+        auto result = (*impostors)->renderSimple(levelScene, eye);
+        if (!result.ok()) {
+          std::fprintf(stderr, "%s\n", result.status().toString().c_str());
+          std::exit(1);
+        }
+        simpleLevel = std::move(result).value();
+      });
+      std::printf(
+          "%s,%s,%zu,simple-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,level_error=%.3e "
+          "tolerance=%.3e level_error_texels=%.3f %s\n",
+          name, file, levelTriangles, sl.median, sl.min, sl.p90, sl.cpu, simpleLevel.coverage,
+          chosen.error, chosen.tolerance,
+          chosen.tolerance > 0 ? chosen.error / chosen.tolerance : 0.0,
+          differenceText(simple.texture, simpleLevel.texture).c_str());
+      MeshedImpostor meshedLevel;
+      const Summary ml = timeIt(repetitions, [&] {
+        auto result = (*impostors)->renderMeshed(levelScene, eye);
+        if (!result.ok()) {
+          std::fprintf(stderr, "%s\n", result.status().toString().c_str());
+          std::exit(1);
+        }
+        meshedLevel = std::move(result).value();
+      });
+      const ImpostorTimings& tl = (*impostors)->lastTimings();
+      const Displacement moved = vertexDisplacement(meshed.mesh, meshedLevel.mesh, 256);
+      std::printf(
+          "%s,%s,%zu,meshed-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,render=%.2fms mesh=%.2fms %s "
+          "vertex_moved_max=%.3e p99=%.3e mean=%.3e matched=%zu/%zu radius=%.3e\n",
+          name, file, levelTriangles, ml.median, ml.min, ml.p90, ml.cpu, meshedLevel.coverage,
+          tl.renderMs, tl.meshMs, differenceText(meshed.texture, meshedLevel.texture).c_str(),
+          moved.max, moved.p99, moved.mean, moved.matched, moved.vertices, sphere.radius);
     }
     (*impostors).reset();
   }

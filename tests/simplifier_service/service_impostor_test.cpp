@@ -7,6 +7,7 @@
 #include "service_test_util.h"
 #include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/conic_range.h"
+#include "thinlod/simplifier/impostor_level.h"
 #include "thinlod/simplifier/service.h"
 
 namespace thinlod::simplifier {
@@ -104,6 +105,44 @@ TEST(SimplifierServiceImpostor, SimpleImpostorOfTheCow) {
   // About (cow size) / (2 texels): the quad is ~0.8 m over 128 texels.
   EXPECT_GT(rep.accuracy, 30.0);
   EXPECT_LT(rep.accuracy, 128.0);
+}
+
+// The daemon renders the cow from a coarser level (impostor_level.h): the
+// texture stays within the stated tolerance of the full-mesh capture, the
+// level is extracted once, and the reported accuracy D / (2 s + e) counts
+// the level's error e <= s (so it lies in [2/3, 1) of the full one's).
+TEST(SimplifierServiceImpostor, RendersFromALevelAndCountsItsError) {
+  for (protocol::RepresentationKind kind : {protocol::RepresentationKind::kSimpleImpostor,
+                                            protocol::RepresentationKind::kMeshedImpostor}) {
+    SimplifierService levels(withDefaultScene());
+    ServiceOptions fullOptions = withDefaultScene();
+    fullOptions.impostorFromLevels = false;
+    SimplifierService full(fullOptions);
+    const protocol::ImpostorRequest request = impostorOf(kCow, kind, 256);
+    const protocol::ImpostorResult fromLevel = levels.renderImpostor(request);
+    const protocol::ImpostorResult fromFull = full.renderImpostor(request);
+    ASSERT_TRUE(fromLevel.status.ok()) << fromLevel.status.toString();
+    ASSERT_TRUE(fromFull.status.ok()) << fromFull.status.toString();
+    EXPECT_EQ(levels.stats().impostorLevelsExtracted, 1u);
+    EXPECT_EQ(full.stats().impostorLevelsExtracted, 0u);
+    // Again: the kept level (and its GPU copy) is reused, the texture identical.
+    const protocol::ImpostorResult again = levels.renderImpostor(request);
+    ASSERT_TRUE(again.status.ok());
+    EXPECT_EQ(levels.stats().impostorLevelsExtracted, 1u);
+    EXPECT_EQ(again.representation.texture.data, fromLevel.representation.texture.data);
+
+    RgbaImage a(256, 256);
+    RgbaImage b(256, 256);
+    a.pixels = fromFull.representation.texture.data;
+    b.pixels = fromLevel.representation.texture.data;
+    auto diff = compareImpostorTextures(a, b);
+    ASSERT_TRUE(diff.ok()) << diff.status().toString();
+    EXPECT_LE(diff->meanAbs, 1.0);
+    EXPECT_LE(diff->coverageMismatch, diff->coveredEither / 50);  // <= 2 %
+    const double ratio = fromLevel.representation.accuracy / fromFull.representation.accuracy;
+    EXPECT_LT(ratio, 1.0);
+    EXPECT_GE(ratio, 2.0 / 3.0 - 1e-9);
+  }
 }
 
 TEST(SimplifierServiceImpostor, MeshedImpostorOfTheCow) {

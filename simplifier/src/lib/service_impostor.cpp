@@ -1,16 +1,18 @@
 // SimplifierService: ImpostorRequest handling (service.h). Objects are drawn
-// in world space from the coarsest level whose error stays under half a
-// texel, then the quad / depth mesh and the texture are encoded.
+// in world space from the coarsest level whose error stays under one texel
+// (impostor_level.h), then the quad / depth mesh and the texture are encoded.
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <optional>
 #include <set>
 #include <string>
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/scene_render.h"
+#include "thinlod/simplifier/impostor_level.h"
 
 namespace thinlod::simplifier {
 
@@ -176,15 +178,11 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   }
   Result<ImpostorFraming> framing = frameImpostor(points, request.eye, base);
   if (!framing.ok()) return framing.status();
-  // Smallest texel footprint on the object: at its nearest depth.
-  const double texelAtPlane =
-      std::min(framing->quad.width, framing->quad.height) / static_cast<double>(size);
-  const double nearScale = framing->planeDistance > 0.0f
-                               ? std::max(0.0f, framing->nearDepth) / framing->planeDistance
-                               : 1.0;
-  const double allowedError = 0.5 * texelAtPlane * nearScale;
+  // The smallest texel footprint on the objects (impostor_level.h says why
+  // one texel); 0 when levels are switched off: every object at full resolution.
+  const double allowedError = options.impostorFromLevels ? impostorLevelTolerance(*framing) : 0.0;
 
-  // --- The coarsest level of each object within half a texel. ---
+  // --- The coarsest level of each object within one texel. ---
   ImpostorScene impostorScene;
   impostorScene.lighting = loaded->lighting;
   double levelError = 0.0;  // world metres, largest over the objects
@@ -218,14 +216,11 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
       if (!model.ok()) return model.status();
       THINLOD_RETURN_IF_ERROR(ensureCurve(**model));
       MeshModel& m = **model;
-      const double allowedRelative = allowedError / (m.diameter * scale);
-      const LevelCredit* chosen = nullptr;
-      for (const LevelCredit& rung : m.ladder) {
-        if (rung.relativeError <= allowedRelative) {
-          chosen = &rung;
-          break;
-        }
-      }
+      std::vector<double> credits(m.ladder.size());
+      for (std::size_t i = 0; i < credits.size(); ++i) credits[i] = m.ladder[i].relativeError;
+      const std::optional<std::size_t> level =
+          chooseImpostorLevel(credits, m.diameter * scale, allowedError);
+      const LevelCredit* chosen = level ? &m.ladder[*level] : nullptr;
       if (chosen == nullptr) {
         mesh = m.original;  // nothing coarser is fine enough: the full mesh (error 0)
       } else {
@@ -240,6 +235,7 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
                       chosen->requestedTriangles,
                       std::make_shared<const IndexedMesh>(m.pm.extract(chosen->requestedTriangles)))
                   .first;
+          ++stats.impostorLevelsExtracted;
         }
         mesh = cached->second;
         levelError = std::max(levelError, chosen->relativeError * m.diameter * scale);

@@ -6,6 +6,7 @@
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/simplifier/impostor_level.h"
 
 namespace thinlod::simplifier::service_detail {
 
@@ -26,14 +27,12 @@ DeliveredLevel deliveredLevel(double relativeError) {
 
 std::vector<LevelCredit> creditLevels(const std::vector<CurveLevel>& levels,
                                       double minRelativeError) {
+  const std::vector<double> credits = creditedRelativeErrors(levels, minRelativeError);
   std::vector<LevelCredit> ladder(levels.size());
-  double worstFiner = 0.0;
-  for (std::size_t i = levels.size(); i-- > 0;) {
-    const double d = std::max(levels[i].relativeMaxError, minRelativeError);
-    worstFiner = std::max(worstFiner, d);
+  for (std::size_t i = 0; i < levels.size(); ++i) {
     ladder[i].requestedTriangles = levels[i].requestedTriangles;
     ladder[i].triangles = levels[i].triangles;
-    ladder[i].relativeError = worstFiner;
+    ladder[i].relativeError = credits[i];
   }
   return ladder;
 }

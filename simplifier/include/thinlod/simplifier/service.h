@@ -50,6 +50,9 @@ struct ServiceOptions {
   std::size_t maxCachedScenes = 4;           // least recently used scenes are dropped
   int maxPrimitiveTriangles = 65536;         // finest primitive tessellation served
   std::size_t meshedImpostorTriangles = 64;  // depth-mesh target (QEM) of meshed impostors
+  // Render impostors from the coarsest level within one texel
+  // (impostor_level.h); false: always the full meshes (the reference capture).
+  bool impostorFromLevels = true;
   MeshCurveOptions curve = defaultCurveOptions();
 
   static MeshCurveOptions defaultCurveOptions();
@@ -63,6 +66,7 @@ struct ServiceStats {
   std::uint64_t curvesFromDisk = 0;  // read from the curve cache directory
   std::uint64_t simplifyRequests = 0;
   std::uint64_t impostorRequests = 0;
+  std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
   std::uint64_t failedRequests = 0;
 };
 
