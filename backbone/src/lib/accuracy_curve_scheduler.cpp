@@ -42,6 +42,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
       budget.fixedAccuracy ? hard : reserveShare(hard, config.budgetReserveShare);
   const bool trianglesFirst = !(hard.useLink && !hard.useTriangles);
 
+  state.stepCandidates.reset();
   std::vector<LeafSelection> selections;
   double target = budget.fixedAccuracy.value_or(kInf);
   bool useSolver = hard.useTriangles && hard.useLink;
@@ -68,6 +69,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
     }
   }
   if (useSolver) {
+    state.stepCandidates.reset();  // the solver's selections have none stored
     stats.usedExactSolver = true;
     selections.clear();
     JointSolver solver(scene, config, region, state, reserved, stats);

@@ -253,9 +253,28 @@ const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
 }
 
 void CurvePropagator::pushDown(double targetAccuracy, std::vector<LeafSelection>& out) {
+  StepCandidates& kept = state_.stepCandidates;
+  kept.reset();
+  const std::size_t first = out.size();
   out_ = &out;
   pushAbsolute(0, targetAccuracy);
   out_ = nullptr;
+  if (config_.reuseLeafWork && first == 0) {
+    kept.begin.push_back(static_cast<std::uint32_t>(kept.pool.size()));
+    kept.valid = kept.begin.size() == out.size() + 1;
+  } else {
+    kept.reset();
+  }
+}
+
+void CurvePropagator::emit(const LeafSelection& selection,
+                           const std::vector<LeafCandidate>* candidates) {
+  if (config_.reuseLeafWork) {
+    StepCandidates& kept = state_.stepCandidates;
+    kept.begin.push_back(static_cast<std::uint32_t>(kept.pool.size()));
+    if (candidates) kept.pool.insert(kept.pool.end(), candidates->begin(), candidates->end());
+  }
+  out_->push_back(selection);
 }
 
 void CurvePropagator::reportUnrenderable(std::uint32_t n) {
@@ -265,7 +284,7 @@ void CurvePropagator::reportUnrenderable(std::uint32_t n) {
     s.node = n;
     s.object = node.object;
     s.rendered = false;
-    out_->push_back(s);
+    emit(s, nullptr);
   } else if (node.kind == SceneNodeKind::kGroup) {
     for (std::uint32_t i = 0; i < node.childCount; ++i)
       reportUnrenderable(scene_.children[node.firstChild + i]);
@@ -374,7 +393,7 @@ void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, doubl
     reportUnrenderable(n);
     return;
   }
-  out_->push_back(makeSelection(n, node.object, scratch_[pick], need, distance, diameter));
+  emit(makeSelection(n, node.object, scratch_[pick], need, distance, diameter), &scratch_);
 }
 
 }  // namespace thinlod::backbone

@@ -44,6 +44,8 @@ class CurvePropagator {
   void pushRelative(std::uint32_t n, double relativeAccuracy, double absoluteAccuracy);
   void chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
   void reportUnrenderable(std::uint32_t n);
+  // Appends a selection and, when reusing leaf work, its candidates.
+  void emit(const LeafSelection& selection, const std::vector<LeafCandidate>* candidates);
 
   const SchedulingScene& scene_;
   const SchedulerConfig& config_;

@@ -40,6 +40,23 @@ struct ResourceCache {
   std::vector<RelativeEntry> relative;
 };
 
+// The exact candidates of each leaf selection of this step as the push-down
+// collected them (selection i owns pool[begin[i], begin[i + 1])), so the
+// hysteresis pass need not collect them again (SchedulerConfig::
+// reuseLeafWork). Only valid right after a push-down; cleared before any
+// other producer of selections runs.
+struct StepCandidates {
+  bool valid = false;
+  std::vector<LeafCandidate> pool;
+  std::vector<std::uint32_t> begin;
+
+  void reset() {
+    valid = false;
+    pool.clear();
+    begin.clear();
+  }
+};
+
 struct LinkSend {
   double time = 0.0;
   double bytes = 0.0;
@@ -51,6 +68,7 @@ struct PlannerStateImpl {
   std::size_t nodeCount = 0;
   std::size_t objectCount = 0;
   ResourceCache cache[2];  // [0] triangles, [1] link bytes
+  StepCandidates stepCandidates;
   std::uint64_t pendingGeneration = 1;
   std::uint64_t nextRequestId = 1;
   std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object

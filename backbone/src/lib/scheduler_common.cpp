@@ -111,7 +111,9 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     bool byDelay;
   };
   std::vector<Wish> wishes;
-  std::vector<LeafCandidate> candidates;
+  std::vector<LeafCandidate> collected;
+  const bool stored = config.reuseLeafWork && state.stepCandidates.valid &&
+                      state.stepCandidates.begin.size() == selections.size() + 1;
   for (std::size_t i = 0; i < selections.size(); ++i) {
     LeafSelection& s = selections[i];
     if (!s.rendered || s.object >= state.switchCounters.size()) continue;
@@ -127,12 +129,23 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
       hasCopy = scene.options[object.firstOption + k].atFrontend.present;
     if (!hasCopy) continue;
-    const SceneNode& node = scene.nodes[s.node];
-    collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
-                          pendingFor(state, s.object), node.bounds, candidates);
+    // The push-down's candidates for this leaf are the same ones (same
+    // region, scene and in-flight requests): reuse them when stored.
+    const LeafCandidate* candidates = nullptr;
+    std::size_t candidateCount = 0;
+    if (stored) {
+      candidates = state.stepCandidates.pool.data() + state.stepCandidates.begin[i];
+      candidateCount = state.stepCandidates.begin[i + 1] - state.stepCandidates.begin[i];
+    } else {
+      const SceneNode& node = scene.nodes[s.node];
+      collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
+                            pendingFor(state, s.object), node.bounds, collected);
+      candidates = collected.data();
+      candidateCount = collected.size();
+    }
     int best = -1;
     CandidateCost bestCost;
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
+    for (std::size_t c = 0; c < candidateCount; ++c) {
       const LeafCandidate& k = candidates[c];
       if (k.source != CandidateSource::kFrontendCopy && k.source != CandidateSource::kPending)
         continue;
@@ -179,6 +192,7 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     counter = w.byDelay ? static_cast<std::uint16_t>(counter + 1) : 0;
     ++stats.hysteresisKeeps;
   }
+  state.stepCandidates.reset();
 }
 
 }  // namespace thinlod::backbone
