@@ -123,11 +123,23 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
       counter = 0;
       continue;
     }
-    // Cheap skip: nothing displayed or in flight for this object.
-    const SceneObject& object = scene.objects[s.object];
-    bool hasCopy = pendingFor(state, s.object) != nullptr;
-    for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
-      hasCopy = scene.options[object.firstOption + k].atFrontend.present;
+    // Cheap skip: nothing displayed or in flight for this object. A stored
+    // frontend or in-flight candidate proves there is one without reading
+    // the scene's options again (a cache miss per leaf).
+    bool hasCopy = false;
+    if (stored) {
+      for (std::uint32_t c = state.stepCandidates.begin[i];
+           c < state.stepCandidates.begin[i + 1] && !hasCopy; ++c) {
+        const CandidateSource source = state.stepCandidates.pool[c].source;
+        hasCopy = source == CandidateSource::kFrontendCopy || source == CandidateSource::kPending;
+      }
+    }
+    if (!hasCopy) {
+      const SceneObject& object = scene.objects[s.object];
+      hasCopy = pendingFor(state, s.object) != nullptr;
+      for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
+        hasCopy = scene.options[object.firstOption + k].atFrontend.present;
+    }
     if (!hasCopy) continue;
     // The push-down's candidates for this leaf are the same ones (same
     // region, scene and in-flight requests): reuse them when stored.
@@ -175,11 +187,24 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     wishes.push_back({i, candidates[best], bestCost.triangles - s.cost.triangles,
                       bestCost.linkBytes - s.cost.linkBytes, !smallGain});
   }
-  std::stable_sort(wishes.begin(), wishes.end(), [](const Wish& a, const Wish& b) {
+  // Cheapest extras first, ties in wish order: a stable sort of small keys
+  // (the same order as sorting the wishes themselves, fewer bytes moved).
+  struct WishKey {
+    double extraTriangles;
+    double extraLink;
+    std::uint32_t wish;
+  };
+  std::vector<WishKey> order;
+  order.reserve(wishes.size());
+  for (std::size_t w = 0; w < wishes.size(); ++w)
+    order.push_back(
+        {wishes[w].extraTriangles, wishes[w].extraLink, static_cast<std::uint32_t>(w)});
+  std::stable_sort(order.begin(), order.end(), [](const WishKey& a, const WishKey& b) {
     if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
     return a.extraLink < b.extraLink;
   });
-  for (const Wish& w : wishes) {
+  for (const WishKey& key : order) {
+    const Wish& w = wishes[key.wish];
     LeafSelection& s = selections[w.selection];
     std::uint16_t& counter = state.switchCounters[s.object];
     if (w.extraTriangles > roomTriangles || w.extraLink > roomLink) {
