@@ -112,7 +112,14 @@ CurvePropagator::CurvePropagator(const SchedulingScene& scene, const SchedulerCo
       resource_(resource),
       stats_(stats) {}
 
-const AccuracyCurve& CurvePropagator::evaluateRoot() { return evaluateAbsolute(0, false); }
+const AccuracyCurve& CurvePropagator::evaluateRoot() {
+  EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+  ++evaluated.epoch;
+  evaluated.pool.clear();
+  if (config_.reuseLeafWork && evaluated.byNode.size() != scene_.nodes.size())
+    evaluated.byNode.assign(scene_.nodes.size(), EvaluatedCandidates::Span{});
+  return evaluateAbsolute(0, false);
+}
 
 AccuracyCurve CurvePropagator::leafRelativeCurve(std::uint32_t n, const PredictedRegion& region,
                                                  CandidateContext context) {
@@ -121,6 +128,14 @@ AccuracyCurve CurvePropagator::leafRelativeCurve(std::uint32_t n, const Predicte
       context == CandidateContext::kExact ? pendingFor(state_, node.object) : nullptr;
   collectLeafCandidates(scene_, node.object, region, config_, context, pending, node.bounds,
                         scratch_);
+  if (config_.reuseLeafWork && context == CandidateContext::kExact && &region == &region_) {
+    EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+    if (n < evaluated.byNode.size()) {
+      evaluated.byNode[n] = {evaluated.epoch, static_cast<std::uint32_t>(evaluated.pool.size()),
+                             static_cast<std::uint32_t>(scratch_.size())};
+      evaluated.pool.insert(evaluated.pool.end(), scratch_.begin(), scratch_.end());
+    }
+  }
   if (scratch_.empty()) return AccuracyCurve();
   std::vector<AccuracyCurve> owned;
   owned.reserve(scratch_.size());
@@ -384,8 +399,16 @@ void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, doubl
   const double diameter = 2.0 * node.bounds.radius;
   const double distance =
       conversionDistance(region_.center, region_.reachRadius, node.bounds, config_.minimalDistance);
-  collectLeafCandidates(scene_, node.object, region_, config_, CandidateContext::kExact,
-                        pendingFor(state_, node.object), node.bounds, scratch_);
+  const EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+  if (config_.reuseLeafWork && n < evaluated.byNode.size() &&
+      evaluated.byNode[n].epoch == evaluated.epoch) {
+    const EvaluatedCandidates::Span span = evaluated.byNode[n];
+    scratch_.assign(evaluated.pool.begin() + span.begin,
+                    evaluated.pool.begin() + span.begin + span.count);
+  } else {
+    collectLeafCandidates(scene_, node.object, region_, config_, CandidateContext::kExact,
+                          pendingFor(state_, node.object), node.bounds, scratch_);
+  }
   double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
   need = std::min(need, bestCandidateAccuracy(scratch_));
   int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);

@@ -57,6 +57,20 @@ struct StepCandidates {
   }
 };
 
+// Exact candidates a leaf's absolute curve was built from in the current
+// evaluation (epoch), so its push-down need not collect them again (same
+// region, scene and in-flight requests within one step).
+struct EvaluatedCandidates {
+  std::uint64_t epoch = 0;  // bumped by every evaluateRoot
+  std::vector<LeafCandidate> pool;
+  struct Span {
+    std::uint64_t epoch = 0;
+    std::uint32_t begin = 0;
+    std::uint32_t count = 0;
+  };
+  std::vector<Span> byNode;
+};
+
 struct LinkSend {
   double time = 0.0;
   double bytes = 0.0;
@@ -69,6 +83,7 @@ struct PlannerStateImpl {
   std::size_t objectCount = 0;
   ResourceCache cache[2];  // [0] triangles, [1] link bytes
   StepCandidates stepCandidates;
+  EvaluatedCandidates evaluatedCandidates;
   std::uint64_t pendingGeneration = 1;
   std::uint64_t nextRequestId = 1;
   std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object

@@ -197,8 +197,7 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
   std::vector<WishKey> order;
   order.reserve(wishes.size());
   for (std::size_t w = 0; w < wishes.size(); ++w)
-    order.push_back(
-        {wishes[w].extraTriangles, wishes[w].extraLink, static_cast<std::uint32_t>(w)});
+    order.push_back({wishes[w].extraTriangles, wishes[w].extraLink, static_cast<std::uint32_t>(w)});
   std::stable_sort(order.begin(), order.end(), [](const WishKey& a, const WishKey& b) {
     if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
     return a.extraLink < b.extraLink;
