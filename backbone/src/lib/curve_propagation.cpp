@@ -270,13 +270,14 @@ const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
 void CurvePropagator::pushDown(double targetAccuracy, std::vector<LeafSelection>& out) {
   StepCandidates& kept = state_.stepCandidates;
   kept.reset();
+  deferred_.clear();
   const std::size_t first = out.size();
   out_ = &out;
   pushAbsolute(0, targetAccuracy);
+  decideDeferredLeaves();
   out_ = nullptr;
   if (config_.reuseLeafWork && first == 0) {
-    kept.begin.push_back(static_cast<std::uint32_t>(kept.pool.size()));
-    kept.valid = kept.begin.size() == out.size() + 1;
+    kept.valid = kept.begin.size() == out.size() && kept.count.size() == out.size();
   } else {
     kept.reset();
   }
@@ -287,19 +288,47 @@ void CurvePropagator::emit(const LeafSelection& selection,
   if (config_.reuseLeafWork) {
     StepCandidates& kept = state_.stepCandidates;
     kept.begin.push_back(static_cast<std::uint32_t>(kept.pool.size()));
+    kept.count.push_back(candidates ? static_cast<std::uint32_t>(candidates->size()) : 0);
     if (candidates) kept.pool.insert(kept.pool.end(), candidates->begin(), candidates->end());
   }
   out_->push_back(selection);
 }
 
+LeafSelection CurvePropagator::unrenderedLeaf(std::uint32_t n) const {
+  LeafSelection s;
+  s.node = n;
+  s.object = scene_.nodes[n].object;
+  s.rendered = false;
+  return s;
+}
+
+void CurvePropagator::deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
+  const std::uint32_t slot = static_cast<std::uint32_t>(out_->size());
+  emit(unrenderedLeaf(n), nullptr);  // placeholder, overwritten in decideDeferredLeaves
+  deferred_.push_back({scene_.nodes[n].object, slot, n, absoluteAccuracy, relativeCap});
+}
+
+void CurvePropagator::decideDeferredLeaves() {
+  if (deferred_.empty()) return;
+  std::sort(deferred_.begin(), deferred_.end(),
+            [](const DeferredLeaf& a, const DeferredLeaf& b) {
+              return a.object != b.object ? a.object < b.object : a.slot < b.slot;
+            });
+  StepCandidates& kept = state_.stepCandidates;
+  for (const DeferredLeaf& d : deferred_) {
+    LeafSelection s = decideLeaf(d.node, d.absoluteAccuracy, d.relativeCap);
+    kept.begin[d.slot] = static_cast<std::uint32_t>(kept.pool.size());
+    kept.count[d.slot] = s.rendered ? static_cast<std::uint32_t>(scratch_.size()) : 0;
+    if (s.rendered) kept.pool.insert(kept.pool.end(), scratch_.begin(), scratch_.end());
+    (*out_)[d.slot] = s;
+  }
+  deferred_.clear();
+}
+
 void CurvePropagator::reportUnrenderable(std::uint32_t n) {
   const SceneNode& node = scene_.nodes[n];
   if (node.kind == SceneNodeKind::kLeaf) {
-    LeafSelection s;
-    s.node = n;
-    s.object = node.object;
-    s.rendered = false;
-    emit(s, nullptr);
+    emit(unrenderedLeaf(n), nullptr);
   } else if (node.kind == SceneNodeKind::kGroup) {
     for (std::uint32_t i = 0; i < node.childCount; ++i)
       reportUnrenderable(scene_.children[node.firstChild + i]);
@@ -317,7 +346,11 @@ void CurvePropagator::pushAbsolute(std::uint32_t n, double accuracy) {
       reportUnrenderable(n);
       return;
     }
-    chooseLeaf(n, accuracy, kInf);
+    if (config_.reuseLeafWork) {
+      deferLeaf(n, accuracy, kInf);
+    } else {
+      chooseLeaf(n, accuracy, kInf);
+    }
     return;
   }
   if (e.merged) {
@@ -362,7 +395,11 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
   }
   const double clamped = std::min(relativeAccuracy, r.curve.maxAccuracy());
   if (node.kind == SceneNodeKind::kLeaf) {
-    chooseLeaf(n, absoluteAccuracy, clamped);
+    if (config_.reuseLeafWork) {
+      deferLeaf(n, absoluteAccuracy, clamped);
+    } else {
+      chooseLeaf(n, absoluteAccuracy, clamped);
+    }
     return;
   }
   const double diameter = 2.0 * node.bounds.radius;
@@ -395,6 +432,12 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
 }
 
 void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
+  const LeafSelection s = decideLeaf(n, absoluteAccuracy, relativeCap);
+  emit(s, s.rendered ? &scratch_ : nullptr);
+}
+
+LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, double absoluteAccuracy,
+                                          double relativeCap) {
   const SceneNode& node = scene_.nodes[n];
   const double diameter = 2.0 * node.bounds.radius;
   const double distance =
@@ -412,11 +455,8 @@ void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, doubl
   double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
   need = std::min(need, bestCandidateAccuracy(scratch_));
   int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
-  if (pick < 0) {
-    reportUnrenderable(n);
-    return;
-  }
-  emit(makeSelection(n, node.object, scratch_[pick], need, distance, diameter), &scratch_);
+  if (pick < 0) return unrenderedLeaf(n);
+  return makeSelection(n, node.object, scratch_[pick], need, distance, diameter);
 }
 
 }  // namespace thinlod::backbone

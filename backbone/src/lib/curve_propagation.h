@@ -42,7 +42,15 @@ class CurvePropagator {
                                   CandidateContext context);
   void pushAbsolute(std::uint32_t n, double accuracy);
   void pushRelative(std::uint32_t n, double relativeAccuracy, double absoluteAccuracy);
+  // Reference path: decides the leaf now, in tree order.
   void chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  // reuseLeafWork: keeps the leaf's slot in tree order and decides it later,
+  // in object order (the scene's objects and options are then read nearly
+  // sequentially instead of at random; the decision itself is the same).
+  void deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  void decideDeferredLeaves();
+  LeafSelection decideLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  LeafSelection unrenderedLeaf(std::uint32_t n) const;
   void reportUnrenderable(std::uint32_t n);
   // Appends a selection and, when reusing leaf work, its candidates.
   void emit(const LeafSelection& selection, const std::vector<LeafCandidate>* candidates);
@@ -56,6 +64,14 @@ class CurvePropagator {
   PlanStats& stats_;
   std::vector<LeafCandidate> scratch_;
   std::vector<LeafSelection>* out_ = nullptr;
+  struct DeferredLeaf {
+    std::uint32_t object;
+    std::uint32_t slot;  // index into *out_
+    std::uint32_t node;
+    double absoluteAccuracy;
+    double relativeCap;
+  };
+  std::vector<DeferredLeaf> deferred_;
 };
 
 }  // namespace thinlod::backbone

@@ -41,19 +41,21 @@ struct ResourceCache {
 };
 
 // The exact candidates of each leaf selection of this step as the push-down
-// collected them (selection i owns pool[begin[i], begin[i + 1])), so the
-// hysteresis pass need not collect them again (SchedulerConfig::
+// collected them (selection i owns pool[begin[i], begin[i] + count[i])), so
+// the hysteresis pass need not collect them again (SchedulerConfig::
 // reuseLeafWork). Only valid right after a push-down; cleared before any
 // other producer of selections runs.
 struct StepCandidates {
   bool valid = false;
   std::vector<LeafCandidate> pool;
   std::vector<std::uint32_t> begin;
+  std::vector<std::uint32_t> count;
 
   void reset() {
     valid = false;
     pool.clear();
     begin.clear();
+    count.clear();
   }
 };
 

@@ -113,7 +113,8 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
   std::vector<Wish> wishes;
   std::vector<LeafCandidate> collected;
   const bool stored = config.reuseLeafWork && state.stepCandidates.valid &&
-                      state.stepCandidates.begin.size() == selections.size() + 1;
+                      state.stepCandidates.begin.size() == selections.size() &&
+                      state.stepCandidates.count.size() == selections.size();
   for (std::size_t i = 0; i < selections.size(); ++i) {
     LeafSelection& s = selections[i];
     if (!s.rendered || s.object >= state.switchCounters.size()) continue;
@@ -128,8 +129,8 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     // the scene's options again (a cache miss per leaf).
     bool hasCopy = false;
     if (stored) {
-      for (std::uint32_t c = state.stepCandidates.begin[i];
-           c < state.stepCandidates.begin[i + 1] && !hasCopy; ++c) {
+      const std::uint32_t end = state.stepCandidates.begin[i] + state.stepCandidates.count[i];
+      for (std::uint32_t c = state.stepCandidates.begin[i]; c < end && !hasCopy; ++c) {
         const CandidateSource source = state.stepCandidates.pool[c].source;
         hasCopy = source == CandidateSource::kFrontendCopy || source == CandidateSource::kPending;
       }
@@ -147,7 +148,7 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     std::size_t candidateCount = 0;
     if (stored) {
       candidates = state.stepCandidates.pool.data() + state.stepCandidates.begin[i];
-      candidateCount = state.stepCandidates.begin[i + 1] - state.stepCandidates.begin[i];
+      candidateCount = state.stepCandidates.count[i];
     } else {
       const SceneNode& node = scene.nodes[s.node];
       collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
