@@ -270,7 +270,7 @@ const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
 void CurvePropagator::pushDown(double targetAccuracy, std::vector<LeafSelection>& out) {
   StepCandidates& kept = state_.stepCandidates;
   kept.reset();
-  deferred_.clear();
+  state_.deferredLeaves.clear();
   const std::size_t first = out.size();
   out_ = &out;
   pushAbsolute(0, targetAccuracy);
@@ -305,24 +305,44 @@ LeafSelection CurvePropagator::unrenderedLeaf(std::uint32_t n) const {
 void CurvePropagator::deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
   const std::uint32_t slot = static_cast<std::uint32_t>(out_->size());
   emit(unrenderedLeaf(n), nullptr);  // placeholder, overwritten in decideDeferredLeaves
-  deferred_.push_back({scene_.nodes[n].object, slot, n, absoluteAccuracy, relativeCap});
+  const SceneNode& node = scene_.nodes[n];
+  DeferredLeaf d;
+  d.object = node.object;
+  d.slot = slot;
+  d.node = n;
+  d.bounds = node.bounds;
+  d.absoluteAccuracy = absoluteAccuracy;
+  d.relativeCap = relativeCap;
+  state_.deferredLeaves.push_back(d);
 }
 
 void CurvePropagator::decideDeferredLeaves() {
-  if (deferred_.empty()) return;
-  std::sort(deferred_.begin(), deferred_.end(),
-            [](const DeferredLeaf& a, const DeferredLeaf& b) {
-              return a.object != b.object ? a.object < b.object : a.slot < b.slot;
-            });
+  std::vector<DeferredLeaf>& leaves = state_.deferredLeaves;
+  if (leaves.empty()) return;
+  // Stable LSD radix sort by object, 11 bits a pass (each object has one
+  // leaf, so this is the order of (object, slot)).
+  std::uint32_t maxObject = 0;
+  for (const DeferredLeaf& d : leaves) maxObject = std::max(maxObject, d.object);
+  std::vector<DeferredLeaf>& buffer = state_.deferredSorted;
+  buffer.resize(leaves.size());
+  constexpr int kBits = 11;
+  constexpr std::uint32_t kBuckets = 1u << kBits;
+  for (int shift = 0; shift < 32 && (maxObject >> shift) != 0; shift += kBits) {
+    std::uint32_t counts[kBuckets + 1] = {};
+    for (const DeferredLeaf& d : leaves) ++counts[((d.object >> shift) & (kBuckets - 1)) + 1];
+    for (std::uint32_t b = 1; b <= kBuckets; ++b) counts[b] += counts[b - 1];
+    for (const DeferredLeaf& d : leaves) buffer[counts[(d.object >> shift) & (kBuckets - 1)]++] = d;
+    leaves.swap(buffer);
+  }
   StepCandidates& kept = state_.stepCandidates;
-  for (const DeferredLeaf& d : deferred_) {
-    LeafSelection s = decideLeaf(d.node, d.absoluteAccuracy, d.relativeCap);
+  for (const DeferredLeaf& d : leaves) {
+    LeafSelection s = decideLeaf(d.node, d.object, d.bounds, d.absoluteAccuracy, d.relativeCap);
     kept.begin[d.slot] = static_cast<std::uint32_t>(kept.pool.size());
     kept.count[d.slot] = s.rendered ? static_cast<std::uint32_t>(scratch_.size()) : 0;
     if (s.rendered) kept.pool.insert(kept.pool.end(), scratch_.begin(), scratch_.end());
     (*out_)[d.slot] = s;
   }
-  deferred_.clear();
+  leaves.clear();
 }
 
 void CurvePropagator::reportUnrenderable(std::uint32_t n) {
@@ -432,16 +452,17 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
 }
 
 void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
-  const LeafSelection s = decideLeaf(n, absoluteAccuracy, relativeCap);
+  const SceneNode& node = scene_.nodes[n];
+  const LeafSelection s = decideLeaf(n, node.object, node.bounds, absoluteAccuracy, relativeCap);
   emit(s, s.rendered ? &scratch_ : nullptr);
 }
 
-LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, double absoluteAccuracy,
+LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, std::uint32_t object,
+                                          const Sphere& bounds, double absoluteAccuracy,
                                           double relativeCap) {
-  const SceneNode& node = scene_.nodes[n];
-  const double diameter = 2.0 * node.bounds.radius;
+  const double diameter = 2.0 * bounds.radius;
   const double distance =
-      conversionDistance(region_.center, region_.reachRadius, node.bounds, config_.minimalDistance);
+      conversionDistance(region_.center, region_.reachRadius, bounds, config_.minimalDistance);
   const EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
   if (config_.reuseLeafWork && n < evaluated.byNode.size() &&
       evaluated.byNode[n].epoch == evaluated.epoch) {
@@ -449,14 +470,14 @@ LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, double absoluteAccura
     scratch_.assign(evaluated.pool.begin() + span.begin,
                     evaluated.pool.begin() + span.begin + span.count);
   } else {
-    collectLeafCandidates(scene_, node.object, region_, config_, CandidateContext::kExact,
-                          pendingFor(state_, node.object), node.bounds, scratch_);
+    collectLeafCandidates(scene_, object, region_, config_, CandidateContext::kExact,
+                          pendingFor(state_, object), bounds, scratch_);
   }
   double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
   need = std::min(need, bestCandidateAccuracy(scratch_));
   int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
   if (pick < 0) return unrenderedLeaf(n);
-  return makeSelection(n, node.object, scratch_[pick], need, distance, diameter);
+  return makeSelection(n, object, scratch_[pick], need, distance, diameter);
 }
 
 }  // namespace thinlod::backbone

@@ -49,7 +49,8 @@ class CurvePropagator {
   // sequentially instead of at random; the decision itself is the same).
   void deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
   void decideDeferredLeaves();
-  LeafSelection decideLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  LeafSelection decideLeaf(std::uint32_t n, std::uint32_t object, const Sphere& bounds,
+                           double absoluteAccuracy, double relativeCap);
   LeafSelection unrenderedLeaf(std::uint32_t n) const;
   void reportUnrenderable(std::uint32_t n);
   // Appends a selection and, when reusing leaf work, its candidates.
@@ -64,14 +65,6 @@ class CurvePropagator {
   PlanStats& stats_;
   std::vector<LeafCandidate> scratch_;
   std::vector<LeafSelection>* out_ = nullptr;
-  struct DeferredLeaf {
-    std::uint32_t object;
-    std::uint32_t slot;  // index into *out_
-    std::uint32_t node;
-    double absoluteAccuracy;
-    double relativeCap;
-  };
-  std::vector<DeferredLeaf> deferred_;
 };
 
 }  // namespace thinlod::backbone

@@ -59,6 +59,18 @@ struct StepCandidates {
   }
 };
 
+// A leaf whose decision the push-down put off to decide all leaves in
+// object order (curve_propagation.cpp); kept here so the buffers survive
+// the step.
+struct DeferredLeaf {
+  std::uint32_t object = 0;
+  std::uint32_t slot = 0;  // index of its selection
+  std::uint32_t node = 0;
+  Sphere bounds;  // the node's, read while the traversal has it in cache
+  double absoluteAccuracy = 0.0;
+  double relativeCap = 0.0;
+};
+
 // Exact candidates a leaf's absolute curve was built from in the current
 // evaluation (epoch), so its push-down need not collect them again (same
 // region, scene and in-flight requests within one step).
@@ -86,6 +98,8 @@ struct PlannerStateImpl {
   ResourceCache cache[2];  // [0] triangles, [1] link bytes
   StepCandidates stepCandidates;
   EvaluatedCandidates evaluatedCandidates;
+  std::vector<DeferredLeaf> deferredLeaves;
+  std::vector<DeferredLeaf> deferredSorted;  // radix-sort buffer
   std::uint64_t pendingGeneration = 1;
   std::uint64_t nextRequestId = 1;
   std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object
