@@ -44,6 +44,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
 
   state.stepCandidates.reset();
   std::vector<LeafSelection> selections;
+  if (config.reuseLeafWork) selections.reserve(state.lastSelectionCount);  // no regrowth copies
   double target = budget.fixedAccuracy.value_or(kInf);
   bool useSolver = hard.useTriangles && hard.useLink;
   if (!useSolver) {
@@ -105,6 +106,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
   }
   preferCurrentCopies(scene, config, region, state, hard, trianglesFirst, selections, stats);
   state.previousTarget = target;
+  state.lastSelectionCount = selections.size();
 
   Selection selection;
   selection.leaves = std::move(selections);

@@ -98,6 +98,7 @@ struct PlannerStateImpl {
   ResourceCache cache[2];  // [0] triangles, [1] link bytes
   StepCandidates stepCandidates;
   EvaluatedCandidates evaluatedCandidates;
+  std::size_t lastSelectionCount = 0;  // capacity hint for the next step's selections
   std::vector<DeferredLeaf> deferredLeaves;
   std::vector<DeferredLeaf> deferredSorted;  // radix-sort buffer
   std::uint64_t pendingGeneration = 1;

@@ -190,20 +190,42 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
   }
   // Cheapest extras first, ties in wish order: a stable sort of small keys
   // (the same order as sorting the wishes themselves, fewer bytes moved).
+  // When every wish fits together, with a margin far above the rounding of
+  // the running room (n ulps), each one is kept whatever the order: then
+  // the sort is skipped (reuseLeafWork) and the outcome is the same.
   struct WishKey {
     double extraTriangles;
     double extraLink;
     std::uint32_t wish;
   };
+  auto allFit = [&](double room, double Wish::*extra) {
+    if (!config.reuseLeafWork) return false;
+    if (room == kInf) return true;
+    double positive = 0.0;
+    double negative = 0.0;
+    for (const Wish& w : wishes) (w.*extra > 0.0 ? positive : negative) += std::fabs(w.*extra);
+    const double margin = 1e-6 * (std::fabs(room) + positive + negative);
+    return std::isfinite(positive + negative) && room >= 0.0 && positive <= room - margin;
+  };
+  const bool sortNeeded =
+      !(allFit(roomTriangles, &Wish::extraTriangles) && allFit(roomLink, &Wish::extraLink));
   std::vector<WishKey> order;
   order.reserve(wishes.size());
   for (std::size_t w = 0; w < wishes.size(); ++w)
     order.push_back({wishes[w].extraTriangles, wishes[w].extraLink, static_cast<std::uint32_t>(w)});
-  std::stable_sort(order.begin(), order.end(), [](const WishKey& a, const WishKey& b) {
-    if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
-    return a.extraLink < b.extraLink;
-  });
-  for (const WishKey& key : order) {
+  if (sortNeeded)
+    std::stable_sort(order.begin(), order.end(), [](const WishKey& a, const WishKey& b) {
+      if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
+      return a.extraLink < b.extraLink;
+    });
+  constexpr std::size_t kLookahead = 8;  // prefetch distance (random option reads)
+  for (std::size_t at = 0; at < order.size(); ++at) {
+    if (at + kLookahead < order.size()) {
+      const Wish& ahead = wishes[order[at + kLookahead].wish];
+      __builtin_prefetch(&ahead.copy.representation->atFrontend);
+      __builtin_prefetch(&selections[ahead.selection]);
+    }
+    const WishKey& key = order[at];
     const Wish& w = wishes[key.wish];
     LeafSelection& s = selections[w.selection];
     std::uint16_t& counter = state.switchCounters[s.object];
