@@ -313,6 +313,11 @@ void CurvePropagator::deferLeaf(std::uint32_t n, double absoluteAccuracy, double
   d.bounds = node.bounds;
   d.absoluteAccuracy = absoluteAccuracy;
   d.relativeCap = relativeCap;
+  if (const EvaluatedCandidates::Span* span = evaluatedSpan(n)) {
+    d.evaluated = true;
+    d.candidatesBegin = span->begin;
+    d.candidateCount = span->count;
+  }
   state_.deferredLeaves.push_back(d);
 }
 
@@ -335,8 +340,11 @@ void CurvePropagator::decideDeferredLeaves() {
     leaves.swap(buffer);
   }
   StepCandidates& kept = state_.stepCandidates;
-  for (const DeferredLeaf& d : leaves) {
-    LeafSelection s = decideLeaf(d.node, d.object, d.bounds, d.absoluteAccuracy, d.relativeCap);
+  for (std::size_t at = 0; at < leaves.size(); ++at) {
+    const DeferredLeaf& d = leaves[at];
+    const EvaluatedCandidates::Span span{0, d.candidatesBegin, d.candidateCount};
+    LeafSelection s = decideLeaf(d.node, d.object, d.bounds, d.absoluteAccuracy, d.relativeCap,
+                                 d.evaluated ? &span : nullptr);
     kept.begin[d.slot] = static_cast<std::uint32_t>(kept.pool.size());
     kept.count[d.slot] = s.rendered ? static_cast<std::uint32_t>(scratch_.size()) : 0;
     if (s.rendered) kept.pool.insert(kept.pool.end(), scratch_.begin(), scratch_.end());
@@ -453,22 +461,30 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
 
 void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
   const SceneNode& node = scene_.nodes[n];
-  const LeafSelection s = decideLeaf(n, node.object, node.bounds, absoluteAccuracy, relativeCap);
+  const LeafSelection s =
+      decideLeaf(n, node.object, node.bounds, absoluteAccuracy, relativeCap, evaluatedSpan(n));
   emit(s, s.rendered ? &scratch_ : nullptr);
+}
+
+const EvaluatedCandidates::Span* CurvePropagator::evaluatedSpan(std::uint32_t n) const {
+  const EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+  if (config_.reuseLeafWork && n < evaluated.byNode.size() &&
+      evaluated.byNode[n].epoch == evaluated.epoch)
+    return &evaluated.byNode[n];
+  return nullptr;
 }
 
 LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, std::uint32_t object,
                                           const Sphere& bounds, double absoluteAccuracy,
-                                          double relativeCap) {
+                                          double relativeCap,
+                                          const EvaluatedCandidates::Span* evaluated) {
   const double diameter = 2.0 * bounds.radius;
   const double distance =
       conversionDistance(region_.center, region_.reachRadius, bounds, config_.minimalDistance);
-  const EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
-  if (config_.reuseLeafWork && n < evaluated.byNode.size() &&
-      evaluated.byNode[n].epoch == evaluated.epoch) {
-    const EvaluatedCandidates::Span span = evaluated.byNode[n];
-    scratch_.assign(evaluated.pool.begin() + span.begin,
-                    evaluated.pool.begin() + span.begin + span.count);
+  if (evaluated) {
+    const std::vector<LeafCandidate>& pool = state_.evaluatedCandidates.pool;
+    scratch_.assign(pool.begin() + evaluated->begin,
+                    pool.begin() + evaluated->begin + evaluated->count);
   } else {
     collectLeafCandidates(scene_, object, region_, config_, CandidateContext::kExact,
                           pendingFor(state_, object), bounds, scratch_);

@@ -49,8 +49,11 @@ class CurvePropagator {
   // sequentially instead of at random; the decision itself is the same).
   void deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
   void decideDeferredLeaves();
+  // `evaluated`: the leaf's exact candidates from this evaluation, or null.
   LeafSelection decideLeaf(std::uint32_t n, std::uint32_t object, const Sphere& bounds,
-                           double absoluteAccuracy, double relativeCap);
+                           double absoluteAccuracy, double relativeCap,
+                           const EvaluatedCandidates::Span* evaluated);
+  const EvaluatedCandidates::Span* evaluatedSpan(std::uint32_t n) const;
   LeafSelection unrenderedLeaf(std::uint32_t n) const;
   void reportUnrenderable(std::uint32_t n);
   // Appends a selection and, when reusing leaf work, its candidates.

@@ -69,6 +69,11 @@ struct DeferredLeaf {
   Sphere bounds;  // the node's, read while the traversal has it in cache
   double absoluteAccuracy = 0.0;
   double relativeCap = 0.0;
+  // Its candidates from this evaluation (EvaluatedCandidates), looked up
+  // while the traversal is in tree order; evaluated == false: collect them.
+  bool evaluated = false;
+  std::uint32_t candidatesBegin = 0;
+  std::uint32_t candidateCount = 0;
 };
 
 // Exact candidates a leaf's absolute curve was built from in the current
