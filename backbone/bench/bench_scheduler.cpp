@@ -3,6 +3,8 @@
 // show cost linear in visible nodes), and the accuracy reached / time taken
 // by the accuracy-curve scheduler, the Funkhouser-Sequin greedy, VRML static
 // LOD and brute force on small scenes. Fixed seeds; CSV on stdout.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -22,6 +24,9 @@ using namespace thinlod::backbone;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+bool g_verbose = false;  // per-step lines on stderr (--verbose)
+std::string g_only;      // run only this scaling config (--only; empty: all)
+bool wanted(const char* config) { return g_only.empty() || g_only == config; }
 
 // CPU time of this thread: the machine is shared, wall time is noisy.
 double now() {
@@ -72,8 +77,8 @@ void deliver(SchedulingScene& scene, const Plan& plan, std::vector<std::uint32_t
     option.atFrontend.relativeAccuracy = r.relativeAccuracy;
     option.atFrontend.triangles = r.expectedTriangles;
     option.atFrontend.encodedBytes = r.expectedBytes;
-    const bool impostor = option.kind == OptionKind::kMeshedImpostor ||
-                          option.kind == OptionKind::kSimpleImpostor;
+    const bool impostor =
+        option.kind == OptionKind::kMeshedImpostor || option.kind == OptionKind::kSimpleImpostor;
     option.atFrontend.validity = impostor
                                      ? ConicRange::ball(r.viewRegion.center, r.viewRegion.radius)
                                      : ConicRange::everywhere();
@@ -102,19 +107,74 @@ void deliver(SchedulingScene& scene, const Plan& plan, std::vector<std::uint32_t
 struct StepTimes {
   double coldMicros = 0.0;
   double medianMicros = 0.0;
+  double referenceColdMicros = 0.0;
+  double referenceMedianMicros = 0.0;
   double visibleNodes = 0.0;
   double visibleObjects = 0.0;
   double reuses = 0.0;
   double computes = 0.0;
   bool budgetHeld = true;
+  bool samePlans = true;  // bitwise equal to the reference path on every step
+  double stateBytesPerObject = 0.0;
 };
 
-StepTimes runFlight(SchedulingScene& scene, const Scheduler& scheduler, const Budget& budget,
-                    double worldSize, int steps) {
+// Resident set size of this process (bytes), for the planner state's memory.
+double residentBytes() {
+  long pages = 0, resident = 0;
+  FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0.0;
+  if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+  std::fclose(f);
+  return double(resident) * double(sysconf(_SC_PAGESIZE));
+}
+
+// Every field a frontend or the daemon acts on, compared exactly.
+bool samePlan(const Plan& a, const Plan& b) {
+  if (a.targetAccuracy != b.targetAccuracy || a.achievedMinAccuracy != b.achievedMinAccuracy ||
+      a.predictedTriangles != b.predictedTriangles || a.linkBytesThisStep != b.linkBytesThisStep ||
+      a.decisions.size() != b.decisions.size() || a.requests.size() != b.requests.size() ||
+      a.removals.size() != b.removals.size() || a.belowTarget != b.belowTarget ||
+      a.dropped != b.dropped)
+    return false;
+  for (std::size_t i = 0; i < a.decisions.size(); ++i) {
+    const ObjectDecision& x = a.decisions[i];
+    const ObjectDecision& y = b.decisions[i];
+    if (x.object != y.object || x.option != y.option || x.action != y.action ||
+        x.source != y.source || x.relativeAccuracy != y.relativeAccuracy ||
+        x.absoluteAccuracy != y.absoluteAccuracy || x.triangles != y.triangles ||
+        x.linkBytes != y.linkBytes)
+      return false;
+  }
+  for (std::size_t i = 0; i < a.requests.size(); ++i) {
+    const RepresentationRequest& x = a.requests[i];
+    const RepresentationRequest& y = b.requests[i];
+    if (x.requestId != y.requestId || x.object != y.object || x.option != y.option ||
+        x.relativeAccuracy != y.relativeAccuracy || x.expectedTriangles != y.expectedTriangles)
+      return false;
+  }
+  for (std::size_t i = 0; i < a.removals.size(); ++i)
+    if (a.removals[i].object != b.removals[i].object ||
+        a.removals[i].option != b.removals[i].option)
+      return false;
+  return true;
+}
+
+// Flies the optimised scheduler and, when `reference` is given, the slow
+// reference path (SchedulerConfig::reuseLeafWork = false) in lockstep on two
+// copies of the scene, timing each and comparing their plans every step.
+StepTimes runFlight(const SchedulingScene& generated, const Scheduler& scheduler,
+                    const Scheduler* reference, const Budget& budget, double worldSize, int steps) {
+  SchedulingScene scene = generated;
+  SchedulingScene referenceScene;
+  if (reference) referenceScene = generated;
   PlannerState state;
+  PlannerState referenceState;
   std::vector<std::uint32_t> leafOf;
+  std::vector<std::uint32_t> referenceLeafOf;
   std::vector<double> times;
+  std::vector<double> referenceTimes;
   StepTimes out;
+  const double residentBefore = residentBytes();
   for (int s = 0; s < steps; ++s) {
     // Outside the cube, drifting along x at 0.1 m/s, looking at the centre.
     const glm::dvec3 p(-0.4 * worldSize + 0.01 * s, 0.1 * worldSize, 0.9 * worldSize);
@@ -126,10 +186,38 @@ StepTimes runFlight(SchedulingScene& scene, const Scheduler& scheduler, const Bu
       std::fprintf(stderr, "plan failed: %s\n", plan.status().toString().c_str());
       std::exit(1);
     }
+    if (s == 0)
+      out.stateBytesPerObject =
+          (residentBytes() - residentBefore) / std::max<double>(1.0, double(scene.objects.size()));
+    double referenceMicros = 0.0;
+    if (reference) {
+      const double r0 = now();
+      auto slow = reference->plan(referenceScene, v, budget, referenceState);
+      referenceMicros = (now() - r0) * 1e6;
+      if (!slow.ok()) {
+        std::fprintf(stderr, "reference plan failed: %s\n", slow.status().toString().c_str());
+        std::exit(1);
+      }
+      if (!samePlan(*plan, *slow)) {
+        out.samePlans = false;
+        std::fprintf(stderr, "step %d: plans differ (target %.17g vs reference %.17g)\n", s,
+                     plan->targetAccuracy, slow->targetAccuracy);
+      }
+      deliver(referenceScene, *slow, referenceLeafOf);
+    }
+    if (g_verbose)
+      std::fprintf(stderr,
+                   "step %d: %.0f us (reference %.0f us), solver %d, target %.17g, visited %u, "
+                   "computes %u, reuses %u, requests %zu, keeps %u\n",
+                   s, micros, referenceMicros, int(plan->stats.usedExactSolver),
+                   plan->targetAccuracy, plan->stats.visitedNodes, plan->stats.curveComputes,
+                   plan->stats.curveReuses, plan->requests.size(), plan->row.keeps);
     if (s == 0) {
       out.coldMicros = micros;
+      out.referenceColdMicros = referenceMicros;
     } else {
       times.push_back(micros);
+      referenceTimes.push_back(referenceMicros);
     }
     if (budget.maxTriangles && plan->predictedTriangles > *budget.maxTriangles)
       out.budgetHeld = false;
@@ -139,12 +227,33 @@ StepTimes runFlight(SchedulingScene& scene, const Scheduler& scheduler, const Bu
     out.computes = plan->stats.curveComputes;
     deliver(scene, *plan, leafOf);
   }
-  std::sort(times.begin(), times.end());
-  out.medianMicros = times.empty() ? out.coldMicros : times[times.size() / 2];
+  auto median = [&](std::vector<double>& t, double cold) {
+    std::sort(t.begin(), t.end());
+    return t.empty() ? cold : t[t.size() / 2];
+  };
+  out.medianMicros = median(times, out.coldMicros);
+  out.referenceMedianMicros = median(referenceTimes, out.referenceColdMicros);
   return out;
 }
 
-void scaling(std::size_t maxObjects, int steps) {
+void printRow(std::size_t n, const char* name, const StepTimes& t, bool compared) {
+  std::printf("scaling,%zu,%s,%.0f,%.0f,%.0f,%.0f,%.1f,%.0f,%.0f,%s,", n, name, t.visibleNodes,
+              t.visibleObjects, t.coldMicros, t.medianMicros,
+              1e3 * t.medianMicros / std::max(1.0, t.visibleObjects), t.reuses, t.computes,
+              t.budgetHeld ? "yes" : "NO");
+  if (compared) {
+    std::printf("%.0f,%.0f,%.2f,%s,", t.referenceColdMicros, t.referenceMedianMicros,
+                t.referenceMedianMicros / std::max(1e-9, t.medianMicros),
+                t.samePlans ? "yes" : "NO");
+  } else {
+    std::printf("-,-,-,-,");
+  }
+  std::printf("%.0f\n", t.stateBytesPerObject);
+  std::fflush(stdout);
+}
+
+void scaling(std::size_t minObjects, std::size_t maxObjects, std::size_t maxBothBudgets,
+             std::size_t maxReference, int steps) {
   std::printf(
       "# scaling: accuracy-curve scheduler, flight of %d steps (0.1 s, 0.1 m/s), "
       "polygon budget 20 triangles per object; thread CPU microseconds per step\n",
@@ -153,9 +262,15 @@ void scaling(std::size_t maxObjects, int steps) {
       "# visible_nodes: nodes given an absolute curve (a merged subtree counts once); every "
       "visible object is still pushed down and planned\n");
   std::printf(
+      "# reference_*: the same flight in lockstep with SchedulerConfig::reuseLeafWork = false "
+      "(the unoptimised path); same_plans: every plan bitwise equal to it; "
+      "state_bytes_per_object: resident memory added by the first step / objects\n");
+  std::printf(
       "section,objects,config,visible_nodes,visible_objects,cold_us,median_us,"
-      "median_ns_per_visible_object,curve_reuses,curve_computes,budget_held\n");
+      "median_ns_per_visible_object,curve_reuses,curve_computes,budget_held,reference_cold_us,"
+      "reference_median_us,speedup,same_plans,state_bytes_per_object\n");
   for (std::size_t n = 100; n <= maxObjects; n *= 10) {
+    if (n < minObjects) continue;
     SyntheticSceneOptions o;
     o.seed = 42;
     o.objects = n;
@@ -170,28 +285,27 @@ void scaling(std::size_t maxObjects, int steps) {
     }
     Budget budget;
     budget.maxTriangles = 20.0 * double(n);
+    const bool compare = n <= maxReference;
     for (const char* name : {"paper", "no-merge"}) {
-      SchedulingScene scene = *generated;
-      const SchedulerConfig config = std::string(name) == "paper" ? paperConfig() : exactConfig();
+      if (!wanted(name)) continue;
+      SchedulerConfig config = std::string(name) == "paper" ? paperConfig() : exactConfig();
       auto scheduler = makeAccuracyCurveScheduler(config).value();
-      const StepTimes t = runFlight(scene, *scheduler, budget, o.worldSize, steps);
-      std::printf("scaling,%zu,%s,%.0f,%.0f,%.0f,%.0f,%.1f,%.0f,%.0f,%s\n", n, name, t.visibleNodes,
-                  t.visibleObjects, t.coldMicros, t.medianMicros,
-                  1e3 * t.medianMicros / std::max(1.0, t.visibleObjects), t.reuses, t.computes,
-                  t.budgetHeld ? "yes" : "NO");
-      std::fflush(stdout);
+      config.reuseLeafWork = false;
+      auto reference = makeAccuracyCurveScheduler(config).value();
+      const StepTimes t = runFlight(*generated, *scheduler, compare ? reference.get() : nullptr,
+                                    budget, o.worldSize, steps);
+      printRow(n, name, t, compare);
     }
-    if (n <= 10000) {
-      SchedulingScene scene = *generated;
+    if (n <= maxBothBudgets && wanted("paper-both-budgets")) {
       Budget both = budget;
       both.maxLinkBytesPerSecond = 2000.0 * double(n);
-      auto scheduler = makeAccuracyCurveScheduler(paperConfig()).value();
-      const StepTimes t = runFlight(scene, *scheduler, both, o.worldSize, steps);
-      std::printf("scaling,%zu,paper-both-budgets,%.0f,%.0f,%.0f,%.0f,%.1f,%.0f,%.0f,%s\n", n,
-                  t.visibleNodes, t.visibleObjects, t.coldMicros, t.medianMicros,
-                  1e3 * t.medianMicros / std::max(1.0, t.visibleObjects), t.reuses, t.computes,
-                  t.budgetHeld ? "yes" : "NO");
-      std::fflush(stdout);
+      SchedulerConfig config = paperConfig();
+      auto scheduler = makeAccuracyCurveScheduler(config).value();
+      config.reuseLeafWork = false;
+      auto reference = makeAccuracyCurveScheduler(config).value();
+      const StepTimes t = runFlight(*generated, *scheduler, compare ? reference.get() : nullptr,
+                                    both, o.worldSize, steps);
+      printRow(n, "paper-both-budgets", t, compare);
     }
   }
 }
@@ -274,14 +388,24 @@ void comparison(int scenes) {
 int main(int argc, char** argv) {
   CLI::App app{"bench_scheduler: scheduling time and accuracy of the backbone schedulers"};
   std::size_t maxObjects = 1000000;
+  std::size_t minObjects = 100;
+  std::size_t maxBothBudgets = 10000;
+  std::size_t maxReference = 1000000;
   int steps = 20;
   int scenes = 100;
   app.add_option("--max-objects", maxObjects, "largest scene (powers of ten from 100)");
+  app.add_option("--min-objects", minObjects, "smallest scene (powers of ten from 100)");
+  app.add_option("--max-both-budgets", maxBothBudgets,
+                 "largest scene flown with both budgets (polygon + link)");
+  app.add_option("--max-reference", maxReference,
+                 "largest scene also flown on the reference path (plans compared)");
   app.add_option("--steps", steps, "planning steps per flight")->check(CLI::Range(2, 100000));
   app.add_option("--scenes", scenes, "small scenes in the comparison")
       ->check(CLI::Range(1, 100000));
+  app.add_option("--only", g_only, "scaling config to run (paper, no-merge, paper-both-budgets)");
+  app.add_flag("--verbose", g_verbose, "one line per planning step on stderr");
   CLI11_PARSE(app, argc, argv);
   comparison(scenes);
-  scaling(maxObjects, steps);
+  scaling(minObjects, maxObjects, maxBothBudgets, maxReference, steps);
   return 0;
 }

@@ -42,7 +42,9 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
       budget.fixedAccuracy ? hard : reserveShare(hard, config.budgetReserveShare);
   const bool trianglesFirst = !(hard.useLink && !hard.useTriangles);
 
+  state.stepCandidates.reset();
   std::vector<LeafSelection> selections;
+  if (config.reuseLeafWork) selections.reserve(state.lastSelectionCount);  // no regrowth copies
   double target = budget.fixedAccuracy.value_or(kInf);
   bool useSolver = hard.useTriangles && hard.useLink;
   if (!useSolver) {
@@ -68,6 +70,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
     }
   }
   if (useSolver) {
+    state.stepCandidates.reset();  // the solver's selections have none stored
     stats.usedExactSolver = true;
     selections.clear();
     JointSolver solver(scene, config, region, state, reserved, stats);
@@ -103,6 +106,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
   }
   preferCurrentCopies(scene, config, region, state, hard, trianglesFirst, selections, stats);
   state.previousTarget = target;
+  state.lastSelectionCount = selections.size();
 
   Selection selection;
   selection.leaves = std::move(selections);

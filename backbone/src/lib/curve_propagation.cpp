@@ -112,7 +112,14 @@ CurvePropagator::CurvePropagator(const SchedulingScene& scene, const SchedulerCo
       resource_(resource),
       stats_(stats) {}
 
-const AccuracyCurve& CurvePropagator::evaluateRoot() { return evaluateAbsolute(0, false); }
+const AccuracyCurve& CurvePropagator::evaluateRoot() {
+  EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+  ++evaluated.epoch;
+  evaluated.pool.clear();
+  if (config_.reuseLeafWork && evaluated.byNode.size() != scene_.nodes.size())
+    evaluated.byNode.assign(scene_.nodes.size(), EvaluatedCandidates::Span{});
+  return evaluateAbsolute(0, false);
+}
 
 AccuracyCurve CurvePropagator::leafRelativeCurve(std::uint32_t n, const PredictedRegion& region,
                                                  CandidateContext context) {
@@ -121,6 +128,14 @@ AccuracyCurve CurvePropagator::leafRelativeCurve(std::uint32_t n, const Predicte
       context == CandidateContext::kExact ? pendingFor(state_, node.object) : nullptr;
   collectLeafCandidates(scene_, node.object, region, config_, context, pending, node.bounds,
                         scratch_);
+  if (config_.reuseLeafWork && context == CandidateContext::kExact && &region == &region_) {
+    EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+    if (n < evaluated.byNode.size()) {
+      evaluated.byNode[n] = {evaluated.epoch, static_cast<std::uint32_t>(evaluated.pool.size()),
+                             static_cast<std::uint32_t>(scratch_.size())};
+      evaluated.pool.insert(evaluated.pool.end(), scratch_.begin(), scratch_.end());
+    }
+  }
   if (scratch_.empty()) return AccuracyCurve();
   std::vector<AccuracyCurve> owned;
   owned.reserve(scratch_.size());
@@ -253,19 +268,95 @@ const AccuracyCurve& CurvePropagator::evaluateRelative(std::uint32_t n,
 }
 
 void CurvePropagator::pushDown(double targetAccuracy, std::vector<LeafSelection>& out) {
+  StepCandidates& kept = state_.stepCandidates;
+  kept.reset();
+  state_.deferredLeaves.clear();
+  const std::size_t first = out.size();
   out_ = &out;
   pushAbsolute(0, targetAccuracy);
+  decideDeferredLeaves();
   out_ = nullptr;
+  if (config_.reuseLeafWork && first == 0) {
+    kept.valid = kept.begin.size() == out.size() && kept.count.size() == out.size();
+  } else {
+    kept.reset();
+  }
+}
+
+void CurvePropagator::emit(const LeafSelection& selection,
+                           const std::vector<LeafCandidate>* candidates) {
+  if (config_.reuseLeafWork) {
+    StepCandidates& kept = state_.stepCandidates;
+    kept.begin.push_back(static_cast<std::uint32_t>(kept.pool.size()));
+    kept.count.push_back(candidates ? static_cast<std::uint32_t>(candidates->size()) : 0);
+    if (candidates) kept.pool.insert(kept.pool.end(), candidates->begin(), candidates->end());
+  }
+  out_->push_back(selection);
+}
+
+LeafSelection CurvePropagator::unrenderedLeaf(std::uint32_t n) const {
+  LeafSelection s;
+  s.node = n;
+  s.object = scene_.nodes[n].object;
+  s.rendered = false;
+  return s;
+}
+
+void CurvePropagator::deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
+  const std::uint32_t slot = static_cast<std::uint32_t>(out_->size());
+  emit(unrenderedLeaf(n), nullptr);  // placeholder, overwritten in decideDeferredLeaves
+  const SceneNode& node = scene_.nodes[n];
+  DeferredLeaf d;
+  d.object = node.object;
+  d.slot = slot;
+  d.node = n;
+  d.bounds = node.bounds;
+  d.absoluteAccuracy = absoluteAccuracy;
+  d.relativeCap = relativeCap;
+  if (const EvaluatedCandidates::Span* span = evaluatedSpan(n)) {
+    d.evaluated = true;
+    d.candidatesBegin = span->begin;
+    d.candidateCount = span->count;
+  }
+  state_.deferredLeaves.push_back(d);
+}
+
+void CurvePropagator::decideDeferredLeaves() {
+  std::vector<DeferredLeaf>& leaves = state_.deferredLeaves;
+  if (leaves.empty()) return;
+  // Stable LSD radix sort by object, 11 bits a pass (each object has one
+  // leaf, so this is the order of (object, slot)).
+  std::uint32_t maxObject = 0;
+  for (const DeferredLeaf& d : leaves) maxObject = std::max(maxObject, d.object);
+  std::vector<DeferredLeaf>& buffer = state_.deferredSorted;
+  buffer.resize(leaves.size());
+  constexpr int kBits = 11;
+  constexpr std::uint32_t kBuckets = 1u << kBits;
+  for (int shift = 0; shift < 32 && (maxObject >> shift) != 0; shift += kBits) {
+    std::uint32_t counts[kBuckets + 1] = {};
+    for (const DeferredLeaf& d : leaves) ++counts[((d.object >> shift) & (kBuckets - 1)) + 1];
+    for (std::uint32_t b = 1; b <= kBuckets; ++b) counts[b] += counts[b - 1];
+    for (const DeferredLeaf& d : leaves) buffer[counts[(d.object >> shift) & (kBuckets - 1)]++] = d;
+    leaves.swap(buffer);
+  }
+  StepCandidates& kept = state_.stepCandidates;
+  for (std::size_t at = 0; at < leaves.size(); ++at) {
+    const DeferredLeaf& d = leaves[at];
+    const EvaluatedCandidates::Span span{0, d.candidatesBegin, d.candidateCount};
+    LeafSelection s = decideLeaf(d.node, d.object, d.bounds, d.absoluteAccuracy, d.relativeCap,
+                                 d.evaluated ? &span : nullptr);
+    kept.begin[d.slot] = static_cast<std::uint32_t>(kept.pool.size());
+    kept.count[d.slot] = s.rendered ? static_cast<std::uint32_t>(scratch_.size()) : 0;
+    if (s.rendered) kept.pool.insert(kept.pool.end(), scratch_.begin(), scratch_.end());
+    (*out_)[d.slot] = s;
+  }
+  leaves.clear();
 }
 
 void CurvePropagator::reportUnrenderable(std::uint32_t n) {
   const SceneNode& node = scene_.nodes[n];
   if (node.kind == SceneNodeKind::kLeaf) {
-    LeafSelection s;
-    s.node = n;
-    s.object = node.object;
-    s.rendered = false;
-    out_->push_back(s);
+    emit(unrenderedLeaf(n), nullptr);
   } else if (node.kind == SceneNodeKind::kGroup) {
     for (std::uint32_t i = 0; i < node.childCount; ++i)
       reportUnrenderable(scene_.children[node.firstChild + i]);
@@ -283,7 +374,11 @@ void CurvePropagator::pushAbsolute(std::uint32_t n, double accuracy) {
       reportUnrenderable(n);
       return;
     }
-    chooseLeaf(n, accuracy, kInf);
+    if (config_.reuseLeafWork) {
+      deferLeaf(n, accuracy, kInf);
+    } else {
+      chooseLeaf(n, accuracy, kInf);
+    }
     return;
   }
   if (e.merged) {
@@ -328,7 +423,11 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
   }
   const double clamped = std::min(relativeAccuracy, r.curve.maxAccuracy());
   if (node.kind == SceneNodeKind::kLeaf) {
-    chooseLeaf(n, absoluteAccuracy, clamped);
+    if (config_.reuseLeafWork) {
+      deferLeaf(n, absoluteAccuracy, clamped);
+    } else {
+      chooseLeaf(n, absoluteAccuracy, clamped);
+    }
     return;
   }
   const double diameter = 2.0 * node.bounds.radius;
@@ -362,19 +461,39 @@ void CurvePropagator::pushRelative(std::uint32_t n, double relativeAccuracy,
 
 void CurvePropagator::chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap) {
   const SceneNode& node = scene_.nodes[n];
-  const double diameter = 2.0 * node.bounds.radius;
+  const LeafSelection s =
+      decideLeaf(n, node.object, node.bounds, absoluteAccuracy, relativeCap, evaluatedSpan(n));
+  emit(s, s.rendered ? &scratch_ : nullptr);
+}
+
+const EvaluatedCandidates::Span* CurvePropagator::evaluatedSpan(std::uint32_t n) const {
+  const EvaluatedCandidates& evaluated = state_.evaluatedCandidates;
+  if (config_.reuseLeafWork && n < evaluated.byNode.size() &&
+      evaluated.byNode[n].epoch == evaluated.epoch)
+    return &evaluated.byNode[n];
+  return nullptr;
+}
+
+LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, std::uint32_t object,
+                                          const Sphere& bounds, double absoluteAccuracy,
+                                          double relativeCap,
+                                          const EvaluatedCandidates::Span* evaluated) {
+  const double diameter = 2.0 * bounds.radius;
   const double distance =
-      conversionDistance(region_.center, region_.reachRadius, node.bounds, config_.minimalDistance);
-  collectLeafCandidates(scene_, node.object, region_, config_, CandidateContext::kExact,
-                        pendingFor(state_, node.object), node.bounds, scratch_);
+      conversionDistance(region_.center, region_.reachRadius, bounds, config_.minimalDistance);
+  if (evaluated) {
+    const std::vector<LeafCandidate>& pool = state_.evaluatedCandidates.pool;
+    scratch_.assign(pool.begin() + evaluated->begin,
+                    pool.begin() + evaluated->begin + evaluated->count);
+  } else {
+    collectLeafCandidates(scene_, object, region_, config_, CandidateContext::kExact,
+                          pendingFor(state_, object), bounds, scratch_);
+  }
   double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
   need = std::min(need, bestCandidateAccuracy(scratch_));
   int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
-  if (pick < 0) {
-    reportUnrenderable(n);
-    return;
-  }
-  out_->push_back(makeSelection(n, node.object, scratch_[pick], need, distance, diameter));
+  if (pick < 0) return unrenderedLeaf(n);
+  return makeSelection(n, object, scratch_[pick], need, distance, diameter);
 }
 
 }  // namespace thinlod::backbone

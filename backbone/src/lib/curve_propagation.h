@@ -42,8 +42,22 @@ class CurvePropagator {
                                   CandidateContext context);
   void pushAbsolute(std::uint32_t n, double accuracy);
   void pushRelative(std::uint32_t n, double relativeAccuracy, double absoluteAccuracy);
+  // Reference path: decides the leaf now, in tree order.
   void chooseLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  // reuseLeafWork: keeps the leaf's slot in tree order and decides it later,
+  // in object order (the scene's objects and options are then read nearly
+  // sequentially instead of at random; the decision itself is the same).
+  void deferLeaf(std::uint32_t n, double absoluteAccuracy, double relativeCap);
+  void decideDeferredLeaves();
+  // `evaluated`: the leaf's exact candidates from this evaluation, or null.
+  LeafSelection decideLeaf(std::uint32_t n, std::uint32_t object, const Sphere& bounds,
+                           double absoluteAccuracy, double relativeCap,
+                           const EvaluatedCandidates::Span* evaluated);
+  const EvaluatedCandidates::Span* evaluatedSpan(std::uint32_t n) const;
+  LeafSelection unrenderedLeaf(std::uint32_t n) const;
   void reportUnrenderable(std::uint32_t n);
+  // Appends a selection and, when reusing leaf work, its candidates.
+  void emit(const LeafSelection& selection, const std::vector<LeafCandidate>* candidates);
 
   const SchedulingScene& scene_;
   const SchedulerConfig& config_;

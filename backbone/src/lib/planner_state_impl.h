@@ -40,6 +40,56 @@ struct ResourceCache {
   std::vector<RelativeEntry> relative;
 };
 
+// The exact candidates of each leaf selection of this step as the push-down
+// collected them (selection i owns pool[begin[i], begin[i] + count[i])), so
+// the hysteresis pass need not collect them again (SchedulerConfig::
+// reuseLeafWork). Only valid right after a push-down; cleared before any
+// other producer of selections runs.
+struct StepCandidates {
+  bool valid = false;
+  std::vector<LeafCandidate> pool;
+  std::vector<std::uint32_t> begin;
+  std::vector<std::uint32_t> count;
+
+  void reset() {
+    valid = false;
+    pool.clear();
+    begin.clear();
+    count.clear();
+  }
+};
+
+// A leaf whose decision the push-down put off to decide all leaves in
+// object order (curve_propagation.cpp); kept here so the buffers survive
+// the step.
+struct DeferredLeaf {
+  std::uint32_t object = 0;
+  std::uint32_t slot = 0;  // index of its selection
+  std::uint32_t node = 0;
+  Sphere bounds;  // the node's, read while the traversal has it in cache
+  double absoluteAccuracy = 0.0;
+  double relativeCap = 0.0;
+  // Its candidates from this evaluation (EvaluatedCandidates), looked up
+  // while the traversal is in tree order; evaluated == false: collect them.
+  bool evaluated = false;
+  std::uint32_t candidatesBegin = 0;
+  std::uint32_t candidateCount = 0;
+};
+
+// Exact candidates a leaf's absolute curve was built from in the current
+// evaluation (epoch), so its push-down need not collect them again (same
+// region, scene and in-flight requests within one step).
+struct EvaluatedCandidates {
+  std::uint64_t epoch = 0;  // bumped by every evaluateRoot
+  std::vector<LeafCandidate> pool;
+  struct Span {
+    std::uint64_t epoch = 0;
+    std::uint32_t begin = 0;
+    std::uint32_t count = 0;
+  };
+  std::vector<Span> byNode;
+};
+
 struct LinkSend {
   double time = 0.0;
   double bytes = 0.0;
@@ -51,6 +101,11 @@ struct PlannerStateImpl {
   std::size_t nodeCount = 0;
   std::size_t objectCount = 0;
   ResourceCache cache[2];  // [0] triangles, [1] link bytes
+  StepCandidates stepCandidates;
+  EvaluatedCandidates evaluatedCandidates;
+  std::size_t lastSelectionCount = 0;  // capacity hint for the next step's selections
+  std::vector<DeferredLeaf> deferredLeaves;
+  std::vector<DeferredLeaf> deferredSorted;  // radix-sort buffer
   std::uint64_t pendingGeneration = 1;
   std::uint64_t nextRequestId = 1;
   std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object

@@ -111,7 +111,10 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     bool byDelay;
   };
   std::vector<Wish> wishes;
-  std::vector<LeafCandidate> candidates;
+  std::vector<LeafCandidate> collected;
+  const bool stored = config.reuseLeafWork && state.stepCandidates.valid &&
+                      state.stepCandidates.begin.size() == selections.size() &&
+                      state.stepCandidates.count.size() == selections.size();
   for (std::size_t i = 0; i < selections.size(); ++i) {
     LeafSelection& s = selections[i];
     if (!s.rendered || s.object >= state.switchCounters.size()) continue;
@@ -121,18 +124,41 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
       counter = 0;
       continue;
     }
-    // Cheap skip: nothing displayed or in flight for this object.
-    const SceneObject& object = scene.objects[s.object];
-    bool hasCopy = pendingFor(state, s.object) != nullptr;
-    for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
-      hasCopy = scene.options[object.firstOption + k].atFrontend.present;
+    // Cheap skip: nothing displayed or in flight for this object. A stored
+    // frontend or in-flight candidate proves there is one without reading
+    // the scene's options again (a cache miss per leaf).
+    bool hasCopy = false;
+    if (stored) {
+      const std::uint32_t end = state.stepCandidates.begin[i] + state.stepCandidates.count[i];
+      for (std::uint32_t c = state.stepCandidates.begin[i]; c < end && !hasCopy; ++c) {
+        const CandidateSource source = state.stepCandidates.pool[c].source;
+        hasCopy = source == CandidateSource::kFrontendCopy || source == CandidateSource::kPending;
+      }
+    }
+    if (!hasCopy) {
+      const SceneObject& object = scene.objects[s.object];
+      hasCopy = pendingFor(state, s.object) != nullptr;
+      for (std::uint32_t k = 0; k < object.optionCount && !hasCopy; ++k)
+        hasCopy = scene.options[object.firstOption + k].atFrontend.present;
+    }
     if (!hasCopy) continue;
-    const SceneNode& node = scene.nodes[s.node];
-    collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
-                          pendingFor(state, s.object), node.bounds, candidates);
+    // The push-down's candidates for this leaf are the same ones (same
+    // region, scene and in-flight requests): reuse them when stored.
+    const LeafCandidate* candidates = nullptr;
+    std::size_t candidateCount = 0;
+    if (stored) {
+      candidates = state.stepCandidates.pool.data() + state.stepCandidates.begin[i];
+      candidateCount = state.stepCandidates.count[i];
+    } else {
+      const SceneNode& node = scene.nodes[s.node];
+      collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
+                            pendingFor(state, s.object), node.bounds, collected);
+      candidates = collected.data();
+      candidateCount = collected.size();
+    }
     int best = -1;
     CandidateCost bestCost;
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
+    for (std::size_t c = 0; c < candidateCount; ++c) {
       const LeafCandidate& k = candidates[c];
       if (k.source != CandidateSource::kFrontendCopy && k.source != CandidateSource::kPending)
         continue;
@@ -162,11 +188,45 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     wishes.push_back({i, candidates[best], bestCost.triangles - s.cost.triangles,
                       bestCost.linkBytes - s.cost.linkBytes, !smallGain});
   }
-  std::stable_sort(wishes.begin(), wishes.end(), [](const Wish& a, const Wish& b) {
-    if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
-    return a.extraLink < b.extraLink;
-  });
-  for (const Wish& w : wishes) {
+  // Cheapest extras first, ties in wish order: a stable sort of small keys
+  // (the same order as sorting the wishes themselves, fewer bytes moved).
+  // When every wish fits together, with a margin far above the rounding of
+  // the running room (n ulps), each one is kept whatever the order: then
+  // the sort is skipped (reuseLeafWork) and the outcome is the same.
+  struct WishKey {
+    double extraTriangles;
+    double extraLink;
+    std::uint32_t wish;
+  };
+  auto allFit = [&](double room, double Wish::*extra) {
+    if (!config.reuseLeafWork) return false;
+    if (room == kInf) return true;
+    double positive = 0.0;
+    double negative = 0.0;
+    for (const Wish& w : wishes) (w.*extra > 0.0 ? positive : negative) += std::fabs(w.*extra);
+    const double margin = 1e-6 * (std::fabs(room) + positive + negative);
+    return std::isfinite(positive + negative) && room >= 0.0 && positive <= room - margin;
+  };
+  const bool sortNeeded =
+      !(allFit(roomTriangles, &Wish::extraTriangles) && allFit(roomLink, &Wish::extraLink));
+  std::vector<WishKey> order;
+  order.reserve(wishes.size());
+  for (std::size_t w = 0; w < wishes.size(); ++w)
+    order.push_back({wishes[w].extraTriangles, wishes[w].extraLink, static_cast<std::uint32_t>(w)});
+  if (sortNeeded)
+    std::stable_sort(order.begin(), order.end(), [](const WishKey& a, const WishKey& b) {
+      if (a.extraTriangles != b.extraTriangles) return a.extraTriangles < b.extraTriangles;
+      return a.extraLink < b.extraLink;
+    });
+  constexpr std::size_t kLookahead = 8;  // prefetch distance (random option reads)
+  for (std::size_t at = 0; at < order.size(); ++at) {
+    if (at + kLookahead < order.size()) {
+      const Wish& ahead = wishes[order[at + kLookahead].wish];
+      __builtin_prefetch(&ahead.copy.representation->atFrontend);
+      __builtin_prefetch(&selections[ahead.selection]);
+    }
+    const WishKey& key = order[at];
+    const Wish& w = wishes[key.wish];
     LeafSelection& s = selections[w.selection];
     std::uint16_t& counter = state.switchCounters[s.object];
     if (w.extraTriangles > roomTriangles || w.extraLink > roomLink) {
@@ -179,6 +239,7 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     counter = w.byDelay ? static_cast<std::uint16_t>(counter + 1) : 0;
     ++stats.hysteresisKeeps;
   }
+  state.stepCandidates.reset();
 }
 
 }  // namespace thinlod::backbone

@@ -76,6 +76,13 @@ struct SchedulerConfig {
   // counted in PlanStats.
   int paretoCap = 64;
   int maxParetoPasses = 16;
+  // Speed only, never the plan: true reuses per-step and per-leaf work of
+  // the accuracy-curve scheduler (the push-down's candidates in the
+  // hysteresis pass, cached leaf envelopes while a leaf's candidates are
+  // unchanged, scratch buffers kept across steps). false is the slower
+  // reference path kept so bench_scheduler can check, in the same run, that
+  // both give identical plans (docs/scheduling.md).
+  bool reuseLeafWork = true;
 };
 
 Status validateConfig(const SchedulerConfig& config);
