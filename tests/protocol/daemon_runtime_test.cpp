@@ -137,6 +137,42 @@ TEST(DaemonRuntime, OutOfRangeIntegerIsAnError) {
   EXPECT_NE(testing::internal::GetCapturedStderr().find("out of range"), std::string::npos);
 }
 
+TEST(DaemonRuntime, NonFiniteNumbersInTomlAreErrors) {
+  for (const char* value : {"nan", "+inf", "-inf"}) {
+    DaemonRuntime runtime("thinlod-test", "test");
+    Config config;
+    config.registerWith(runtime);
+    const Status status =
+        runtime.applyConfig(std::string("[scheduler]\naccuracy = ") + value + "\n", "inline.toml");
+    EXPECT_EQ(status.code(), ErrorCode::kParseError) << value;
+    EXPECT_NE(status.message().find("inline.toml:2:"), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("must be a finite number"), std::string::npos)
+        << status.message();
+    EXPECT_DOUBLE_EQ(config.accuracy, 0.5) << value;
+  }
+}
+
+TEST(DaemonRuntime, NonFiniteNumberFlagIsAnError) {
+  DaemonRuntime runtime("thinlod-test", "test");
+  Config config;
+  config.registerWith(runtime);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(parseArgs(runtime, {"--scheduler.accuracy", "nan"}), 2);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("must be a finite number"),
+            std::string::npos);
+}
+
+TEST(DaemonRuntime, ConfigTextAfterParseKeepsFlagsWinning) {
+  DaemonRuntime runtime("thinlod-test", "test");
+  Config config;
+  config.registerWith(runtime);
+  ASSERT_FALSE(parseArgs(runtime, {"--workers", "4"}).has_value());
+  // parse()'s command-line parser is gone by now; what it saw is kept.
+  ASSERT_TRUE(runtime.applyConfig("workers = 9\nverbose = true\n", "late.toml").ok());
+  EXPECT_EQ(config.workers, 4);
+  EXPECT_TRUE(config.verbose);
+}
+
 TEST(DaemonRuntime, MalformedTomlIsAnError) {
   TempToml file("[scheduler\n");
   DaemonRuntime runtime("thinlod-test", "test");
