@@ -235,6 +235,25 @@ TEST(MeshIo, BinaryPlyWithNaNIsRejected) {
   EXPECT_TRUE(contains(r.status().message(), "nan.ply: vertex 0")) << r.status().message();
 }
 
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-vertex-colour-11.obj): OpenMesh
+// turns "v x y z r g b" into an 8-bit colour as 255 * r, undefined behaviour
+// for r outside [0, 1]; the pre-check rejects such lines and keeps good ones.
+TEST(MeshIo, ObjVertexColourOutsideUnitRangeIsRejected) {
+  const std::string faces = "f 1 2 3\n";
+  for (const char* colour : {"11 0 0", "0 -0.5 0", "0 0 1.0001"}) {
+    const std::string text = std::string("v 0 0 0 ") + colour + "\nv 1 0 0\nv 0 1 0\n" + faces;
+    Result<LoadedMesh> r = loadMeshFromMemory(text, "obj", "colour.obj");
+    ASSERT_FALSE(r.ok()) << colour;
+    EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_TRUE(contains(r.status().message(), "colour.obj:1: vertex colour component"))
+        << r.status().message();
+  }
+  const std::string good = "v 0 0 0 1 0.5 0\nv 1 0 0 0 0 0\nv 0 1 0 0 1 1 # rgb\n" + faces;
+  Result<LoadedMesh> r = loadMeshFromMemory(good, "obj", "colour.obj");
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

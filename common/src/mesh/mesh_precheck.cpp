@@ -106,6 +106,28 @@ Status limitError(const std::string& name, const char* what, std::uint64_t count
 
 // ---------------------------------------------------------------- OBJ
 
+// "v x y z r g b": OpenMesh reads the three numbers after z as a colour
+// whenever all three are there, and converts each with 255 * value to an
+// unsigned char; outside [0, 1] that conversion is undefined behaviour
+// (OpenMesh color_cast.hh; found by fuzz/mesh_file.cpp, regression seed
+// fuzz/corpus/mesh/crash-obj-vertex-colour-11.obj). Precondition: the
+// tokens are finite numbers (checkFiniteNumbers).
+Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const std::string& name,
+                            int line) {
+  std::size_t numbers = 0;
+  while (1 + numbers < tokens.size() && tokens[1 + numbers][0] != '#') ++numbers;
+  if (numbers < 6) return Status();
+  for (std::size_t i = 4; i <= 6; ++i) {
+    double v = 0.0;
+    parseNumberToken(tokens[i], &v);
+    if (!(v >= 0.0 && v <= 1.0)) {
+      return lineError(name, line,
+                       "vertex colour component " + quoted(tokens[i]) + " is outside [0, 1]");
+    }
+  }
+  return Status();
+}
+
 Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& name,
                                    const MeshLoadOptions& options) {
   LineScanner scanner(bytes);
@@ -119,6 +141,7 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
     const int ln = scanner.lineNumber();
     if (key == "v") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex"));
+      THINLOD_RETURN_IF_ERROR(checkObjVertexColour(tokens, name, ln));
       if (++vertices > options.maxVertices) {
         return limitError(name, "vertices", vertices, options.maxVertices);
       }
