@@ -254,6 +254,19 @@ TEST(MeshIo, ObjVertexColourOutsideUnitRangeIsRejected) {
   EXPECT_EQ(r->mesh.triangleCount(), 1u);
 }
 
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-comment-in-vertex.obj): a comment
+// inside a vertex line hid missing coordinates from the pre-check; OpenMesh
+// skipped the vertex and a face's uv was then written past its vertices.
+TEST(MeshIo, ObjVertexWithTooFewNumbersBeforeACommentIsRejected) {
+  const std::string text = "v 0 #0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 2/1 3/1 4/1\n";
+  Result<LoadedMesh> r = loadMeshFromMemory(text, "obj", "comment.obj");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.status().message(), "comment.obj:1: vertex needs 3 numbers, found 1"))
+      << r.status().message();
+  const std::string trailing = "v 0 0 0 # a comment\nv 1 0 0\nv 0 1 0\nf 1 2 3 # face\n";
+  EXPECT_TRUE(loadMeshFromMemory(trailing, "obj", "comment.obj").ok());
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

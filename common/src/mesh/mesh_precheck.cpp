@@ -63,17 +63,22 @@ Status lineError(const std::string& name, int line, const std::string& problem) 
   return Status(ErrorCode::kInvalidArgument, name + ":" + std::to_string(line) + ": " + problem);
 }
 
-// All tokens from `first` on must be finite numbers.
+// All tokens from `first` up to a comment must be finite numbers, at least
+// `minCount` of them. A comment token does not count: "v 0 # 0 0" has one
+// number, and OpenMesh skips such a vertex, so face indices checked against
+// our count went past its vertices (an out-of-bounds texcoord write;
+// found by fuzz/mesh_file.cpp, seed fuzz/corpus/mesh/crash-obj-comment-in-vertex.obj).
 Status checkFiniteNumbers(const std::vector<std::string_view>& tokens, std::size_t first,
                           std::size_t minCount, const std::string& name, int line,
                           const char* what) {
-  if (tokens.size() < first + minCount) {
+  std::size_t end = first;
+  while (end < tokens.size() && tokens[end][0] != '#') ++end;
+  if (end < first + minCount) {
     return lineError(name, line,
                      std::string(what) + " needs " + std::to_string(minCount) + " numbers, found " +
-                         std::to_string(tokens.size() > first ? tokens.size() - first : 0));
+                         std::to_string(end > first ? end - first : 0));
   }
-  for (std::size_t i = first; i < tokens.size(); ++i) {
-    if (tokens[i][0] == '#') break;
+  for (std::size_t i = first; i < end; ++i) {
     double v = 0.0;
     if (!parseNumberToken(tokens[i], &v)) {
       return lineError(name, line, std::string(what) + " has a bad number " + quoted(tokens[i]));
