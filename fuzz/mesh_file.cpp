@@ -26,8 +26,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   thinlod::Result<thinlod::LoadedMesh> r = thinlod::loadMeshFromMemory(
       std::string_view(reinterpret_cast<const char*>(data + 1), size - 1), format, "fuzz", options);
   if (r.ok()) {
-    if (!r->mesh.validate("fuzz").ok()) {
-      std::fprintf(stderr, "mesh fuzz oracle: loaded mesh is invalid\n");
+    if (const thinlod::Status valid = r->mesh.validate("fuzz"); !valid.ok()) {
+      std::fprintf(stderr, "mesh fuzz oracle: loaded mesh is invalid: %s\n",
+                   valid.message().c_str());
       std::abort();
     }
     if (r->mesh.triangleCount() == 0) {  // mesh_io.h: zero faces is an error

@@ -248,6 +248,11 @@ TEST(MeshIo, ObjVertexColourOutsideUnitRangeIsRejected) {
     EXPECT_TRUE(contains(r.status().message(), "colour.obj:1: vertex colour component"))
         << r.status().message();
   }
+  const std::string vc = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvc 0 0 -1\n" + faces;
+  Result<LoadedMesh> vcLine = loadMeshFromMemory(vc, "obj", "colour.obj");
+  ASSERT_FALSE(vcLine.ok());
+  EXPECT_TRUE(contains(vcLine.status().message(), "colour.obj:4: vertex colour component '-1'"))
+      << vcLine.status().message();
   const std::string good = "v 0 0 0 1 0.5 0\nv 1 0 0 0 0 0\nv 0 1 0 0 1 1 # rgb\n" + faces;
   Result<LoadedMesh> r = loadMeshFromMemory(good, "obj", "colour.obj");
   ASSERT_TRUE(r.ok()) << r.status().toString();

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -244,11 +245,12 @@ Result<LoadedMesh> loadChecked(std::string_view bytes, MeshFormat format, const 
   out.mesh = toIndexedMesh(tm, attributes);
   THINLOD_RETURN_IF_ERROR(out.mesh.validate(name));
   // File normals are often unnormalised (VCG writes area-weighted ones);
-  // zero ones cannot be fixed locally, so then all are recomputed.
+  // zero ones cannot be fixed locally, so then all are recomputed. So are
+  // ones whose float length overflows (components near FLT_MAX).
   bool zeroNormal = false;
   for (glm::vec3& n : out.mesh.normals) {
     const float len = glm::length(n);
-    if (!(len > 1e-20f)) {
+    if (!(len > 1e-20f) || !std::isfinite(len)) {
       zeroNormal = true;
       break;
     }

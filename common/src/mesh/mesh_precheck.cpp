@@ -116,13 +116,12 @@ Status limitError(const std::string& name, const char* what, std::uint64_t count
 // unsigned char; outside [0, 1] that conversion is undefined behaviour
 // (OpenMesh color_cast.hh; found by fuzz/mesh_file.cpp, regression seed
 // fuzz/corpus/mesh/crash-obj-vertex-colour-11.obj). Precondition: the
-// tokens are finite numbers (checkFiniteNumbers).
-Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const std::string& name,
-                            int line) {
-  std::size_t numbers = 0;
-  while (1 + numbers < tokens.size() && tokens[1 + numbers][0] != '#') ++numbers;
-  if (numbers < 6) return Status();
-  for (std::size_t i = 4; i <= 6; ++i) {
+// tokens are finite numbers (checkFiniteNumbers). "vc r g b" lines (a
+// colour of their own, from token 1; seed crash-obj-vc-line.obj) are read
+// the same way.
+Status checkColourRange(const std::vector<std::string_view>& tokens, std::size_t first,
+                        const std::string& name, int line) {
+  for (std::size_t i = first; i < first + 3; ++i) {
     double v = 0.0;
     parseNumberToken(tokens[i], &v);
     if (!(v >= 0.0 && v <= 1.0)) {
@@ -131,6 +130,14 @@ Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const s
     }
   }
   return Status();
+}
+
+Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const std::string& name,
+                            int line) {
+  std::size_t numbers = 0;
+  while (1 + numbers < tokens.size() && tokens[1 + numbers][0] != '#') ++numbers;
+  if (numbers < 6) return Status();
+  return checkColourRange(tokens, 4, name, line);
 }
 
 Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& name,
@@ -150,6 +157,9 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
       if (++vertices > options.maxVertices) {
         return limitError(name, "vertices", vertices, options.maxVertices);
       }
+    } else if (key == "vc") {
+      THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex colour"));
+      THINLOD_RETURN_IF_ERROR(checkColourRange(tokens, 1, name, ln));
     } else if (key == "vn") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "normal"));
     } else if (key == "vt") {
