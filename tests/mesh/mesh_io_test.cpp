@@ -268,8 +268,29 @@ TEST(MeshIo, ObjVertexWithTooFewNumbersBeforeACommentIsRejected) {
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(contains(r.status().message(), "comment.obj:1: vertex needs 3 numbers, found 1"))
       << r.status().message();
-  const std::string trailing = "v 0 0 0 # a comment\nv 1 0 0\nv 0 1 0\nf 1 2 3 # face\n";
+  const std::string trailing = "v 0 0 0 # a comment\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
   EXPECT_TRUE(loadMeshFromMemory(trailing, "obj", "comment.obj").ok());
+}
+
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-comment-in-face.obj): OpenMesh's
+// face parser reads "#4/4/1" as vertex -1 and wrote its normal out of
+// bounds; comments in face lines and references to texture coordinates or
+// normals that do not exist are errors before OpenMesh runs.
+TEST(MeshIo, ObjFaceCommentsAndDanglingReferencesAreRejected) {
+  const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+  const std::pair<const char*, const char*> cases[] = {
+      {"f 1/1/1 2/1/1 3/1/1 #4/4/1\n", "comment inside a face line '#4/4/1'"},
+      {"f 1 2 3 # trailing\n", "comment inside a face line '#'"},
+      {"f 1/2 2/1 3/1\n", "face references texture coordinate '2' (only 1 so far)"},
+      {"f 1//1 2//-2 3//1\n", "face references normal '-2' (only 1 so far)"},
+  };
+  for (const auto& [face, message] : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(head + face, "obj", "refs.obj");
+    ASSERT_FALSE(r.ok()) << face;
+    EXPECT_TRUE(contains(r.status().message(), std::string("refs.obj:6: ") + message))
+        << r.status().message();
+  }
+  EXPECT_TRUE(loadMeshFromMemory(head + "f 1/1/1 2/-1/1 3//-1\n", "obj", "refs.obj").ok());
 }
 
 // Memory safety: every truncated prefix and random byte corruptions of valid

@@ -34,53 +34,18 @@ std::mutex& openMeshMutex() {
   return mutex;
 }
 
-// Where omerr() writes: into the active capture's stream, else std::cerr.
-// OpenMesh's mostream::disconnect() drops its target without deleting it
-// (16 bytes leaked per connect/disconnect pair, found by LeakSanitizer under
-// fuzz/mesh_file.cpp), so omerr() is connected to this sink once per process
-// and never disconnected; captures only switch the sink's destination.
-// Used under openMeshMutex().
-class OpenMeshErrorSink : public std::streambuf {
- public:
-  void redirect(std::ostream* into) { into_ = into; }
-
- protected:
-  int_type overflow(int_type c) override {
-    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
-    target().put(traits_type::to_char_type(c));
-    return c;
-  }
-  std::streamsize xsputn(const char* s, std::streamsize n) override {
-    target().write(s, n);
-    return n;
-  }
-
- private:
-  std::ostream& target() { return into_ != nullptr ? *into_ : std::cerr; }
-  std::ostream* into_ = nullptr;
-};
-
-OpenMeshErrorSink& openMeshErrorSink() {
-  static OpenMeshErrorSink sink;
-  static std::ostream stream(&sink);
-  static const bool connected = [] {
-    omerr().disconnect(std::cerr);  // the sink writes there between captures
-    return omerr().connect(stream);
-  }();
-  (void)connected;
-  return sink;
-}
-
 // Redirects OpenMesh's error stream into a string for the lifetime of the
 // object (OpenMesh reports bad faces there and still returns "ok"), and
-// silences its log stream. Some OpenMesh readers also write to std::cerr
-// directly ("Unsupported keyword"), so std::cerr's buffer is swapped too;
-// spdlog writes to the C stderr stream and is not affected. Construct under
-// openMeshMutex().
+// silences its log stream. omerr() writes to std::cerr (its default
+// target), and so do some readers directly ("Unsupported keyword"), so
+// swapping std::cerr's buffer captures both; spdlog writes to the C stderr
+// stream and is not affected. omerr()'s targets are never connected or
+// disconnected here: OpenMesh's mostream::disconnect() drops a target
+// without deleting it (16 bytes per load; found by LeakSanitizer under
+// fuzz/mesh_file.cpp). Construct under openMeshMutex().
 class ErrorStreamCapture {
  public:
   ErrorStreamCapture() {
-    openMeshErrorSink().redirect(&buffer_);
     logWasEnabled_ = omlog().is_enabled();
     omlog().disable();
     outWasEnabled_ = omout().is_enabled();
@@ -90,7 +55,6 @@ class ErrorStreamCapture {
   ~ErrorStreamCapture() {
     omerr().flush();
     std::cerr.rdbuf(savedCerr_);
-    openMeshErrorSink().redirect(nullptr);
     if (logWasEnabled_) omlog().enable();
     if (outWasEnabled_) omout().enable();
   }

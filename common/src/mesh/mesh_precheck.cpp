@@ -145,6 +145,8 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
   LineScanner scanner(bytes);
   std::string_view line;
   std::uint64_t vertices = 0;
+  std::uint64_t normals = 0;
+  std::uint64_t texcoords = 0;
   std::uint64_t faces = 0;
   while (scanner.next(&line)) {
     const std::vector<std::string_view> tokens = tokenize(line);
@@ -162,24 +164,55 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
       THINLOD_RETURN_IF_ERROR(checkColourRange(tokens, 1, name, ln));
     } else if (key == "vn") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "normal"));
+      ++normals;
     } else if (key == "vt") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 2, name, ln, "texture coordinate"));
+      ++texcoords;
     } else if (key == "f") {
       std::size_t corners = 0;
-      for (std::size_t i = 1; i < tokens.size() && tokens[i][0] != '#'; ++i) {
-        // "v", "v/t", "v//n", "v/t/n": the vertex index is before the first '/'.
-        const std::string_view ref = tokens[i].substr(0, tokens[i].find('/'));
+      for (std::size_t i = 1; i < tokens.size(); ++i) {
+        // OpenMesh's face parser knows no comments: "#4/4/1" is vertex
+        // atoi("#4") - 1 = -1, and it then wrote that vertex's normal at
+        // index -1 (found by fuzz/mesh_file.cpp, seed
+        // fuzz/corpus/mesh/crash-obj-comment-in-face.obj).
+        if (tokens[i].find('#') != std::string_view::npos) {
+          return lineError(name, ln, "comment inside a face line " + quoted(tokens[i]));
+        }
+        // "v", "v/t", "v//n", "v/t/n": vertex, texture coordinate and
+        // normal references, each 1-based or negative (counting back from
+        // the last element read so far).
+        const std::string_view token = tokens[i];
+        const std::size_t slash1 = token.find('/');
+        const std::string_view ref = token.substr(0, slash1);
         std::int64_t index = 0;
         if (!parseSigned(ref, &index)) {
           return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[i]));
         }
-        // Positive indices are 1-based, negative ones count back from the
-        // last vertex read so far.
         const std::int64_t n = static_cast<std::int64_t>(vertices);
         if (index == 0 || index > n || index < -n) {
           return lineError(name, ln,
                            "face references vertex " + std::to_string(index) + " (only " +
                                std::to_string(vertices) + " vertices so far)");
+        }
+        if (slash1 != std::string_view::npos) {
+          const std::string_view rest = token.substr(slash1 + 1);
+          const std::size_t slash2 = rest.find('/');
+          const std::string_view texRef = rest.substr(0, slash2);
+          const std::string_view normalRef =
+              slash2 == std::string_view::npos ? std::string_view() : rest.substr(slash2 + 1);
+          const auto checkRef = [&](std::string_view r, std::uint64_t count, const char* what) {
+            if (r.empty()) return Status();
+            std::int64_t k = 0;
+            const std::int64_t c = static_cast<std::int64_t>(count);
+            if (!parseSigned(r, &k) || k == 0 || k > c || k < -c) {
+              return lineError(name, ln,
+                               std::string("face references ") + what + " " + quoted(r) +
+                                   " (only " + std::to_string(count) + " so far)");
+            }
+            return Status();
+          };
+          THINLOD_RETURN_IF_ERROR(checkRef(texRef, texcoords, "texture coordinate"));
+          THINLOD_RETURN_IF_ERROR(checkRef(normalRef, normals, "normal"));
         }
         ++corners;
       }
