@@ -25,8 +25,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::fprintf(stderr, "scene fuzz oracle: more instances than maxInstances\n");
       std::abort();
     }
+    // A short tessellation ladder: the default (16384 triangles) spent
+    // ~0.1 s per sphere, 80 inputs/s; the code paths are the same.
+    thinlod::PrimitiveCurveOptions curveOptions;
+    curveOptions.maxTriangles = 256;
     for (const thinlod::scene::NodePtr& root : r->roots) {
-      (void)thinlod::scene::relativeCurve(*root);  // errors are fine; crashes and UB are not
+      // Errors are fine; crashes and UB are not.
+      (void)thinlod::scene::relativeCurve(*root, curveOptions);
     }
   } else if (r.status().message().rfind("fuzz.wrl:", 0) != 0) {
     std::fprintf(stderr, "scene fuzz oracle: error without file:line:column: %s\n",

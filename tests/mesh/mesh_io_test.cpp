@@ -293,6 +293,30 @@ TEST(MeshIo, ObjFaceCommentsAndDanglingReferencesAreRejected) {
   EXPECT_TRUE(loadMeshFromMemory(head + "f 1/1/1 2/-1/1 3//-1\n", "obj", "refs.obj").ok());
 }
 
+// Fuzz finding (fuzz/corpus/mesh/crash-off-counts-on-header.off): OpenMesh's
+// OFF reader ignores counts on the header line and skips no comments, so
+// the pre-check's view of the counts and OpenMesh's differed ("OFF\v0 0"
+// made it reserve 11 GB from an uninitialised count).
+TEST(MeshIo, OffLayoutsOpenMeshReadsDifferentlyAreRejected) {
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::pair<std::string, const char*> cases[] = {
+      {"OFF 3 1 0\n" + body, "bad.off:1: the OFF header line holds only 'OFF'"},
+      {std::string("OFF\v0 0\n"), "bad.off:1: the OFF header line holds only 'OFF'"},
+      {"OFF\n# made by hand\n3 1 0\n" + body, "bad.off:2: comments are not supported"},
+      {"OFF\n3 1 0\n0 0 0 # first\n1 0 0\n0 1 0\n3 0 1 2\n", "bad.off:3: comments are not"},
+      {"# made by hand\nOFF\n3 1 0\n" + body, "bad.off:1: comments are not supported"},
+      {"\nOFF\n3 1 0\n" + body, "bad.off:2: the OFF header must be the first line"},
+  };
+  for (const auto& [text, message] : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(text, "off", "bad.off");
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_TRUE(contains(r.status().message(), message)) << r.status().message();
+  }
+  Result<LoadedMesh> good = loadMeshFromMemory("  OFF\n3 1 0\n" + body, "off", "good.off");
+  ASSERT_TRUE(good.ok()) << good.status().toString();
+  EXPECT_EQ(good->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

@@ -234,16 +234,40 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
                                    const MeshLoadOptions& options) {
   LineScanner scanner(bytes);
   std::string_view line;
+  int commentLine = 0;  // set when nextContentLine stops at a comment
+  // OpenMesh 9's OFF reader takes the first line as the header and then
+  // reads counts and values with operator>>, skipping no comments: counts
+  // on the header line were ignored (it read the first coordinates as
+  // counts), and a '#' left a count unread and uninitialised, which it then
+  // reserved (an 11 GB allocation from "OFF\v0 0"; found by
+  // fuzz/mesh_file.cpp, seed fuzz/corpus/mesh/crash-off-counts-on-header.off).
+  // So the header line holds the magic alone, and no comment may follow it.
   auto nextContentLine = [&](std::vector<std::string_view>* tokens) {
     while (scanner.next(&line)) {
       *tokens = tokenize(line);
-      if (!tokens->empty() && (*tokens)[0][0] != '#') return true;
+      if (tokens->empty()) continue;
+      for (const std::string_view token : *tokens) {
+        if (token.find('#') != std::string_view::npos) {
+          commentLine = scanner.lineNumber();
+          return false;
+        }
+      }
+      return true;
     }
     return false;
   };
+  const auto stopped = [&](Status truncated) {
+    if (commentLine == 0) return truncated;
+    return lineError(name, commentLine,
+                     "comments are not supported in OFF files (OpenMesh's reader does not skip "
+                     "them)");
+  };
   std::vector<std::string_view> tokens;
   if (!nextContentLine(&tokens)) {
-    return Status(ErrorCode::kInvalidArgument, name + ": empty OFF file");
+    return stopped(Status(ErrorCode::kInvalidArgument, name + ": empty OFF file"));
+  }
+  if (scanner.lineNumber() != 1) {
+    return lineError(name, scanner.lineNumber(), "the OFF header must be the first line");
   }
   const std::string_view magic = tokens[0];
   if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") {
@@ -253,16 +277,19 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
     return Status(ErrorCode::kUnsupported,
                   name + ": OFF variant " + quoted(magic) + " (4D / nD) is not supported");
   }
-  std::size_t countStart = 1;
   if (tokens.size() > 1 && tokens[1] == "BINARY") {
     return Status(ErrorCode::kUnsupported, name + ": binary OFF is not supported");
   }
-  if (tokens.size() <= countStart) {
-    if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: no vertex/face counts");
-    }
-    countStart = 0;
+  if (tokens.size() > 1) {
+    return lineError(name, 1,
+                     "the OFF header line holds only " + quoted(magic) +
+                         "; counts go on the next line (OpenMesh ignores them here)");
   }
+  if (!nextContentLine(&tokens)) {
+    return stopped(
+        Status(ErrorCode::kInvalidArgument, name + ": truncated: no vertex/face counts"));
+  }
+  const std::size_t countStart = 0;
   std::uint64_t nv = 0;
   std::uint64_t nf = 0;
   if (tokens.size() < countStart + 2 || !parseUnsigned(tokens[countStart], &nv) ||
@@ -281,17 +308,17 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
   }
   for (std::uint64_t v = 0; v < nv; ++v) {
     if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
-                                                     std::to_string(nv) + " vertices, found " +
-                                                     std::to_string(v));
+      return stopped(Status(ErrorCode::kInvalidArgument,
+                            name + ": truncated: header declares " + std::to_string(nv) +
+                                " vertices, found " + std::to_string(v)));
     }
     THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 0, 3, name, scanner.lineNumber(), "vertex"));
   }
   for (std::uint64_t f = 0; f < nf; ++f) {
     if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
-                                                     std::to_string(nf) + " faces, found " +
-                                                     std::to_string(f));
+      return stopped(Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                             std::to_string(nf) + " faces, found " +
+                                                             std::to_string(f)));
     }
     const int ln = scanner.lineNumber();
     std::uint64_t k = 0;
