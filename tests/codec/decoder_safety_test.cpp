@@ -208,6 +208,30 @@ TEST(DecoderSafety, DracoAttributeWithACorruptNormalizedFlagIsHandled) {
   decodeChecked(frame, /*isMesh=*/true);  // checks any success is a valid mesh
 }
 
+// Fuzz finding (fuzz/corpus/codec_texture/crash-jpeg-app1-without-nul.bin):
+// OpenImageIO's JPEG reader strcmp()s APP1 data, reading past a segment
+// without a NUL (heap over-read). Such payloads, and JPEG headers whose
+// segments run past the payload, are rejected before OpenImageIO sees them.
+TEST(DecoderSafety, JpegWithAnUnterminatedApp1SegmentIsRejected) {
+  std::ifstream in(std::string(THINLOD_SOURCE_DIR) +
+                       "/fuzz/corpus/codec_texture/crash-jpeg-app1-without-nul.bin",
+                   std::ios::binary);
+  Bytes frame((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(frame.size(), kFrameHeaderBytes);
+  resealFrame(frame);
+  const Result<RgbaImage> decoded = decodeTexture(frame.data(), frame.size());
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kParseError);
+  EXPECT_NE(decoded.status().message().find("JPEG payload has a malformed header"),
+            std::string::npos)
+      << decoded.status().message();
+  // A segment length running past the payload is rejected the same way.
+  Bytes valid = textureFrame(TextureCodec::kJpeg);
+  valid[kFrameHeaderBytes + 4] = 0xFF;  // APP0 length high byte
+  resealFrame(valid);
+  EXPECT_EQ(decodeTexture(valid.data(), valid.size()).status().code(), ErrorCode::kParseError);
+}
+
 TEST(DecoderSafety, NullInputIsAnError) {
   EXPECT_FALSE(decodeMesh(nullptr, 0).ok());
   EXPECT_FALSE(decodeTexture(nullptr, 0).ok());

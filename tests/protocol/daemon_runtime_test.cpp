@@ -173,6 +173,27 @@ TEST(DaemonRuntime, ConfigTextAfterParseKeepsFlagsWinning) {
   EXPECT_TRUE(config.verbose);
 }
 
+// Fuzz finding (fuzz/corpus/config/crash-print-config-quotes.toml):
+// --print-config wrote a string holding three single quotes in a row as a
+// TOML literal string, which no TOML reader accepts back.
+TEST(DaemonRuntime, PrintedConfigReadsBackWhateverTheStrings) {
+  const std::string threeQuotes(3, '\'');
+  for (const std::string& value :
+       {"a" + threeQuotes + "b", threeQuotes, std::string("tab\tquote\" back\\ new\nline")}) {
+    DaemonRuntime runtime("thinlod-test", "test");
+    Config config;
+    config.registerWith(runtime);
+    config.address = value;
+    const std::string printed = runtime.effectiveConfig();
+    DaemonRuntime again("thinlod-test", "test");
+    Config reread;
+    reread.registerWith(again);
+    const Status status = again.applyConfig(printed, "printed.toml");
+    ASSERT_TRUE(status.ok()) << status.toString() << "\n" << printed;
+    EXPECT_EQ(reread.address, value);
+  }
+}
+
 TEST(DaemonRuntime, MalformedTomlIsAnError) {
   TempToml file("[scheduler\n");
   DaemonRuntime runtime("thinlod-test", "test");

@@ -357,8 +357,16 @@ std::string DaemonRuntime::effectiveConfig() const {
         },
         option.target);
   }
+  // Basic (escaped, one-line) strings only: tomlplusplus 3.3 writes a
+  // string holding three quotes in a row as a multi-line literal string it
+  // cannot read back (found by fuzz/daemon_config.cpp, seed
+  // fuzz/corpus/config/crash-print-config-quotes.toml).
+  constexpr auto kFlags =
+      toml::toml_formatter::default_flags &
+      ~(toml::format_flags::allow_literal_strings | toml::format_flags::allow_multi_line_strings |
+        toml::format_flags::allow_real_tabs_in_strings);
   std::ostringstream out;
-  out << root << "\n";
+  out << toml::toml_formatter(root, kFlags) << "\n";
   return out.str();
 }
 
