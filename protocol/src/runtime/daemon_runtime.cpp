@@ -357,17 +357,24 @@ std::string DaemonRuntime::effectiveConfig() const {
         },
         option.target);
   }
-  // Basic (escaped, one-line) strings only: tomlplusplus 3.3 writes a
-  // string holding three quotes in a row as a multi-line literal string it
-  // cannot read back (found by fuzz/daemon_config.cpp, seed
-  // fuzz/corpus/config/crash-print-config-quotes.toml).
-  constexpr auto kFlags =
+  std::ostringstream out;
+  out << root << "\n";
+  // tomlplusplus 3.3 writes a string holding three quotes in a row as a
+  // multi-line literal string it cannot read back (found by
+  // fuzz/daemon_config.cpp, seed fuzz/corpus/config/crash-print-config-quotes.toml).
+  // Such output is written again with basic (escaped, one-line) strings
+  // only; ordinary configs keep the usual 'literal' strings.
+  try {
+    if (toml::parse(out.str()) == root) return out.str();
+  } catch (const toml::parse_error&) {
+  }
+  constexpr auto kBasicStrings =
       toml::toml_formatter::default_flags &
       ~(toml::format_flags::allow_literal_strings | toml::format_flags::allow_multi_line_strings |
         toml::format_flags::allow_real_tabs_in_strings);
-  std::ostringstream out;
-  out << toml::toml_formatter(root, kFlags) << "\n";
-  return out.str();
+  std::ostringstream basic;
+  basic << toml::toml_formatter(root, kBasicStrings) << "\n";
+  return basic.str();
 }
 
 const std::string& DaemonRuntime::name() const { return impl_->name; }
