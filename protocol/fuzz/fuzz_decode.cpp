@@ -1,6 +1,8 @@
-// libFuzzer entry point for the protocol decoder. Built as a fuzzer with
-// -DTHINLOD_FUZZ=ON under clang; replayed over protocol/fuzz/corpus by the
-// ctest test protocol_fuzz_replay under any compiler.
+// libFuzzer entry point for the protocol decoder. Built as the fuzzer
+// thinlod_fuzz_protocol with -DTHINLOD_FUZZ=ON under clang (fuzz/CMakeLists.txt);
+// replayed over protocol/fuzz/corpus by protocol.FuzzReplay.* and, with the
+// campaign findings in fuzz/corpus/protocol, by fuzz.ProtocolMessageFuzzer.*
+// under any compiler.
 //
 // Oracle beyond "no crash": whatever decodes must re-encode, and the
 // re-encoded bytes must decode to an equal message (decode and encode agree

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <limits>
 
 namespace thinlod {
@@ -63,6 +64,23 @@ TEST(IndexedMesh, NormalsOfFlatTrianglePointUp) {
   m.computeNormals();
   ASSERT_EQ(m.normals.size(), 3u);
   for (const auto& n : m.normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);
+}
+
+// Fuzz finding (fuzz/corpus/mesh/crash-stl-normal-overflow.stl): with
+// coordinates near FLT_MAX the float cross product overflowed and the normal
+// became NaN, failing validate() on a mesh the loader had accepted.
+TEST(IndexedMesh, ComputeNormalsStaysFiniteAtExtremeMagnitudes) {
+  for (const float scale : {3e38f, 1e30f, 1e-30f, 1e-44f}) {
+    IndexedMesh m;
+    m.positions = {{-scale, -scale, 0.0f}, {scale, -scale, 0.0f}, {scale, scale, 0.0f}};
+    m.indices = {0, 1, 2};
+    m.computeNormals();
+    ASSERT_TRUE(m.validate("extreme").ok()) << scale;
+    for (const glm::vec3& n : m.normals) {
+      EXPECT_NEAR(glm::length(n), 1.0f, 1e-6f) << scale;
+      EXPECT_NEAR(n.z, 1.0f, 1e-6f) << scale;  // the triangle's normal
+    }
+  }
 }
 
 }  // namespace

@@ -77,6 +77,27 @@ TEST(Trace, LookingStraightDownIsWellDefined) {
   EXPECT_NEAR(glm::length(t->poses[0].orientation), 1.0f, 1e-6f);
 }
 
+// Fuzz finding (fuzz/corpus/trace/lookat_nearly_vertical.trace): glm's
+// quatLookAtRH clamps |up x direction|^2 at 1e-5, so a look direction with
+// 0.999995 < |y| <= 0.999999 gave a quaternion of length 0.88.
+TEST(Trace, NearlyVerticalLookatGivesAUnitRotationTowardsTheTarget) {
+  const glm::vec3 position(2.22f, 660.9647f, 2.9045f);
+  const glm::vec3 target(2.8396f, 0.5f, 1.8771f);
+  for (const glm::vec3& p : {position, glm::vec3(0.0f, 1.0f, 0.0f)}) {
+    for (float dx : {0.0f, 1e-4f, 1e-3f, 2e-3f, 3e-3f, 5e-3f, 0.1f}) {
+      const glm::vec3 to = p == position ? target : glm::vec3(dx, 0.0f, 0.5f * dx);
+      const glm::quat q = lookAtOrientation(p, to);
+      EXPECT_NEAR(glm::length(q), 1.0f, 1e-6f) << dx;
+      const glm::vec3 forward = q * glm::vec3(0.0f, 0.0f, -1.0f);
+      EXPECT_NEAR(glm::dot(forward, glm::normalize(to - p)), 1.0f, 1e-6f) << dx;
+    }
+  }
+  const auto t =
+      parseTrace(withHeader("8.03 2.22 660.9647 2.9045 lookat 2.8396 0.5000 1.8771 45\n"));
+  ASSERT_TRUE(t.ok());
+  EXPECT_NEAR(glm::length(t->poses[0].orientation), 1.0f, 1e-6f);
+}
+
 TEST(Trace, NonUnitQuaternionIsNormalised) {
   const auto t = parseTrace(withHeader("0 0 0 0 quat 2 0 0 0 60\n"));
   ASSERT_TRUE(t.ok());

@@ -14,12 +14,14 @@
 // tests/protocol the transport itself.)
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "fault_harness.h"
 #include "thinlod/common/codec/encoding.h"
@@ -96,8 +98,15 @@ TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePe
        "--transport.heartbeat_ms", "100", "--transport.liveness_misses", "50"},
       dir.path() / "backbone.log");
   ASSERT_TRUE(backbone.waitForLog("event=listening")) << backbone.log();
-  const nlohmann::json ready =
-      nlohmann::json::parse(readFile(dir.path() / "ready.json"), nullptr, false);
+  // The backbone logs "listening" before it writes the ready file (renamed
+  // into place): wait for the file too (the sanitizer build lost this race).
+  nlohmann::json ready;
+  for (const auto end = std::chrono::steady_clock::now() + kDeadline;
+       std::chrono::steady_clock::now() < end;
+       std::this_thread::sleep_for(std::chrono::milliseconds(20))) {
+    ready = nlohmann::json::parse(readFile(dir.path() / "ready.json"), nullptr, false);
+    if (ready.is_object()) break;
+  }
   ASSERT_TRUE(ready.is_object() && ready.contains("frontend") && ready.contains("simplifier"))
       << readFile(dir.path() / "ready.json");
 

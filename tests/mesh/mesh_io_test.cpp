@@ -235,6 +235,88 @@ TEST(MeshIo, BinaryPlyWithNaNIsRejected) {
   EXPECT_TRUE(contains(r.status().message(), "nan.ply: vertex 0")) << r.status().message();
 }
 
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-vertex-colour-11.obj): OpenMesh
+// turns "v x y z r g b" into an 8-bit colour as 255 * r, undefined behaviour
+// for r outside [0, 1]; the pre-check rejects such lines and keeps good ones.
+TEST(MeshIo, ObjVertexColourOutsideUnitRangeIsRejected) {
+  const std::string faces = "f 1 2 3\n";
+  for (const char* colour : {"11 0 0", "0 -0.5 0", "0 0 1.0001"}) {
+    const std::string text = std::string("v 0 0 0 ") + colour + "\nv 1 0 0\nv 0 1 0\n" + faces;
+    Result<LoadedMesh> r = loadMeshFromMemory(text, "obj", "colour.obj");
+    ASSERT_FALSE(r.ok()) << colour;
+    EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_TRUE(contains(r.status().message(), "colour.obj:1: vertex colour component"))
+        << r.status().message();
+  }
+  const std::string vc = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvc 0 0 -1\n" + faces;
+  Result<LoadedMesh> vcLine = loadMeshFromMemory(vc, "obj", "colour.obj");
+  ASSERT_FALSE(vcLine.ok());
+  EXPECT_TRUE(contains(vcLine.status().message(), "colour.obj:4: vertex colour component '-1'"))
+      << vcLine.status().message();
+  const std::string good = "v 0 0 0 1 0.5 0\nv 1 0 0 0 0 0\nv 0 1 0 0 1 1 # rgb\n" + faces;
+  Result<LoadedMesh> r = loadMeshFromMemory(good, "obj", "colour.obj");
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  EXPECT_EQ(r->mesh.triangleCount(), 1u);
+}
+
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-comment-in-vertex.obj): a comment
+// inside a vertex line hid missing coordinates from the pre-check; OpenMesh
+// skipped the vertex and a face's uv was then written past its vertices.
+TEST(MeshIo, ObjVertexWithTooFewNumbersBeforeACommentIsRejected) {
+  const std::string text = "v 0 #0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 2/1 3/1 4/1\n";
+  Result<LoadedMesh> r = loadMeshFromMemory(text, "obj", "comment.obj");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.status().message(), "comment.obj:1: vertex needs 3 numbers, found 1"))
+      << r.status().message();
+  const std::string trailing = "v 0 0 0 # a comment\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_TRUE(loadMeshFromMemory(trailing, "obj", "comment.obj").ok());
+}
+
+// Fuzz finding (fuzz/corpus/mesh/crash-obj-comment-in-face.obj): OpenMesh's
+// face parser reads "#4/4/1" as vertex -1 and wrote its normal out of
+// bounds; comments in face lines and references to texture coordinates or
+// normals that do not exist are errors before OpenMesh runs.
+TEST(MeshIo, ObjFaceCommentsAndDanglingReferencesAreRejected) {
+  const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+  const std::pair<const char*, const char*> cases[] = {
+      {"f 1/1/1 2/1/1 3/1/1 #4/4/1\n", "comment inside a face line '#4/4/1'"},
+      {"f 1 2 3 # trailing\n", "comment inside a face line '#'"},
+      {"f 1/2 2/1 3/1\n", "face references texture coordinate '2' (only 1 so far)"},
+      {"f 1//1 2//-2 3//1\n", "face references normal '-2' (only 1 so far)"},
+  };
+  for (const auto& [face, message] : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(head + face, "obj", "refs.obj");
+    ASSERT_FALSE(r.ok()) << face;
+    EXPECT_TRUE(contains(r.status().message(), std::string("refs.obj:6: ") + message))
+        << r.status().message();
+  }
+  EXPECT_TRUE(loadMeshFromMemory(head + "f 1/1/1 2/-1/1 3//-1\n", "obj", "refs.obj").ok());
+}
+
+// Fuzz finding (fuzz/corpus/mesh/crash-off-counts-on-header.off): OpenMesh's
+// OFF reader ignores counts on the header line and skips no comments, so
+// the pre-check's view of the counts and OpenMesh's differed ("OFF\v0 0"
+// made it reserve 11 GB from an uninitialised count).
+TEST(MeshIo, OffLayoutsOpenMeshReadsDifferentlyAreRejected) {
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::pair<std::string, const char*> cases[] = {
+      {"OFF 3 1 0\n" + body, "bad.off:1: the OFF header line holds only 'OFF'"},
+      {std::string("OFF\v0 0\n"), "bad.off:1: the OFF header line holds only 'OFF'"},
+      {"OFF\n# made by hand\n3 1 0\n" + body, "bad.off:2: comments are not supported"},
+      {"OFF\n3 1 0\n0 0 0 # first\n1 0 0\n0 1 0\n3 0 1 2\n", "bad.off:3: comments are not"},
+      {"# made by hand\nOFF\n3 1 0\n" + body, "bad.off:1: comments are not supported"},
+      {"\nOFF\n3 1 0\n" + body, "bad.off:2: the OFF header must be the first line"},
+  };
+  for (const auto& [text, message] : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(text, "off", "bad.off");
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_TRUE(contains(r.status().message(), message)) << r.status().message();
+  }
+  Result<LoadedMesh> good = loadMeshFromMemory("  OFF\n3 1 0\n" + body, "off", "good.off");
+  ASSERT_TRUE(good.ok()) << good.status().toString();
+  EXPECT_EQ(good->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

@@ -5,6 +5,8 @@
 // (docs/protocol.md, "Testing").
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include "seed_messages.h"
@@ -93,6 +95,24 @@ TEST(CodecRobustness, RandomBytesAreHandled) {
     }
     expectConsistent(decode(noise), "noise " + std::to_string(i));
   }
+}
+
+// Fuzz finding: an ImpostorRequest whose object_ids ([ulong]) vector sits 4
+// bytes off an 8-byte boundary passes the FlatBuffers Verifier, which only
+// checks the length prefix; reading it was a misaligned 8-byte load (UB).
+TEST(CodecRobustness, MisalignedEightByteVectorIsRejected) {
+  std::ifstream in(
+      std::string(THINLOD_SOURCE_DIR) + "/fuzz/corpus/protocol/crash-misaligned-ulong-vector.bin",
+      std::ios::binary);
+  const Bytes bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(bytes.empty());
+  const Result<Message> decoded = decode(bytes);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kInvalidArgument) << decoded.status().toString();
+  EXPECT_NE(decoded.status().message().find("object_ids"), std::string::npos)
+      << decoded.status().message();
+  EXPECT_NE(decoded.status().message().find("not aligned to 8 bytes"), std::string::npos)
+      << decoded.status().message();
 }
 
 }  // namespace

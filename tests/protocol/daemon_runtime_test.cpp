@@ -137,6 +137,63 @@ TEST(DaemonRuntime, OutOfRangeIntegerIsAnError) {
   EXPECT_NE(testing::internal::GetCapturedStderr().find("out of range"), std::string::npos);
 }
 
+TEST(DaemonRuntime, NonFiniteNumbersInTomlAreErrors) {
+  for (const char* value : {"nan", "+inf", "-inf"}) {
+    DaemonRuntime runtime("thinlod-test", "test");
+    Config config;
+    config.registerWith(runtime);
+    const Status status =
+        runtime.applyConfig(std::string("[scheduler]\naccuracy = ") + value + "\n", "inline.toml");
+    EXPECT_EQ(status.code(), ErrorCode::kParseError) << value;
+    EXPECT_NE(status.message().find("inline.toml:2:"), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("must be a finite number"), std::string::npos)
+        << status.message();
+    EXPECT_DOUBLE_EQ(config.accuracy, 0.5) << value;
+  }
+}
+
+TEST(DaemonRuntime, NonFiniteNumberFlagIsAnError) {
+  DaemonRuntime runtime("thinlod-test", "test");
+  Config config;
+  config.registerWith(runtime);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(parseArgs(runtime, {"--scheduler.accuracy", "nan"}), 2);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("must be a finite number"),
+            std::string::npos);
+}
+
+TEST(DaemonRuntime, ConfigTextAfterParseKeepsFlagsWinning) {
+  DaemonRuntime runtime("thinlod-test", "test");
+  Config config;
+  config.registerWith(runtime);
+  ASSERT_FALSE(parseArgs(runtime, {"--workers", "4"}).has_value());
+  // parse()'s command-line parser is gone by now; what it saw is kept.
+  ASSERT_TRUE(runtime.applyConfig("workers = 9\nverbose = true\n", "late.toml").ok());
+  EXPECT_EQ(config.workers, 4);
+  EXPECT_TRUE(config.verbose);
+}
+
+// Fuzz finding (fuzz/corpus/config/crash-print-config-quotes.toml):
+// --print-config wrote a string holding three single quotes in a row as a
+// TOML literal string, which no TOML reader accepts back.
+TEST(DaemonRuntime, PrintedConfigReadsBackWhateverTheStrings) {
+  const std::string threeQuotes(3, '\'');
+  for (const std::string& value :
+       {"a" + threeQuotes + "b", threeQuotes, std::string("tab\tquote\" back\\ new\nline")}) {
+    DaemonRuntime runtime("thinlod-test", "test");
+    Config config;
+    config.registerWith(runtime);
+    config.address = value;
+    const std::string printed = runtime.effectiveConfig();
+    DaemonRuntime again("thinlod-test", "test");
+    Config reread;
+    reread.registerWith(again);
+    const Status status = again.applyConfig(printed, "printed.toml");
+    ASSERT_TRUE(status.ok()) << status.toString() << "\n" << printed;
+    EXPECT_EQ(reread.address, value);
+  }
+}
+
 TEST(DaemonRuntime, MalformedTomlIsAnError) {
   TempToml file("[scheduler\n");
   DaemonRuntime runtime("thinlod-test", "test");

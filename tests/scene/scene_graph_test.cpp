@@ -32,6 +32,22 @@ TEST(SceneGraph, TransformFollowsVrmlOrder) {
   EXPECT_NEAR(p.z, 1.0f, 1e-5f);
 }
 
+// Fuzz finding (fuzz/corpus/scene/crash-scale-overflow.wrl): a scale of 1e32
+// overflowed the float bounds, and the curve rescaling factor (inf or NaN)
+// reached AccuracyCurve::scaledAccuracy's assert. It is an error now.
+TEST(SceneGraph, CurveOfAScaleBeyondFloatBoundsIsAnError) {
+  const Scene scene = parseOk(
+      "DEF A Group { children [ Shape { geometry Sphere { radius 1e-3 } } ] }\n"
+      "DEF B Transform { scale 1e32 1e3 1e3 children [ USE A USE A ] }\n"
+      "Transform { children [ USE B USE B ] }\n");
+  const Result<NodeCurve> curve = relativeCurve(*scene.roots.back());
+  ASSERT_FALSE(curve.ok());
+  EXPECT_EQ(curve.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(curve.status().message().find("scaled beyond what its bounds can represent"),
+            std::string::npos)
+      << curve.status().message();
+}
+
 TEST(SceneGraph, MaxScaleIsTheLargestStretch) {
   const glm::mat4 m = glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(glm::vec3(1, 2, 3))) *
                       glm::scale(glm::mat4(1.0f), glm::vec3(1, -3, 2));

@@ -155,10 +155,41 @@ bool pngChunksComplete(const std::uint8_t* data, std::size_t size) {
   return false;
 }
 
+// True when the bytes are SOI and whole marker segments up to SOS, each
+// APP1 and APP13 segment holding a NUL. OpenImageIO 2.4's JpgInput::open
+// compares those segments' data with strcmp ("Exif", the XMP namespace,
+// "Photoshop 3.0"), reading past the segment when it has no NUL (a heap
+// over-read found by fuzz/codec_texture_frame.cpp, seed
+// fuzz/corpus/codec_texture/crash-jpeg-app1-without-nul.bin).
+bool jpegHeaderSafe(const std::uint8_t* data, std::size_t size) {
+  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return false;
+  std::size_t at = 2;
+  while (at < size) {
+    if (data[at] != 0xFF) return false;
+    while (at < size && data[at] == 0xFF) ++at;  // fill bytes
+    if (at >= size) return false;
+    const std::uint8_t marker = data[at++];
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // no length
+    if (marker == 0xD9 || size - at < 2) return false;                   // EOI before SOS
+    const std::size_t length = (std::size_t{data[at]} << 8) | data[at + 1];
+    if (length < 2 || length > size - at) return false;
+    if (marker == 0xDA) return true;  // SOS: entropy-coded data follows
+    if ((marker == 0xE1 || marker == 0xED) &&
+        std::find(data + at + 2, data + at + length, 0) == data + at + length) {
+      return false;
+    }
+    at += length;
+  }
+  return false;
+}
+
 Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
                    RgbaImage& out) {
   if (codec == TextureCodec::kPng && !pngChunksComplete(payload, size)) {
     return textureError(ErrorCode::kParseError, "PNG payload is truncated or malformed");
+  }
+  if (codec == TextureCodec::kJpeg && !jpegHeaderSafe(payload, size)) {
+    return textureError(ErrorCode::kParseError, "JPEG payload has a malformed header");
   }
   OIIO::Filesystem::IOMemReader proxy(payload, size);
   OIIO::ImageSpec config;

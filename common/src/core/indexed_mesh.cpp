@@ -101,17 +101,23 @@ BoundingSphere IndexedMesh::boundingSphere() const {
 }
 
 void IndexedMesh::computeNormals() {
-  normals.assign(positions.size(), glm::vec3(0.0f));
+  // In double: float positions near FLT_MAX overflow a float cross product
+  // to inf and the normal to NaN (a binary STL found by fuzz/mesh_file.cpp,
+  // seed fuzz/corpus/mesh/crash-stl-normal-overflow.stl); squares of float
+  // differences fit a double.
+  std::vector<glm::dvec3> sums(positions.size(), glm::dvec3(0.0));
   for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const glm::vec3& p0 = positions[indices[t]];
-    const glm::vec3& p1 = positions[indices[t + 1]];
-    const glm::vec3& p2 = positions[indices[t + 2]];
-    const glm::vec3 areaNormal = glm::cross(p1 - p0, p2 - p0);  // length = 2 * area
-    for (int k = 0; k < 3; ++k) normals[indices[t + k]] += areaNormal;
+    const glm::dvec3 p0(positions[indices[t]]);
+    const glm::dvec3 p1(positions[indices[t + 1]]);
+    const glm::dvec3 p2(positions[indices[t + 2]]);
+    const glm::dvec3 areaNormal = glm::cross(p1 - p0, p2 - p0);  // length = 2 * area
+    for (int k = 0; k < 3; ++k) sums[indices[t + k]] += areaNormal;
   }
-  for (glm::vec3& nrm : normals) {
-    const float len = glm::length(nrm);
-    nrm = len > 0.0f ? nrm / len : glm::vec3(0.0f, 0.0f, 1.0f);
+  normals.resize(positions.size());
+  for (std::size_t v = 0; v < sums.size(); ++v) {
+    const double len = glm::length(sums[v]);
+    normals[v] =
+        len > 0.0 && std::isfinite(len) ? glm::vec3(sums[v] / len) : glm::vec3(0.0f, 0.0f, 1.0f);
   }
 }
 

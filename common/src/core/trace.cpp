@@ -10,6 +10,7 @@
 #include <fstream>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/trigonometric.hpp>
 #include <optional>
 #include <system_error>
@@ -189,12 +190,19 @@ glm::mat4 viewMatrix(const Pose& pose) {
 }
 
 glm::quat lookAtOrientation(const glm::vec3& position, const glm::vec3& target) {
-  const glm::vec3 direction = glm::normalize(target - position);
-  glm::vec3 up(0.0f, 1.0f, 0.0f);
+  // The basis glm::quatLookAtRH builds, in double and normalised ourselves:
+  // glm clamps |up x direction|^2 below at 1e-5 before normalising, so for
+  // 0.999995 < |direction.y| <= 0.999999 it returned a non-unit, skewed
+  // rotation (found by fuzz/trace_stream.cpp; tests/common/trace_test.cpp).
+  const glm::dvec3 direction = glm::normalize(glm::dvec3(target) - glm::dvec3(position));
+  glm::dvec3 up(0.0, 1.0, 0.0);
   // Looking (almost) straight down or up: +Y is useless as "up".
-  if (std::fabs(direction.y) > 0.999999f)
-    up = glm::vec3(0.0f, 0.0f, direction.y < 0 ? -1.0f : 1.0f);
-  return glm::quatLookAtRH(direction, up);
+  if (std::fabs(direction.y) > 0.999999) up = glm::dvec3(0.0, 0.0, direction.y < 0 ? -1.0 : 1.0);
+  glm::dmat3 basis;
+  basis[2] = -direction;                                // camera +Z (it looks down -Z)
+  basis[0] = glm::normalize(glm::cross(up, basis[2]));  // camera +X; |cross| >= 1.4e-3 here
+  basis[1] = glm::cross(basis[2], basis[0]);            // camera +Y
+  return glm::normalize(glm::quat(glm::quat_cast(basis)));
 }
 
 void TraceStreamParser::feed(std::string_view bytes, Output& out) {

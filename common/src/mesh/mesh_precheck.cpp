@@ -63,17 +63,22 @@ Status lineError(const std::string& name, int line, const std::string& problem) 
   return Status(ErrorCode::kInvalidArgument, name + ":" + std::to_string(line) + ": " + problem);
 }
 
-// All tokens from `first` on must be finite numbers.
+// All tokens from `first` up to a comment must be finite numbers, at least
+// `minCount` of them. A comment token does not count: "v 0 # 0 0" has one
+// number, and OpenMesh skips such a vertex, so face indices checked against
+// our count went past its vertices (an out-of-bounds texcoord write;
+// found by fuzz/mesh_file.cpp, seed fuzz/corpus/mesh/crash-obj-comment-in-vertex.obj).
 Status checkFiniteNumbers(const std::vector<std::string_view>& tokens, std::size_t first,
                           std::size_t minCount, const std::string& name, int line,
                           const char* what) {
-  if (tokens.size() < first + minCount) {
+  std::size_t end = first;
+  while (end < tokens.size() && tokens[end][0] != '#') ++end;
+  if (end < first + minCount) {
     return lineError(name, line,
                      std::string(what) + " needs " + std::to_string(minCount) + " numbers, found " +
-                         std::to_string(tokens.size() > first ? tokens.size() - first : 0));
+                         std::to_string(end > first ? end - first : 0));
   }
-  for (std::size_t i = first; i < tokens.size(); ++i) {
-    if (tokens[i][0] == '#') break;
+  for (std::size_t i = first; i < end; ++i) {
     double v = 0.0;
     if (!parseNumberToken(tokens[i], &v)) {
       return lineError(name, line, std::string(what) + " has a bad number " + quoted(tokens[i]));
@@ -106,11 +111,42 @@ Status limitError(const std::string& name, const char* what, std::uint64_t count
 
 // ---------------------------------------------------------------- OBJ
 
+// "v x y z r g b": OpenMesh reads the three numbers after z as a colour
+// whenever all three are there, and converts each with 255 * value to an
+// unsigned char; outside [0, 1] that conversion is undefined behaviour
+// (OpenMesh color_cast.hh; found by fuzz/mesh_file.cpp, regression seed
+// fuzz/corpus/mesh/crash-obj-vertex-colour-11.obj). Precondition: the
+// tokens are finite numbers (checkFiniteNumbers). "vc r g b" lines (a
+// colour of their own, from token 1; seed crash-obj-vc-line.obj) are read
+// the same way.
+Status checkColourRange(const std::vector<std::string_view>& tokens, std::size_t first,
+                        const std::string& name, int line) {
+  for (std::size_t i = first; i < first + 3; ++i) {
+    double v = 0.0;
+    parseNumberToken(tokens[i], &v);
+    if (!(v >= 0.0 && v <= 1.0)) {
+      return lineError(name, line,
+                       "vertex colour component " + quoted(tokens[i]) + " is outside [0, 1]");
+    }
+  }
+  return Status();
+}
+
+Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const std::string& name,
+                            int line) {
+  std::size_t numbers = 0;
+  while (1 + numbers < tokens.size() && tokens[1 + numbers][0] != '#') ++numbers;
+  if (numbers < 6) return Status();
+  return checkColourRange(tokens, 4, name, line);
+}
+
 Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& name,
                                    const MeshLoadOptions& options) {
   LineScanner scanner(bytes);
   std::string_view line;
   std::uint64_t vertices = 0;
+  std::uint64_t normals = 0;
+  std::uint64_t texcoords = 0;
   std::uint64_t faces = 0;
   while (scanner.next(&line)) {
     const std::vector<std::string_view> tokens = tokenize(line);
@@ -119,29 +155,64 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
     const int ln = scanner.lineNumber();
     if (key == "v") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex"));
+      THINLOD_RETURN_IF_ERROR(checkObjVertexColour(tokens, name, ln));
       if (++vertices > options.maxVertices) {
         return limitError(name, "vertices", vertices, options.maxVertices);
       }
+    } else if (key == "vc") {
+      THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex colour"));
+      THINLOD_RETURN_IF_ERROR(checkColourRange(tokens, 1, name, ln));
     } else if (key == "vn") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "normal"));
+      ++normals;
     } else if (key == "vt") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 2, name, ln, "texture coordinate"));
+      ++texcoords;
     } else if (key == "f") {
       std::size_t corners = 0;
-      for (std::size_t i = 1; i < tokens.size() && tokens[i][0] != '#'; ++i) {
-        // "v", "v/t", "v//n", "v/t/n": the vertex index is before the first '/'.
-        const std::string_view ref = tokens[i].substr(0, tokens[i].find('/'));
+      for (std::size_t i = 1; i < tokens.size(); ++i) {
+        // OpenMesh's face parser knows no comments: "#4/4/1" is vertex
+        // atoi("#4") - 1 = -1, and it then wrote that vertex's normal at
+        // index -1 (found by fuzz/mesh_file.cpp, seed
+        // fuzz/corpus/mesh/crash-obj-comment-in-face.obj).
+        if (tokens[i].find('#') != std::string_view::npos) {
+          return lineError(name, ln, "comment inside a face line " + quoted(tokens[i]));
+        }
+        // "v", "v/t", "v//n", "v/t/n": vertex, texture coordinate and
+        // normal references, each 1-based or negative (counting back from
+        // the last element read so far).
+        const std::string_view token = tokens[i];
+        const std::size_t slash1 = token.find('/');
+        const std::string_view ref = token.substr(0, slash1);
         std::int64_t index = 0;
         if (!parseSigned(ref, &index)) {
           return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[i]));
         }
-        // Positive indices are 1-based, negative ones count back from the
-        // last vertex read so far.
         const std::int64_t n = static_cast<std::int64_t>(vertices);
         if (index == 0 || index > n || index < -n) {
           return lineError(name, ln,
                            "face references vertex " + std::to_string(index) + " (only " +
                                std::to_string(vertices) + " vertices so far)");
+        }
+        if (slash1 != std::string_view::npos) {
+          const std::string_view rest = token.substr(slash1 + 1);
+          const std::size_t slash2 = rest.find('/');
+          const std::string_view texRef = rest.substr(0, slash2);
+          const std::string_view normalRef =
+              slash2 == std::string_view::npos ? std::string_view() : rest.substr(slash2 + 1);
+          const auto checkRef = [&](std::string_view r, std::uint64_t count, const char* what) {
+            if (r.empty()) return Status();
+            std::int64_t k = 0;
+            const std::int64_t c = static_cast<std::int64_t>(count);
+            if (!parseSigned(r, &k) || k == 0 || k > c || k < -c) {
+              return lineError(name, ln,
+                               std::string("face references ") + what + " " + quoted(r) +
+                                   " (only " + std::to_string(count) + " so far)");
+            }
+            return Status();
+          };
+          THINLOD_RETURN_IF_ERROR(checkRef(texRef, texcoords, "texture coordinate"));
+          THINLOD_RETURN_IF_ERROR(checkRef(normalRef, normals, "normal"));
         }
         ++corners;
       }
@@ -163,16 +234,40 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
                                    const MeshLoadOptions& options) {
   LineScanner scanner(bytes);
   std::string_view line;
+  int commentLine = 0;  // set when nextContentLine stops at a comment
+  // OpenMesh 9's OFF reader takes the first line as the header and then
+  // reads counts and values with operator>>, skipping no comments: counts
+  // on the header line were ignored (it read the first coordinates as
+  // counts), and a '#' left a count unread and uninitialised, which it then
+  // reserved (an 11 GB allocation from "OFF\v0 0"; found by
+  // fuzz/mesh_file.cpp, seed fuzz/corpus/mesh/crash-off-counts-on-header.off).
+  // So the header line holds the magic alone, and no comment may follow it.
   auto nextContentLine = [&](std::vector<std::string_view>* tokens) {
     while (scanner.next(&line)) {
       *tokens = tokenize(line);
-      if (!tokens->empty() && (*tokens)[0][0] != '#') return true;
+      if (tokens->empty()) continue;
+      for (const std::string_view token : *tokens) {
+        if (token.find('#') != std::string_view::npos) {
+          commentLine = scanner.lineNumber();
+          return false;
+        }
+      }
+      return true;
     }
     return false;
   };
+  const auto stopped = [&](Status truncated) {
+    if (commentLine == 0) return truncated;
+    return lineError(name, commentLine,
+                     "comments are not supported in OFF files (OpenMesh's reader does not skip "
+                     "them)");
+  };
   std::vector<std::string_view> tokens;
   if (!nextContentLine(&tokens)) {
-    return Status(ErrorCode::kInvalidArgument, name + ": empty OFF file");
+    return stopped(Status(ErrorCode::kInvalidArgument, name + ": empty OFF file"));
+  }
+  if (scanner.lineNumber() != 1) {
+    return lineError(name, scanner.lineNumber(), "the OFF header must be the first line");
   }
   const std::string_view magic = tokens[0];
   if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") {
@@ -182,16 +277,19 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
     return Status(ErrorCode::kUnsupported,
                   name + ": OFF variant " + quoted(magic) + " (4D / nD) is not supported");
   }
-  std::size_t countStart = 1;
   if (tokens.size() > 1 && tokens[1] == "BINARY") {
     return Status(ErrorCode::kUnsupported, name + ": binary OFF is not supported");
   }
-  if (tokens.size() <= countStart) {
-    if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: no vertex/face counts");
-    }
-    countStart = 0;
+  if (tokens.size() > 1) {
+    return lineError(name, 1,
+                     "the OFF header line holds only " + quoted(magic) +
+                         "; counts go on the next line (OpenMesh ignores them here)");
   }
+  if (!nextContentLine(&tokens)) {
+    return stopped(
+        Status(ErrorCode::kInvalidArgument, name + ": truncated: no vertex/face counts"));
+  }
+  const std::size_t countStart = 0;
   std::uint64_t nv = 0;
   std::uint64_t nf = 0;
   if (tokens.size() < countStart + 2 || !parseUnsigned(tokens[countStart], &nv) ||
@@ -210,17 +308,17 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
   }
   for (std::uint64_t v = 0; v < nv; ++v) {
     if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
-                                                     std::to_string(nv) + " vertices, found " +
-                                                     std::to_string(v));
+      return stopped(Status(ErrorCode::kInvalidArgument,
+                            name + ": truncated: header declares " + std::to_string(nv) +
+                                " vertices, found " + std::to_string(v)));
     }
     THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 0, 3, name, scanner.lineNumber(), "vertex"));
   }
   for (std::uint64_t f = 0; f < nf; ++f) {
     if (!nextContentLine(&tokens)) {
-      return Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
-                                                     std::to_string(nf) + " faces, found " +
-                                                     std::to_string(f));
+      return stopped(Status(ErrorCode::kInvalidArgument, name + ": truncated: header declares " +
+                                                             std::to_string(nf) + " faces, found " +
+                                                             std::to_string(f)));
     }
     const int ln = scanner.lineNumber();
     std::uint64_t k = 0;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <string>
 #include <unordered_map>
 
 #include "thinlod/common/scene.h"
@@ -113,7 +114,19 @@ Status rescaledChildren(const Node& node, double diameter, CurveContext& ctx,
     if (c->curve.empty() || !(c->diameter > 0.0)) continue;
     const double stretch = maxScale(child.localTransform());
     if (!(stretch > 0.0) || !std::isfinite(stretch)) continue;  // collapsed: draws nothing
-    curves->push_back(c->curve.scaledAccuracy(diameter / (stretch * c->diameter)));
+    // Float bounds overflow (scale 1e32 on a child, found by
+    // fuzz/scene_file.cpp, seed fuzz/corpus/scene/crash-scale-overflow.wrl):
+    // the factor is then inf, 0 or NaN, which scaledAccuracy's contract forbids.
+    const double factor = diameter / (stretch * c->diameter);
+    if (!(factor > 0.0) || !std::isfinite(factor)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    std::string("relativeCurve: ") + nodeKindName(node.kind) + " node " +
+                        std::to_string(node.id) + ": child " + std::to_string(child.id) +
+                        " is scaled beyond what its bounds can represent (diameter " +
+                        std::to_string(diameter) + ", child diameter " +
+                        std::to_string(c->diameter) + ", scale " + std::to_string(stretch) + ")");
+    }
+    curves->push_back(c->curve.scaledAccuracy(factor));
     childIndex->push_back(static_cast<int>(i));
   }
   return Status();

@@ -36,6 +36,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "thinlod/protocol/transport.h"
 
@@ -56,6 +57,12 @@ class DaemonRuntime {
   void addOption(const std::string& key, bool* target, const std::string& help);
   // transport.heartbeat_ms, transport.liveness_misses, transport.send_hwm.
   void addTransportOptions(TransportOptions* target);
+
+  // The --config step of parse() on TOML text already in memory (parse()
+  // reads the file and calls this): same keys, types and file:line:column
+  // errors, `sourceName` in place of the path. Flags given to an earlier
+  // parse() still win. For tests and the config fuzzer (fuzz/).
+  Status applyConfig(std::string_view toml, const std::string& sourceName);
 
   // nullopt: run. Otherwise the process exit code (0 after --help).
   // Also installs the signal handlers.

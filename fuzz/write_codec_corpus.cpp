@@ -1,0 +1,124 @@
+// Writes the seed corpora of the codec fuzzers: valid link frames
+// (encoding.h) covering each Draco encoding method (speeds 0, 5, 10 select
+// edgebreaker-valence, edgebreaker and sequential coding), each attribute
+// combination, and each texture codec. Run after a frame format change and
+// commit the result as a reviewed change:
+//   build/fuzz/thinlod_fuzz_write_codec_corpus fuzz/corpus
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/codec/encoding.h"
+
+namespace {
+
+using thinlod::IndexedMesh;
+using thinlod::RgbaImage;
+namespace codec = thinlod::codec;
+
+// An n x n grid of quads on a slightly bumped sheet, with the attributes asked for.
+IndexedMesh grid(int n, bool normals, bool uvs, bool colors) {
+  IndexedMesh mesh;
+  for (int y = 0; y <= n; ++y) {
+    for (int x = 0; x <= n; ++x) {
+      const float u = static_cast<float>(x) / n, v = static_cast<float>(y) / n;
+      mesh.positions.emplace_back(u, v, 0.1f * ((x * 7 + y * 3) % 5));
+      if (uvs) mesh.uvs.emplace_back(u, v);
+      if (colors) {
+        mesh.colors.push_back(
+            {static_cast<std::uint8_t>(x * 40), static_cast<std::uint8_t>(y * 40), 128, 255});
+      }
+    }
+  }
+  const auto at = [n](int x, int y) { return static_cast<std::uint32_t>(y * (n + 1) + x); };
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      mesh.indices.insert(mesh.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1)});
+      mesh.indices.insert(mesh.indices.end(), {at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    }
+  }
+  if (normals) mesh.computeNormals();
+  return mesh;
+}
+
+RgbaImage image(int width, int height, bool opaque) {
+  RgbaImage t(width, height);
+  for (std::size_t i = 0; i < t.pixels.size(); ++i) {
+    t.pixels[i] = static_cast<std::uint8_t>(i % 4 == 3 ? (opaque ? 255 : i * 5) : (i * 7) % 251);
+  }
+  return t;
+}
+
+bool write(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+  std::printf("%s (%zu bytes)\n", path.c_str(), bytes.size());
+  return static_cast<bool>(out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s CORPUS_DIR (writes CORPUS_DIR/codec_mesh, codec_texture)\n",
+                 argv[0]);
+    return 2;
+  }
+  const std::filesystem::path root = argv[1];
+  std::filesystem::create_directories(root / "codec_mesh");
+  std::filesystem::create_directories(root / "codec_texture");
+  bool ok = true;
+  struct MeshSeed {
+    const char* name;
+    bool normals, uvs, colors;
+    int speed, bits;
+  };
+  const MeshSeed meshes[] = {
+      {"positions_speed0", false, false, false, 0, 11},
+      {"positions_speed5", false, false, false, 5, 14},
+      {"positions_speed10", false, false, false, 10, 20},
+      {"normals_speed5", true, false, false, 5, 8},
+      {"uvs_speed10", false, true, false, 10, 12},
+      {"colors_speed0", false, false, true, 0, 14},
+      {"all_speed5", true, true, true, 5, 14},
+      {"all_speed10", true, true, true, 10, 14},
+  };
+  for (const MeshSeed& seed : meshes) {
+    codec::MeshEncodeOptions options;
+    options.encodeSpeed = options.decodeSpeed = seed.speed;
+    options.positionBits = seed.bits;
+    const auto frame = codec::encodeMesh(grid(4, seed.normals, seed.uvs, seed.colors), options);
+    if (!frame.ok()) {
+      std::fprintf(stderr, "%s: %s\n", seed.name, frame.status().toString().c_str());
+      return 1;
+    }
+    ok &= write(root / "codec_mesh" / (std::string(seed.name) + ".bin"), *frame);
+  }
+  struct TextureSeed {
+    const char* name;
+    codec::TextureCodec codec;
+    int width, height;
+    bool opaque;
+  };
+  const TextureSeed textures[] = {
+      {"zstd_8x8", codec::TextureCodec::kZstd, 8, 8, false},
+      {"zstd_17x3", codec::TextureCodec::kZstd, 17, 3, true},
+      {"png_8x8", codec::TextureCodec::kPng, 8, 8, false},
+      {"png_5x9_opaque", codec::TextureCodec::kPng, 5, 9, true},
+      {"jpeg_8x8", codec::TextureCodec::kJpeg, 8, 8, true},
+      {"jpeg_16x24", codec::TextureCodec::kJpeg, 16, 24, true},
+  };
+  for (const TextureSeed& seed : textures) {
+    const auto frame =
+        codec::encodeTextureWith(image(seed.width, seed.height, seed.opaque), seed.codec);
+    if (!frame.ok()) {
+      std::fprintf(stderr, "%s: %s\n", seed.name, frame.status().toString().c_str());
+      return 1;
+    }
+    ok &= write(root / "codec_texture" / (std::string(seed.name) + ".bin"), *frame);
+  }
+  return ok ? 0 : 1;
+}
