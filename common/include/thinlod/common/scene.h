@@ -211,9 +211,9 @@ struct Scene {
   std::uint64_t fingerprint = 0;
 };
 
-// FNV-1a 64 of the scene text, then of every loaded mesh geometry
-// (positions, indices, normals, uvs, colours) in the order Shapes first name
-// them. Independent of where the files were found.
+// FNV-1a 64 of the scene text, then of every loaded mesh's positions and
+// triangle indices in the order Shapes first name them. Independent of where
+// the files were found.
 std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene);
 
 // Bounds of what the node draws, in its content frame; empty for lights,
