@@ -13,7 +13,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   thinlod::scene::ParseLimits limits;

@@ -22,7 +22,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/trace.h"
 
 namespace {
 

@@ -17,8 +17,8 @@
 #include <random>
 #include <vector>
 
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/conic_range.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/conic_range.h"
 
 namespace thinlod {
 namespace {

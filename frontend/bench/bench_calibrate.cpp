@@ -32,8 +32,8 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/frame_cost.h"
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/core/frame_cost.h"
+#include "thinlod/common/mesh/primitives.h"
 #include "thinlod/frontend/frontend_renderer.h"
 
 using namespace thinlod;

@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "raw_gl_baseline.h"
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/render_target.h"

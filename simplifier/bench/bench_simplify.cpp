@@ -11,7 +11,7 @@
 // and a markdown table to --out; progress goes to stderr.
 // OpenMesh's VectorT leaves default-constructed data uninitialised on purpose;
 // GCC then warns (-Wmaybe-uninitialized) inside OpenMesh: silenced for it only,
-// as in common/include/thinlod/common/tri_mesh.h.
+// as in common/include/thinlod/common/mesh/tri_mesh.h.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -39,7 +39,7 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/surface_error.h"
 

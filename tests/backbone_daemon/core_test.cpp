@@ -11,7 +11,7 @@
 #include "backbone_core.h"
 #include "fake_simplifier.h"
 #include "scene_conversion.h"
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/protocol/codec.h"
 
 namespace thinlod::backbone_daemon {

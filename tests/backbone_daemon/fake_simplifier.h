@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "backbone_core.h"
-#include "thinlod/common/primitives.h"
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/mesh/primitives.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::backbone_daemon::testing {
 

@@ -9,7 +9,7 @@
 #include <limits>
 #include <random>
 
-#include "thinlod/common/frame_cost.h"
+#include "thinlod/common/core/frame_cost.h"
 
 namespace thinlod::backbone {
 namespace {

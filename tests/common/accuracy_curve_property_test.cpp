@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "curve_test_util.h"
-#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/core/accuracy_curve.h"
 
 namespace thinlod {
 namespace {

@@ -1,6 +1,6 @@
 // Hand-checked cases for every AccuracyCurve operation, including the
 // situations of Pasman & Jansen 2002, Figures 5-7.
-#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/core/accuracy_curve.h"
 
 #include <gtest/gtest.h>
 

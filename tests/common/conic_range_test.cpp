@@ -1,6 +1,6 @@
 // Conic ranges: validation, hand-checked containment, random balls against
 // point sampling, and intersections checked to be subsets of both ranges.
-#include "thinlod/common/conic_range.h"
+#include "thinlod/common/core/conic_range.h"
 
 #include <gtest/gtest.h>
 

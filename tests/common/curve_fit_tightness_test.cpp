@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "curve_test_util.h"
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod {
 namespace {

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/core/accuracy_curve.h"
 
 namespace thinlod::testing {
 

@@ -1,4 +1,4 @@
-#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/core/indexed_mesh.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Flight-path traces: parsing both pose forms, every error with its line
 // number, bit-exact write/parse round trips, sampling and the view matrix.
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/trace.h"
 
 #include <gtest/gtest.h>
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/rgba_image.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/rgba_image.h"
 #include "thinlod/protocol/messages.h"
 
 namespace thinlod::frontend::daemon::testing {

@@ -15,7 +15,7 @@
 #include <string>
 #include <utility>
 
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/impostor_level.h"

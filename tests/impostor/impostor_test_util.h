@@ -4,7 +4,7 @@
 #include <cmath>
 #include <memory>
 
-#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/core/indexed_mesh.h"
 
 namespace thinlod::simplifier::testing {
 

@@ -1,4 +1,4 @@
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -4,8 +4,8 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "thinlod/common/scene.h"
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
 namespace {

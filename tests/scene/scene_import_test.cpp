@@ -1,7 +1,7 @@
 // importScene() and loadSceneFile()'s dispatch to it: the Debian package
 // assimp-testmodels (installed by deploy/setup) plus hand-written files in
 // tests/data/import/. A missing package file FAILS the test, naming the package.
-#include "thinlod/common/scene_import.h"
+#include "thinlod/common/scene/scene_import.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
 namespace {

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <string>
 
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
 namespace {

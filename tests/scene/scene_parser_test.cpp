@@ -1,4 +1,4 @@
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <random>
 
 #include "test_meshes.h"  // tests/simplifier_error: shared test meshes
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 
 namespace thinlod::qemtest {
 

@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::qemtest {
 

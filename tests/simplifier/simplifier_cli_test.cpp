@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 
 namespace {
 

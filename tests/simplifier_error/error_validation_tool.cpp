@@ -8,7 +8,7 @@
 // THINLOD_ERROR_SAMPLES overrides the samples per mesh (default 100000).
 // OpenMesh's VectorT leaves default-constructed data uninitialised on purpose;
 // GCC then warns (-Wmaybe-uninitialized) inside OpenMesh: silenced for it only,
-// as in common/include/thinlod/common/tri_mesh.h.
+// as in common/include/thinlod/common/mesh/tri_mesh.h.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/IO/MeshIO.hh>

@@ -7,8 +7,8 @@
 #include <cstddef>
 #include <string>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::testing {
 

@@ -6,7 +6,7 @@
 
 #include "service_test_util.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/conic_range.h"
+#include "thinlod/common/core/conic_range.h"
 #include "thinlod/simplifier/impostor_level.h"
 #include "thinlod/simplifier/service.h"
 

@@ -8,8 +8,8 @@
 
 #include "service_test_util.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/mesh_io.h"
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/mesh/mesh_io.h"
+#include "thinlod/common/mesh/primitives.h"
 #include "thinlod/simplifier/service.h"
 
 namespace thinlod::simplifier {

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/protocol/messages.h"
 #include "thinlod/simplifier/service.h"
 

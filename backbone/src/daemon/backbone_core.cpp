@@ -7,7 +7,7 @@
 #include <limits>
 #include <utility>
 
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::backbone_daemon {
 namespace {

@@ -16,7 +16,7 @@
 #include <utility>
 
 #include "backbone_core.h"
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/protocol/daemon_runtime.h"
 #include "thinlod/protocol/transport.h"
 

@@ -42,7 +42,7 @@
 #include <limits>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

@@ -31,7 +31,7 @@
 #include <optional>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

@@ -27,7 +27,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "thinlod/common/frame_cost.h"
+#include "thinlod/common/core/frame_cost.h"
 
 namespace thinlod::backbone {
 

@@ -28,7 +28,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "thinlod/common/hash.h"
+#include "thinlod/common/core/hash.h"
 
 namespace thinlod::codec {
 

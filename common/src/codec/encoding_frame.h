@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/codec/encoding.h"
 
 namespace thinlod::codec::detail {

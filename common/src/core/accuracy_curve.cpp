@@ -20,7 +20,7 @@
 //   not an area: measured curves span decades (r ~ K a), and an area on a
 //   linear accuracy axis ignores the cheap end, where a 10x overestimate of
 //   a coarse level's cost makes the scheduler skip it.
-#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/core/accuracy_curve.h"
 
 #include <algorithm>
 #include <cassert>

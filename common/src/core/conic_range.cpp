@@ -1,7 +1,7 @@
 // Conic ranges: containment tests with a rounding margin, and intersection
 // that is exact where a conic range can express it and otherwise falls back
 // to a verified ball inside both (Pasman & Jansen 2002, section 3.5).
-#include "thinlod/common/conic_range.h"
+#include "thinlod/common/core/conic_range.h"
 
 #include <algorithm>
 #include <cassert>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 
 namespace thinlod {
 namespace {

@@ -1,4 +1,4 @@
-#include "thinlod/common/frame_cost.h"
+#include "thinlod/common/core/frame_cost.h"
 
 #include <algorithm>
 #include <array>

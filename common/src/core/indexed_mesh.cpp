@@ -1,10 +1,10 @@
-#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/core/indexed_mesh.h"
 
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 
 namespace thinlod {
 

@@ -1,4 +1,4 @@
-#include "thinlod/common/representation_kind.h"
+#include "thinlod/common/core/representation_kind.h"
 
 namespace thinlod {
 

@@ -1,4 +1,4 @@
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod {
 

@@ -1,4 +1,4 @@
-#include "thinlod/common/texture_codec.h"
+#include "thinlod/common/core/texture_codec.h"
 
 namespace thinlod {
 

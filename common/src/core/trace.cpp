@@ -1,5 +1,5 @@
 // Flight-path traces: a pure line parser and writer, plus thin file I/O.
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/trace.h"
 
 #include <algorithm>
 #include <cassert>

@@ -4,7 +4,7 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // see tri_mesh.h
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #pragma GCC diagnostic pop
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 // clang-format on
 
 #include <algorithm>
@@ -20,7 +20,7 @@
 #include <sstream>
 
 #include "mesh/mesh_precheck.h"
-#include "thinlod/common/tri_mesh.h"
+#include "thinlod/common/mesh/tri_mesh.h"
 
 namespace thinlod {
 namespace {

@@ -1,4 +1,4 @@
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/mesh/primitives.h"
 
 #include <algorithm>
 #include <cassert>

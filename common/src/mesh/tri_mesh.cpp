@@ -1,4 +1,4 @@
-#include "thinlod/common/tri_mesh.h"
+#include "thinlod/common/mesh/tri_mesh.h"
 
 #include <cassert>
 #include <vector>

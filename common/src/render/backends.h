@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

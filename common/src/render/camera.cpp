@@ -6,7 +6,7 @@
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
 
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 
 namespace thinlod::render {
 namespace {

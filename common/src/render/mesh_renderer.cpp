@@ -12,7 +12,7 @@
 
 #include "render/gl_functions.h"
 #include "render/shaders.h"
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 
 namespace thinlod::render {
 namespace {

@@ -20,7 +20,7 @@
 #include <optional>
 #include <set>
 
-#include "thinlod/common/scene_import.h"
+#include "thinlod/common/scene/scene_import.h"
 
 namespace thinlod::scene {
 namespace {

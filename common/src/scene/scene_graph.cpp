@@ -7,7 +7,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "thinlod/common/scene.h"
+#include "thinlod/common/scene/scene.h"
 
 namespace thinlod::scene {
 namespace {

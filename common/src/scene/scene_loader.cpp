@@ -4,8 +4,8 @@
 #include <fstream>
 #include <map>
 
-#include "thinlod/common/hash.h"
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/core/hash.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
 namespace {

@@ -1,8 +1,8 @@
-#include "thinlod/common/scene_objects.h"
+#include "thinlod/common/scene/scene_objects.h"
 
 #include <glm/geometric.hpp>
 
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::scene {
 namespace {

@@ -1,6 +1,6 @@
 // Recursive-descent parser for the VRML97 subset of docs/scene-format.md.
 // Pure: text in, Scene out. Errors carry "<source>:<line>:<column>".
-#include "thinlod/common/scene_parser.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 #include <charconv>
 #include <cmath>

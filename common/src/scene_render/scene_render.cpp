@@ -1,4 +1,4 @@
-#include "thinlod/common/scene_render.h"
+#include "thinlod/common/scene_render/scene_render.h"
 
 #include <algorithm>
 

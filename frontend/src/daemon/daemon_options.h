@@ -6,7 +6,7 @@
 #include <string>
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/protocol/daemon_runtime.h"
 #include "thinlod/protocol/transport.h"
 

@@ -21,7 +21,7 @@
 #include "pose_source.h"
 #include "replay_loop.h"
 #include "scene_setup.h"
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/trace.h"
 #include "thinlod/protocol/daemon_runtime.h"
 
 namespace thinlod::frontend::daemon {

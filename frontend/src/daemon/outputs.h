@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "replay_loop.h"
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/frontend/frame_record.h"
 
 namespace thinlod::frontend::daemon {

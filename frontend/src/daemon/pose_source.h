@@ -36,8 +36,8 @@
 #include <optional>
 #include <string>
 
-#include "thinlod/common/status.h"
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/trace.h"
 
 namespace thinlod::frontend::daemon {
 

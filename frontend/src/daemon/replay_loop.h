@@ -57,8 +57,8 @@
 #include <vector>
 
 #include "pose_source.h"
-#include "thinlod/common/status.h"
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/trace.h"
 #include "thinlod/frontend/frame_record.h"
 #include "thinlod/frontend/frontend_scene.h"
 #include "thinlod/protocol/messages.h"

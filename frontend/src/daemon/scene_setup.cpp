@@ -2,8 +2,8 @@
 
 #include <utility>
 
-#include "thinlod/common/scene_parser.h"
-#include "thinlod/common/scene_render.h"
+#include "thinlod/common/scene/scene_parser.h"
+#include "thinlod/common/scene_render/scene_render.h"
 
 namespace thinlod::frontend::daemon {
 

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "thinlod/common/render/camera.h"
-#include "thinlod/common/scene.h"
-#include "thinlod/common/scene_objects.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/scene/scene.h"
+#include "thinlod/common/scene/scene_objects.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/frontend/reference_renderer.h"
 #include "thinlod/frontend/shown_frames.h"
 #include "wire_conversion.h"

@@ -28,7 +28,7 @@
 #include <map>
 
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/frontend/frontend_scene.h"
 #include "thinlod/protocol/messages.h"
 

@@ -10,7 +10,7 @@
 
 #include "renderer_checks.h"
 #include "texture_fit.h"
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/render_target.h"
 

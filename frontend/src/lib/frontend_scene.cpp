@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "renderer_checks.h"
-#include "thinlod/common/finite.h"
+#include "thinlod/common/core/finite.h"
 
 namespace thinlod::frontend {
 namespace {

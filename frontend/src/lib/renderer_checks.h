@@ -3,7 +3,7 @@
 #pragma once
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend::detail {
 

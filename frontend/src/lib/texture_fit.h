@@ -4,7 +4,7 @@
 
 #include <glm/vec2.hpp>
 
-#include "thinlod/common/rgba_image.h"
+#include "thinlod/common/core/rgba_image.h"
 
 namespace thinlod::frontend::detail {
 

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::protocol::detail {
 

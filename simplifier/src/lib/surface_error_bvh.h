@@ -12,7 +12,7 @@
 #include <limits>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/core/indexed_mesh.h"
 
 namespace thinlod::simplifier::detail {
 

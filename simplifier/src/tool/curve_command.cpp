@@ -12,7 +12,7 @@
 #include <string>
 
 #include "commands.h"
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/mesh_curve.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "tool_output.h"

@@ -15,7 +15,7 @@
 
 #include "commands.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/simplifier/impostor.h"
 #include "tool_output.h"

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "commands.h"
-#include "thinlod/common/mesh_io.h"
+#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "tool_output.h"
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::simplifier::tool {
 

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "thinlod/backbone/scheduling_scene.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "thinlod/backbone/validity_range.h"
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

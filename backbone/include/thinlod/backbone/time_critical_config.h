@@ -6,8 +6,8 @@
 #include <optional>
 #include <vector>
 
-#include "thinlod/common/frame_cost.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/frame_cost.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone {
 

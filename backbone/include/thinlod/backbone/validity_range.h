@@ -13,7 +13,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "thinlod/common/conic_range.h"
+#include "thinlod/common/core/conic_range.h"
 
 namespace thinlod::backbone {
 

@@ -22,8 +22,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend {
 

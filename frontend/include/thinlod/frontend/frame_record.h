@@ -30,7 +30,7 @@
 #include <utility>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend {
 

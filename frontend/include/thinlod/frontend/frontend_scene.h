@@ -31,10 +31,10 @@
 #include <memory>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/representation_kind.h"
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/representation_kind.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend {
 

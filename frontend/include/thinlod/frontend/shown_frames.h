@@ -34,9 +34,9 @@
 #include <memory>
 #include <vector>
 
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/trace.h"
 
 namespace thinlod::frontend {
 

@@ -15,8 +15,8 @@
 #include <glm/vec3.hpp>
 
 #include "thinlod/common/render/camera.h"
-#include "thinlod/common/status.h"
-#include "thinlod/common/trace.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/trace.h"
 
 namespace thinlod::frontend {
 

@@ -22,7 +22,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/protocol/messages.h"
 
 namespace thinlod::protocol {

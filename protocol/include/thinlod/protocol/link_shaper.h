@@ -21,7 +21,7 @@
 #include <optional>
 #include <utility>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::protocol {
 

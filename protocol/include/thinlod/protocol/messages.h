@@ -24,10 +24,10 @@
 #include <variant>
 #include <vector>
 
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/representation_kind.h"
-#include "thinlod/common/status.h"
-#include "thinlod/common/texture_codec.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/representation_kind.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/texture_codec.h"
 
 namespace thinlod::protocol {
 

@@ -27,7 +27,7 @@
 #include <optional>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::protocol {
 

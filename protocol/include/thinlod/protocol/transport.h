@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/protocol/messages.h"
 #include "thinlod/protocol/pending_requests.h"
 

@@ -41,8 +41,8 @@
 #include <optional>
 #include <vector>
 
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/mesh_curve.h"
 

@@ -33,10 +33,10 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/accuracy_curve.h"
+#include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/surface_error.h"
 

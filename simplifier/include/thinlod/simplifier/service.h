@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/protocol/messages.h"
 #include "thinlod/simplifier/mesh_curve.h"
 

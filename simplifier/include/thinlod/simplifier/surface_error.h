@@ -25,8 +25,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::simplifier {
 

@@ -32,10 +32,10 @@
 #include <limits>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
-#include "thinlod/common/texture_codec.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/core/texture_codec.h"
 
 namespace thinlod::codec {
 

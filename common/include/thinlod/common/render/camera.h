@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

@@ -25,7 +25,7 @@
 #include <memory>
 #include <string>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

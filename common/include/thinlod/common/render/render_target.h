@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/rgba_image.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

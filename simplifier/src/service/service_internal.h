@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/primitives.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/render/camera.h"
-#include "thinlod/common/scene.h"
-#include "thinlod/common/scene_objects.h"
+#include "thinlod/common/scene/scene.h"
+#include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/mesh_curve.h"
 #include "thinlod/simplifier/progressive_mesh.h"

@@ -13,8 +13,8 @@
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/scene_parser.h"
-#include "thinlod/common/scene_render.h"
+#include "thinlod/common/scene/scene_parser.h"
+#include "thinlod/common/scene_render/scene_render.h"
 #include "thinlod/protocol/codec.h"
 
 namespace thinlod::simplifier {

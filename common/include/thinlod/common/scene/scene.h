@@ -32,11 +32,11 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/conic_range.h"
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/primitives.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/conic_range.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/mesh/primitives.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::scene {
 

@@ -30,9 +30,9 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 
-#include "thinlod/common/accuracy_curve.h"
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod {
 

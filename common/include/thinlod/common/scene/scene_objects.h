@@ -22,9 +22,9 @@
 #include <memory>
 #include <vector>
 
-#include "thinlod/common/indexed_mesh.h"
-#include "thinlod/common/scene.h"
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/scene/scene.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::scene {
 

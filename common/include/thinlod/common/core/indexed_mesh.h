@@ -18,7 +18,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod {
 

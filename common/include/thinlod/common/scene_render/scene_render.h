@@ -19,7 +19,7 @@
 
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
-#include "thinlod/common/scene.h"
+#include "thinlod/common/scene/scene.h"
 
 namespace thinlod::scene {
 

@@ -11,7 +11,7 @@
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/scene_render.h"
+#include "thinlod/common/scene_render/scene_render.h"
 #include "thinlod/simplifier/impostor_level.h"
 
 namespace thinlod::simplifier {

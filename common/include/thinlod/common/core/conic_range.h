@@ -30,7 +30,7 @@
 #include <glm/vec3.hpp>
 #include <limits>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod {
 

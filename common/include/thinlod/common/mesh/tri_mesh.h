@@ -25,7 +25,7 @@
 #pragma GCC diagnostic pop
 #include <cstddef>
 
-#include "thinlod/common/indexed_mesh.h"
+#include "thinlod/common/core/indexed_mesh.h"
 
 namespace thinlod {
 

@@ -37,7 +37,7 @@
 #include <string_view>
 #include <vector>
 
-#include "thinlod/common/status.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod {
 
