@@ -12,9 +12,9 @@
 #include <string>
 
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/core/rgba_image.h"
 #include "thinlod/frontend/frontend_scene.h"
 
 namespace thinlod::frontend::testing {

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "daemon_test_util.h"
+#include "thinlod/common/core/trace.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
-#include "thinlod/common/core/trace.h"
 #include "thinlod/protocol/transport.h"
 
 namespace thinlod::frontend::daemon {

@@ -11,11 +11,11 @@
 #include <string>
 
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
-#include "thinlod/common/core/rgba_image.h"
 
 namespace thinlod::render::testing {
 

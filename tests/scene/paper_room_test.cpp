@@ -7,8 +7,8 @@
 #include <glm/geometric.hpp>
 #include <string>
 
-#include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/core/trace.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
 namespace {

@@ -181,8 +181,8 @@ Status BackboneCore::initialize() {
     }
 
     // Impostors: usable from `radii` bounding radii on, every direction.
-    auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind,
-                           double radii, double triangles) -> Status {
+    auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind, double radii,
+                           double triangles) -> Status {
       if (!(radii > 0.0)) return Status();
       Result<ConicRange> validity = ConicRange::make(
           record.bounds.center, radii * record.bounds.radius, kInf, {0.0, 0.0, 1.0}, kPi);
@@ -202,9 +202,9 @@ Status BackboneCore::initialize() {
       rebuildCurves(static_cast<std::uint32_t>(scene_.options.size() - 1));
       return Status();
     };
-    THINLOD_RETURN_IF_ERROR(addImpostor(
-        OptionKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
-        options_.meshedImpostorRadii, options_.meshedImpostorTriangles));
+    THINLOD_RETURN_IF_ERROR(
+        addImpostor(OptionKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
+                    options_.meshedImpostorRadii, options_.meshedImpostorTriangles));
     THINLOD_RETURN_IF_ERROR(addImpostor(OptionKind::kSimpleImpostor,
                                         protocol::RepresentationKind::kSimpleImpostor,
                                         options_.simpleImpostorRadii, 2.0));

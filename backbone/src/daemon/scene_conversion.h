@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "thinlod/backbone/scheduling_scene.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_objects.h"
-#include "thinlod/common/core/status.h"
 
 namespace thinlod::backbone_daemon {
 

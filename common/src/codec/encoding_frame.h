@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "thinlod/common/core/status.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/status.h"
 
 namespace thinlod::codec::detail {
 

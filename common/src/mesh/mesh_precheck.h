@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/mesh/mesh_io.h"
 
 namespace thinlod::mesh_detail {
 

@@ -3,8 +3,8 @@
 
 #include <memory>
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 
 namespace thinlod::render {
 

@@ -8,8 +8,8 @@
 
 #include <string>
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 
 // X(name, PFN type) for every GL function thinlod_render calls.
 #define THINLOD_GL_FUNCTIONS(X)                                  \

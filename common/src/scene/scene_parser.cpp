@@ -1183,7 +1183,8 @@ class Parser {
     for (const NodePtr& root : scene_.roots) {
       total = std::min(cap, total + count(*root));
       if (total > limits_.maxInstances) {
-        return fail(ErrorCode::kResourceExhausted, root->sourceLocation.line, root->sourceLocation.column,
+        return fail(ErrorCode::kResourceExhausted, root->sourceLocation.line,
+                    root->sourceLocation.column,
                     "the scene expands (DEF/USE) to more than " +
                         std::to_string(limits_.maxInstances) + " node instances");
       }

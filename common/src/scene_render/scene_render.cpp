@@ -1,7 +1,6 @@
 #include "thinlod/common/scene_render/scene_render.h"
 
 #include <algorithm>
-
 #include <glm/geometric.hpp>
 
 namespace thinlod::scene {

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/protocol/daemon_runtime.h"
 #include "thinlod/protocol/transport.h"
 

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_objects.h"
-#include "thinlod/common/core/status.h"
 #include "thinlod/frontend/reference_renderer.h"
 #include "thinlod/frontend/shown_frames.h"
 #include "wire_conversion.h"

@@ -66,7 +66,6 @@ Status validateRepresentation(const Representation& rep, const std::string& what
 
 }  // namespace
 
-
 std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture) {
   std::size_t bytes = mesh.vertexCount() * kGpuVertexBytes + mesh.indices.size() * kGpuIndexBytes;
   if (texture != nullptr) bytes += texture->pixels.size();

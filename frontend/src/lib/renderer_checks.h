@@ -2,8 +2,8 @@
 // FrontendScene. Pure except for querying the (caller-owned) GL context.
 #pragma once
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 
 namespace thinlod::frontend::detail {
 

@@ -37,11 +37,11 @@
 #include <memory>
 #include <string>
 
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
-#include "thinlod/common/core/rgba_image.h"
-#include "thinlod/common/core/status.h"
 #include "thinlod/frontend/frontend_scene.h"
 
 namespace thinlod::frontend {

@@ -14,9 +14,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
-#include "thinlod/common/render/camera.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/core/trace.h"
+#include "thinlod/common/render/camera.h"
 
 namespace thinlod::frontend {
 

@@ -33,8 +33,8 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/simplifier/progressive_mesh.h"

@@ -32,8 +32,8 @@
 #include <string>
 #include <vector>
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/protocol/messages.h"
 #include "thinlod/simplifier/mesh_curve.h"
 

@@ -12,11 +12,10 @@
 
 #include <array>
 #include <cstdint>
-#include <string>
-#include <vector>
-
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <string>
+#include <vector>
 
 #include "thinlod/common/core/status.h"
 
@@ -39,10 +38,10 @@ struct BoundingSphere {
 
 struct IndexedMesh {
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;           // optional, per vertex
-  std::vector<glm::vec2> uvs;               // optional, per vertex
+  std::vector<glm::vec3> normals;                   // optional, per vertex
+  std::vector<glm::vec2> uvs;                       // optional, per vertex
   std::vector<std::array<std::uint8_t, 4>> colors;  // optional, per vertex
-  std::vector<std::uint32_t> indices;       // 3 per triangle
+  std::vector<std::uint32_t> indices;               // 3 per triangle
 
   std::size_t vertexCount() const { return positions.size(); }
   std::size_t triangleCount() const { return indices.size() / 3; }

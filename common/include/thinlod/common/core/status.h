@@ -53,7 +53,7 @@ class [[nodiscard]] Status {
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : storage_(std::move(value)) {}  // NOLINT: implicit by design
+  Result(T value) : storage_(std::move(value)) {}         // NOLINT: implicit by design
   Result(Status status) : storage_(std::move(status)) {}  // NOLINT: must be an error
 
   bool ok() const { return std::holds_alternative<T>(storage_); }
@@ -76,8 +76,8 @@ class [[nodiscard]] Result {
 }  // namespace thinlod
 
 // Propagate a non-OK Status from an expression returning Status.
-#define THINLOD_RETURN_IF_ERROR(expr)           \
-  do {                                          \
-    ::thinlod::Status thinlod_status_ = (expr); \
+#define THINLOD_RETURN_IF_ERROR(expr)                  \
+  do {                                                 \
+    ::thinlod::Status thinlod_status_ = (expr);        \
     if (!thinlod_status_.ok()) return thinlod_status_; \
   } while (0)

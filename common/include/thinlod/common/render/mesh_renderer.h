@@ -34,11 +34,11 @@
 #include <vector>
 
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
-#include "thinlod/common/core/rgba_image.h"
-#include "thinlod/common/core/status.h"
 
 namespace thinlod::render {
 

@@ -26,9 +26,9 @@
 #include <memory>
 #include <vector>
 
-#include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/render/offscreen_context.h"
 
 namespace thinlod::render {
 

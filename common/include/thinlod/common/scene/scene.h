@@ -35,8 +35,8 @@
 #include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/core/conic_range.h"
 #include "thinlod/common/core/indexed_mesh.h"
-#include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::scene {
 

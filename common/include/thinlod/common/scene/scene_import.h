@@ -38,9 +38,9 @@
 #include <cstdint>
 #include <string>
 
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/scene/scene.h"
-#include "thinlod/common/core/status.h"
 
 namespace thinlod::scene {
 

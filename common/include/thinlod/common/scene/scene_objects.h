@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "thinlod/common/core/indexed_mesh.h"
-#include "thinlod/common/scene/scene.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/scene/scene.h"
 
 namespace thinlod::scene {
 

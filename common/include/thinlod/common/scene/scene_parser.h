@@ -22,10 +22,10 @@
 #include <string_view>
 #include <vector>
 
+#include "thinlod/common/core/status.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_import.h"
-#include "thinlod/common/core/status.h"
 
 namespace thinlod::scene {
 
