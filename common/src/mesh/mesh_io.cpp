@@ -8,6 +8,7 @@
 // clang-format on
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <exception>
@@ -15,6 +16,8 @@
 #include <fstream>
 #include <glm/geometric.hpp>
 #include <iostream>
+#include <limits>
+#include <map>
 #include <mutex>
 #include <new>
 #include <sstream>
@@ -128,6 +131,55 @@ std::string joined(const std::vector<std::string>& lines) {
   return out;
 }
 
+// OpenMesh's importer gives a face it cannot add manifoldly fresh copies of
+// its vertices (flagged fixed_nonmanifold) and copies only their positions:
+// the copies' normals, colours and texture coordinates are left as
+// uninitialised memory (valgrind, loading suzanne.obj), which made two loads
+// of one scene differ. Which file vertex was copied is not recorded, so each
+// copy takes the attributes of the original at the same position; where
+// several originals share it (a seam with split normals), the one whose
+// normal is closest to the copy's face normals. A copy without an original
+// gets a zero normal (so every normal is recomputed), white and (0, 0).
+void copyAttributesToNonManifoldCopies(TriMesh& tm, const TriMeshAttributes& present) {
+  if (!present.normals && !present.colors && !present.uvs) return;
+  bool anyCopy = false;
+  for (const auto vh : tm.vertices()) anyCopy = anyCopy || tm.status(vh).fixed_nonmanifold();
+  if (!anyCopy) return;
+  std::multimap<std::array<float, 3>, TriMesh::VertexHandle> originalsAt;
+  for (const auto vh : tm.vertices()) {
+    if (tm.status(vh).fixed_nonmanifold()) continue;
+    const auto& p = tm.point(vh);
+    originalsAt.emplace(std::array<float, 3>{p[0], p[1], p[2]}, vh);
+  }
+  for (const auto vh : tm.vertices()) {
+    if (!tm.status(vh).fixed_nonmanifold()) continue;
+    const auto& p = tm.point(vh);
+    const auto [first, last] = originalsAt.equal_range(std::array<float, 3>{p[0], p[1], p[2]});
+    if (first == last) {
+      tm.set_normal(vh, TriMesh::Normal(0.0f, 0.0f, 0.0f));
+      tm.set_color(vh, TriMesh::Color(255, 255, 255, 255));
+      tm.set_texcoord2D(vh, TriMesh::TexCoord2D(0.0f, 0.0f));
+      continue;
+    }
+    auto best = first;
+    TriMesh::Normal faceNormal(0.0f, 0.0f, 0.0f);
+    if (present.normals) {
+      for (const auto fh : tm.vf_range(vh)) faceNormal += tm.calc_face_normal(fh);
+    }
+    float bestAlignment = -std::numeric_limits<float>::infinity();
+    for (auto it = first; present.normals && it != last; ++it) {
+      const float alignment = OpenMesh::dot(tm.normal(it->second), faceNormal);
+      if (alignment > bestAlignment) {  // NaN never wins: the first stays
+        bestAlignment = alignment;
+        best = it;
+      }
+    }
+    if (present.normals) tm.set_normal(vh, tm.normal(best->second));
+    if (present.colors) tm.set_color(vh, tm.color(best->second));
+    if (present.uvs) tm.set_texcoord2D(vh, tm.texcoord2D(best->second));
+  }
+}
+
 Result<LoadedMesh> loadChecked(std::string_view bytes, MeshFormat format, const std::string& ext,
                                const std::string& name, const MeshLoadOptions& options) {
   if (bytes.size() > options.maxFileBytes) {
@@ -206,6 +258,7 @@ Result<LoadedMesh> loadChecked(std::string_view bytes, MeshFormat format, const 
   attributes.normals = perVertexAttributes && opt.vertex_has_normal();
   attributes.colors = perVertexAttributes && opt.vertex_has_color();
   attributes.uvs = perVertexAttributes && opt.vertex_has_texcoord();
+  copyAttributesToNonManifoldCopies(tm, attributes);
   out.mesh = toIndexedMesh(tm, attributes);
   THINLOD_RETURN_IF_ERROR(out.mesh.validate(name));
   // File normals are often unnormalised (VCG writes area-weighted ones);

@@ -59,10 +59,11 @@ std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene) {
     const IndexedMesh* mesh =
         shape->geometry.kind == GeometryKind::kMeshFile ? shape->geometry.mesh.get() : nullptr;
     if (mesh == nullptr || !hashed.emplace(mesh, true).second) continue;
-    // Positions and triangles only: the geometry both daemons must agree on.
-    // Attribute arrays are left out: a live run showed two loads of the same
-    // gallery scene hashing differently through them (values of vertices no
-    // triangle references are not defined by every loader).
+    // Positions and triangles only: the geometry both daemons must agree on
+    // to address the same objects. (Two loads of the gallery once hashed
+    // differently through the normals: OpenMesh left the normals of vertices
+    // it copies for non-manifold faces uninitialised; mesh_io.cpp now
+    // defines them, see copyAttributesToNonManifoldCopies.)
     hash = hashVector(mesh->positions, hash);
     hash = hashVector(mesh->indices, hash);
   }
