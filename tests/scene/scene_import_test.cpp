@@ -4,6 +4,7 @@
 #include "thinlod/common/scene/scene_import.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -109,8 +110,8 @@ TEST(SceneImport, GltfBoxTexturedHasUvsAndRecordsTheTexturePath) {
   expectNear(b.min, glm::vec3(-0.5f), 1e-5f);
   expectNear(b.max, glm::vec3(0.5f), 1e-5f);
   bool noted = false;
-  for (const std::string& w : r->warnings) noted |= w.find("not drawn") != std::string::npos;
-  EXPECT_TRUE(noted) << "the importer must say that textures are not drawn";
+  for (const std::string& w : r->warnings) noted |= w.find("reference only") != std::string::npos;
+  EXPECT_TRUE(noted) << "the importer must say where textures are drawn";
 }
 
 TEST(SceneImport, GltfBinaryAndEmbeddedBoxesMatchTheSeparateFiles) {
@@ -425,6 +426,45 @@ TEST(SceneImport, VrmlInlineOfAGltfFileIsFlattenedIntoOneMesh) {
   expectNear(b.max, glm::vec3(10, 102, 0), 1e-4f);
   // The rotated, uniformly scaled instance keeps unit normals facing +z.
   for (const glm::vec3& n : mesh.normals) expectNear(n, glm::vec3(0, 0, 1), 1e-5f);
+}
+
+TEST(SceneTextures, AGltfBaseColourTextureResolvesNextToTheFile) {
+  const std::string path = packageFile("glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  ASSERT_TRUE(havePackageFile(path));
+  Result<Scene> r = loadSceneFile(path);
+  ASSERT_TRUE(r.ok()) << r.status().toString();
+  const std::vector<const ShapeNode*> shapes = distinctShapes(*r);
+  ASSERT_EQ(shapes.size(), 1u);
+  EXPECT_EQ(fs::path(shapes[0]->appearance.texturePath),
+            fs::path(path).parent_path() / "CesiumLogoFlat.png");
+  for (const std::string& w : r->warnings) EXPECT_EQ(w.find("untextured"), std::string::npos) << w;
+}
+
+TEST(SceneTextures, UnresolvableTexturesAreWarningsAndStayUntextured) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("thinlod_textures_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "present.png") << "not checked here";
+  Scene scene;
+  auto group = std::make_shared<GroupNode>();
+  for (const char* url : {"present.png", "missing.png", "../present.png", "*0", "http://x/y.png"}) {
+    auto shape = std::make_shared<ShapeNode>();
+    shape->appearance.textureUrl = url;
+    group->children.push_back(shape);
+  }
+  scene.roots.push_back(group);
+  resolveTextures(scene, dir.string());
+  const auto& shapes = group->children;
+  EXPECT_EQ(shapes[0]->as<ShapeNode>()->appearance.texturePath, (dir / "present.png").string());
+  for (std::size_t i = 1; i < shapes.size(); ++i) {
+    EXPECT_TRUE(shapes[i]->as<ShapeNode>()->appearance.texturePath.empty()) << i;
+  }
+  ASSERT_EQ(scene.warnings.size(), 4u);
+  EXPECT_NE(scene.warnings[0].find("no file"), std::string::npos) << scene.warnings[0];
+  EXPECT_NE(scene.warnings[1].find(".."), std::string::npos) << scene.warnings[1];
+  EXPECT_NE(scene.warnings[2].find("embedded"), std::string::npos) << scene.warnings[2];
+  EXPECT_NE(scene.warnings[3].find("scheme"), std::string::npos) << scene.warnings[3];
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -228,6 +228,24 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
   return Status();
 }
 
+// RGBA8 from an image file's pixels (1 grey, 2 grey + alpha, 3 RGB, 4+ RGBA).
+void expandToRgba(const std::vector<std::uint8_t>& in, int channels, RgbaImage& out) {
+  const std::size_t pixels = out.pixels.size() / 4;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const std::uint8_t* src = in.data() + p * static_cast<std::size_t>(channels);
+    std::uint8_t* dst = out.pixels.data() + 4 * p;
+    if (channels <= 2) {
+      dst[0] = dst[1] = dst[2] = src[0];
+      dst[3] = channels == 2 ? src[1] : 255;
+    } else {
+      dst[0] = src[0];
+      dst[1] = src[1];
+      dst[2] = src[2];
+      dst[3] = channels >= 4 ? src[3] : 255;
+    }
+  }
+}
+
 double psnrRgb(const RgbaImage& a, const RgbaImage& b) {
   double squared = 0.0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
@@ -326,6 +344,73 @@ Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
     return textureError(ErrorCode::kResourceExhausted, "out of memory");
   } catch (const std::exception& e) {
     return textureError(ErrorCode::kParseError, e.what());
+  }
+}
+
+Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
+                                  const DecodeLimits& limits) {
+  if (data == nullptr || size == 0) return textureError(ErrorCode::kParseError, "empty file");
+  if (size > limits.maxPayloadBytes) {
+    return textureError(ErrorCode::kResourceExhausted, "file of " + std::to_string(size) +
+                                                           " bytes is over the limit of " +
+                                                           std::to_string(limits.maxPayloadBytes));
+  }
+  static constexpr std::uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  TextureCodec codec;
+  if (size >= 8 && std::equal(kPngMagic, kPngMagic + 8, data)) {
+    codec = TextureCodec::kPng;
+    if (!pngChunksComplete(data, size)) {
+      return textureError(ErrorCode::kParseError, "PNG file is truncated or malformed");
+    }
+  } else if (size >= 2 && data[0] == 0xFF && data[1] == 0xD8) {
+    codec = TextureCodec::kJpeg;
+    if (!jpegHeaderSafe(data, size)) {
+      return textureError(ErrorCode::kParseError, "JPEG file has a malformed header");
+    }
+  } else {
+    return textureError(ErrorCode::kUnsupported, "not a PNG or JPEG file (only those are read)");
+  }
+  try {
+    OIIO::Filesystem::IOMemReader proxy(data, size);
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    void* proxyPointer = &proxy;  // see decodeImage
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
+    std::unique_ptr<OIIO::ImageInput> input =
+        OIIO::ImageInput::open(formatFileName(codec), &config);
+    if (!input) {
+      return textureError(ErrorCode::kParseError, "OpenImageIO: " + OIIO::geterror());
+    }
+    const OIIO::ImageSpec& spec = input->spec();
+    const std::string dims = std::to_string(spec.width) + "x" + std::to_string(spec.height);
+    if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.nchannels <= 0 ||
+        spec.nchannels > 16) {
+      return textureError(ErrorCode::kParseError,
+                          "image is " + dims + "x" + std::to_string(spec.nchannels));
+    }
+    const std::uint64_t side = limits.maxDecodableSide();
+    const std::uint64_t bytes = std::uint64_t(spec.width) * std::uint64_t(spec.height) * 4u;
+    if (std::uint64_t(spec.width) > side || std::uint64_t(spec.height) > side ||
+        bytes > std::uint64_t(limits.maxPayloadBytes) * 16u) {
+      return textureError(ErrorCode::kResourceExhausted,
+                          "image of " + dims + " is over the decode limits");
+    }
+    RgbaImage out;
+    out.width = spec.width;
+    out.height = spec.height;
+    out.pixels.assign(static_cast<std::size_t>(bytes), 0);
+    const int channels = std::min(spec.nchannels, 4);
+    std::vector<std::uint8_t> raw(static_cast<std::size_t>(bytes / 4) *
+                                  static_cast<std::size_t>(channels));
+    if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
+      return textureError(ErrorCode::kParseError, "OpenImageIO: " + input->geterror());
+    }
+    expandToRgba(raw, channels, out);
+    return out;
+  } catch (const std::bad_alloc&) {
+    return textureError(ErrorCode::kResourceExhausted, "out of memory decoding the image");
+  } catch (const std::exception& e) {
+    return textureError(ErrorCode::kParseError, std::string("OpenImageIO threw: ") + e.what());
   }
 }
 

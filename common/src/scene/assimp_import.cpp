@@ -288,7 +288,11 @@ class Converter {
     if (ai_.mNumCameras > 0) warn(std::to_string(ai_.mNumCameras) + " camera(s) ignored");
     if (ai_.mNumLights > 0) warn(std::to_string(ai_.mNumLights) + " light(s) ignored");
     if (ai_.mNumAnimations > 0) warn(std::to_string(ai_.mNumAnimations) + " animation(s) ignored");
-    if (texturesRecorded_) warn("base-colour textures recorded but not drawn");
+    if (texturesRecorded_) {
+      warn(
+          "base-colour textures: drawn in the frontend's reference only (the link does not carry "
+          "them yet)");
+    }
     return std::move(scene_);
   }
 

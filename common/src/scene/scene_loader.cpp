@@ -70,6 +70,37 @@ std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene) {
   return hash == 0 ? 1 : hash;  // 0 means "no scene"
 }
 
+void resolveTextures(Scene& scene, const std::string& sceneDirectory) {
+  std::map<const Node*, bool> seen;
+  std::vector<ShapeNode*> shapes;
+  for (const NodePtr& root : scene.roots) forEachShape(*root, seen, shapes);
+  for (ShapeNode* shape : shapes) {
+    Appearance& appearance = shape->appearance;
+    if (appearance.textureUrl.empty() || !appearance.texturePath.empty()) continue;
+    const std::string where = "texture '" + appearance.textureUrl + "'";
+    if (appearance.textureUrl[0] == '*') {
+      scene.warnings.push_back(where + ": embedded textures are not read yet; drawn untextured");
+      continue;
+    }
+    const Status url = checkUrl(appearance.textureUrl, where);
+    if (!url.ok()) {
+      scene.warnings.push_back(url.message() + "; drawn untextured");
+      continue;
+    }
+    // Relative to the file that names it: the imported mesh file, else the scene.
+    const fs::path base = shape->geometry.resolvedPath.empty()
+                              ? fs::path(sceneDirectory)
+                              : fs::path(shape->geometry.resolvedPath).parent_path();
+    const fs::path candidate = (base.empty() ? fs::path(".") : base) / appearance.textureUrl;
+    std::error_code ec;
+    if (!fs::is_regular_file(candidate, ec)) {
+      scene.warnings.push_back(where + ": no file " + candidate.string() + "; drawn untextured");
+      continue;
+    }
+    appearance.texturePath = candidate.string();
+  }
+}
+
 Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
                      const SceneLoadOptions& options) {
   std::vector<std::string> directories = options.meshSearchPaths;
@@ -158,9 +189,9 @@ Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& opt
   Result<Scene> scene =
       imported ? importScene(path, options.importLimits) : parseScene(text, path, options.limits);
   if (!scene.ok()) return scene.status();
-  if (!imported) {
-    THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, fs::path(path).parent_path().string(), options));
-  }
+  const std::string directory = fs::path(path).parent_path().string();
+  if (!imported) THINLOD_RETURN_IF_ERROR(resolveMeshes(*scene, directory, options));
+  resolveTextures(*scene, directory);
   scene->fingerprint = sceneFingerprint(text, *scene);
   return scene;
 }

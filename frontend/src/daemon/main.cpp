@@ -201,6 +201,9 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
           "reference\" count={}",
           scene->laterLodLevelObjects);
     }
+    for (const std::string& warning : scene->warnings) {
+      spdlog::warn("event=scene_warning message=\"{}\"", warning);
+    }
     if (scene->droppedLights > 0) {
       spdlog::warn("event=lights_dropped count={}", scene->droppedLights);
     }

@@ -1,11 +1,35 @@
 #include "scene_setup.h"
 
+#include <fstream>
+#include <map>
 #include <utility>
 
+#include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
 
 namespace thinlod::frontend::daemon {
+namespace {
+
+// The bytes of a texture file, at most `limit` of them.
+Result<std::vector<std::uint8_t>> readTextureFile(const std::string& path, std::size_t limit) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
+  const std::streamoff size = in.tellg();
+  if (size < 0) return Status(ErrorCode::kIoError, path + ": cannot tell its size");
+  if (static_cast<std::uint64_t>(size) > limit) {
+    return Status(
+        ErrorCode::kResourceExhausted,
+        path + ": " + std::to_string(size) + " bytes exceed the limit of " + std::to_string(limit));
+  }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(bytes.data()), size);
+  if (in.gcount() != size) return Status(ErrorCode::kIoError, path + ": short read");
+  return bytes;
+}
+
+}  // namespace
 
 Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::string& modelsDir) {
   scene::SceneLoadOptions loadOptions;
@@ -21,6 +45,29 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
   }
   loaded.objects = std::move(objects).value();
   loaded.lighting = scene::sceneLighting(*loaded.scene, &loaded.droppedLights);
+  loaded.warnings = loaded.scene->warnings;
+  // Scene textures for the reference, decoded once per file; one that fails
+  // is a warning and its shapes are drawn untextured.
+  std::map<std::string, std::shared_ptr<const RgbaImage>> textures;
+  auto textureOf = [&](const std::string& path) -> std::shared_ptr<const RgbaImage> {
+    if (path.empty()) return nullptr;
+    const auto known = textures.find(path);
+    if (known != textures.end()) return known->second;
+    std::shared_ptr<const RgbaImage> image;
+    const codec::DecodeLimits limits;
+    Result<std::vector<std::uint8_t>> bytes = readTextureFile(path, limits.maxPayloadBytes);
+    Result<RgbaImage> decoded = bytes.ok()
+                                    ? codec::decodeImageFile(bytes->data(), bytes->size(), limits)
+                                    : Result<RgbaImage>(bytes.status());
+    if (decoded.ok()) {
+      image = std::make_shared<const RgbaImage>(std::move(decoded).value());
+      ++loaded.textures;
+    } else {
+      loaded.warnings.push_back(path + ": " + decoded.status().message() + "; drawn untextured");
+    }
+    textures.emplace(path, image);
+    return image;
+  };
   // Position of each instance among its parent's children (pre-order lists
   // a parent's children in order), to tell an LOD's first level from the others.
   const std::vector<scene::NodeInstance> instances = scene::flattenInstances(*loaded.scene);
@@ -61,6 +108,7 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     ReferenceItem item;
     item.object.mesh = object.fullMesh;
     item.object.material = material;
+    item.object.texture = textureOf(object.shape->appearance.texturePath);
     item.object.transform = object.objectToWorld;
     item.worldCentre = object.worldBounds.center();
     item.blended = material.alphaMode == render::AlphaMode::kBlend;

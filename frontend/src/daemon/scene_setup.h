@@ -7,7 +7,9 @@
 // pattern USEs the same Shape in every level, which would otherwise be drawn
 // once per level), and all objects under one outermost LOD form one group
 // for the completeness check (ObjectExtent::group).
-// Reads files (the scene and its meshes); errors name the path.
+// Reference objects carry their shape's base-colour texture (decoded once per
+// file; a file that fails is a warning and draws untextured).
+// Reads files (the scene, its meshes and textures); errors name the path.
 #pragma once
 
 #include <cstddef>
@@ -44,6 +46,8 @@ struct LoadedScene {
   std::size_t referenceTriangles = 0;
   std::size_t laterLodLevelObjects = 0;  // left out of the reference
   std::vector<ObjectExtent> extents;     // every object, for completeness
+  std::size_t textures = 0;              // texture files decoded for the reference
+  std::vector<std::string> warnings;     // the scene's, then texture decoding's
 };
 
 Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::string& modelsDir);

@@ -72,8 +72,12 @@ struct Appearance {
   bool hasMaterial = false;  // VRML: no material means unlit (emissive white)
   Material material;
   // Base-colour texture as the file names it (imported scenes only,
-  // scene_import.h); recorded, not drawn yet. Empty when there is none.
+  // scene_import.h); empty when there is none. texturePath: the file it
+  // resolved to (resolveTextures), empty when it did not resolve. The
+  // frontend's reference rendering draws it; the link does not carry
+  // textures yet, so the frontend's own representations are untextured.
   std::string textureUrl;
+  std::string texturePath;
 };
 
 enum class GeometryKind : std::uint8_t { kNone, kPrimitive, kMeshFile, kIndexedFaceSet };
@@ -204,7 +208,7 @@ struct Scene {
   std::vector<NodePtr> roots;
   std::map<std::string, NodePtr> defs;  // DEF'd scene-graph nodes (last DEF wins)
   std::uint32_t nodeCount = 0;          // distinct nodes (ids 1..nodeCount)
-  std::vector<std::string> warnings;    // from mesh loading
+  std::vector<std::string> warnings;    // from mesh and texture loading
   // loadSceneFile(): sceneFingerprint() of the file's text and its meshes
   // (0 for a scene parsed from text alone). Daemons compare it at the
   // handshake: equal scene text and mesh geometry give equal fingerprints.

@@ -58,7 +58,14 @@ struct SceneLoadOptions {
 Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
                      const SceneLoadOptions& options);
 
-// Reads the file, parses it and resolves its meshes. A path ending in
+// Sets Appearance::texturePath of every shape whose textureUrl names an
+// existing file (url rules as for meshes; relative to the imported mesh file
+// that names it, else to `sceneDirectory`); the others get a Scene::warnings
+// line and stay untextured. Reads no pixels: decoding is the renderer side's
+// (codec::decodeImageFile).
+void resolveTextures(Scene& scene, const std::string& sceneDirectory);
+
+// Reads the file, parses it and resolves its meshes and textures. A path ending in
 // .gltf .glb .dae .fbx or .obj is imported instead (importScene(), limits from
 // options.importLimits); the fingerprint is then sceneFingerprint() of the
 // file's bytes and the imported meshes.

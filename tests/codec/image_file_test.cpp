@@ -1,0 +1,82 @@
+// codec::decodeImageFile: scene texture files (PNG / JPEG without a frame).
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "thinlod/common/codec/encoding.h"
+
+namespace thinlod::codec {
+namespace {
+
+RgbaImage noise(int w, int h, std::uint32_t seed, bool opaque) {
+  std::mt19937 rng(seed);
+  RgbaImage t(w, h);
+  for (std::size_t i = 0; i < t.pixels.size(); ++i) {
+    t.pixels[i] = (opaque && i % 4 == 3) ? 255 : static_cast<std::uint8_t>(rng());
+  }
+  return t;
+}
+
+// The image file inside a link frame: the frame's payload.
+std::vector<std::uint8_t> fileBytes(const RgbaImage& image, TextureCodec codec) {
+  Result<std::vector<std::uint8_t>> frame = encodeTextureWith(image, codec);
+  EXPECT_TRUE(frame.ok()) << frame.status().toString();
+  if (!frame.ok()) return {};
+  return std::vector<std::uint8_t>(frame->begin() + kFrameHeaderBytes, frame->end());
+}
+
+TEST(ImageFile, PngDecodesToTheSameRgbaPixels) {
+  const RgbaImage image = noise(37, 21, 7, false);
+  const std::vector<std::uint8_t> png = fileBytes(image, TextureCodec::kPng);
+  Result<RgbaImage> decoded = decodeImageFile(png.data(), png.size());
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  EXPECT_EQ(decoded->width, 37);
+  EXPECT_EQ(decoded->height, 21);
+  EXPECT_EQ(decoded->pixels, image.pixels);
+}
+
+TEST(ImageFile, JpegDecodesOpaqueAtItsOwnSize) {
+  const RgbaImage image = noise(40, 24, 8, true);
+  const std::vector<std::uint8_t> jpeg = fileBytes(image, TextureCodec::kJpeg);
+  Result<RgbaImage> decoded = decodeImageFile(jpeg.data(), jpeg.size());
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  EXPECT_EQ(decoded->width, 40);
+  EXPECT_EQ(decoded->height, 24);
+  for (std::size_t i = 3; i < decoded->pixels.size(); i += 4) ASSERT_EQ(decoded->pixels[i], 255);
+}
+
+TEST(ImageFile, OtherFormatsAreUnsupported) {
+  const std::vector<std::uint8_t> tga = {0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 1, 0, 24, 0};
+  Result<RgbaImage> decoded = decodeImageFile(tga.data(), tga.size());
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kUnsupported);
+  EXPECT_EQ(decodeImageFile(nullptr, 0).status().code(), ErrorCode::kParseError);
+}
+
+TEST(ImageFile, TruncatedFilesAreParseErrors) {
+  const RgbaImage image = noise(16, 16, 9, true);
+  for (TextureCodec codec : {TextureCodec::kPng, TextureCodec::kJpeg}) {
+    const std::vector<std::uint8_t> bytes = fileBytes(image, codec);
+    for (std::size_t keep : {std::size_t{3}, std::size_t{20}, bytes.size() / 2}) {
+      Result<RgbaImage> decoded = decodeImageFile(bytes.data(), keep);
+      EXPECT_FALSE(decoded.ok()) << "kept " << keep << " bytes";
+    }
+  }
+}
+
+TEST(ImageFile, ImagesOverTheLimitsAreRefusedBeforeDecoding) {
+  const std::vector<std::uint8_t> png = fileBytes(noise(64, 8, 10, false), TextureCodec::kPng);
+  DecodeLimits limits;
+  limits.maxTextureDimension = 32;
+  Result<RgbaImage> decoded = decodeImageFile(png.data(), png.size(), limits);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
+  limits = DecodeLimits{};
+  limits.maxPayloadBytes = png.size() - 1;
+  EXPECT_EQ(decodeImageFile(png.data(), png.size(), limits).status().code(),
+            ErrorCode::kResourceExhausted);
+}
+
+}  // namespace
+}  // namespace thinlod::codec
