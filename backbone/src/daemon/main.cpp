@@ -461,6 +461,9 @@ int main(int argc, char** argv) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, scene.status().toString());
     return 1;
   }
+  for (const std::string& warning : scene->warnings) {
+    spdlog::warn("event=scene_warning message=\"{}\"", warning);
+  }
   auto core = BackboneCore::create(std::move(scene).value(), scenePath, *options);
   if (!core.ok()) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, core.status().toString());
