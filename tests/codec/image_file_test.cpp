@@ -1,7 +1,10 @@
 // codec::decodeImageFile: scene texture files (PNG / JPEG without a frame).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "thinlod/common/codec/encoding.h"
@@ -76,6 +79,34 @@ TEST(ImageFile, ImagesOverTheLimitsAreRefusedBeforeDecoding) {
   limits.maxPayloadBytes = png.size() - 1;
   EXPECT_EQ(decodeImageFile(png.data(), png.size(), limits).status().code(),
             ErrorCode::kResourceExhausted);
+}
+
+std::vector<std::uint8_t> seedFile(const std::string& name) {
+  std::ifstream in(std::string(THINLOD_SOURCE_DIR) + "/fuzz/corpus/image_file/" + name,
+                   std::ios::binary);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), {});
+}
+
+// grey_4x3.png / grey_alpha_3x5.png (written by hand: value = (40x + 17y + 60c) mod 256).
+TEST(ImageFile, GreyAndGreyAlphaBecomeRgba) {
+  const std::vector<std::uint8_t> grey = seedFile("grey_4x3.png");
+  ASSERT_FALSE(grey.empty());
+  Result<RgbaImage> g = decodeImageFile(grey.data(), grey.size());
+  ASSERT_TRUE(g.ok()) << g.status().toString();
+  ASSERT_EQ(g->width, 4);
+  ASSERT_EQ(g->height, 3);
+  const std::uint8_t* p = g->at(2, 1);
+  EXPECT_EQ(p[0], 40 * 2 + 17);
+  EXPECT_EQ(p[1], p[0]);
+  EXPECT_EQ(p[2], p[0]);
+  EXPECT_EQ(p[3], 255);
+  const std::vector<std::uint8_t> greyAlpha = seedFile("grey_alpha_3x5.png");
+  Result<RgbaImage> ga = decodeImageFile(greyAlpha.data(), greyAlpha.size());
+  ASSERT_TRUE(ga.ok()) << ga.status().toString();
+  const std::uint8_t* q = ga->at(1, 4);
+  EXPECT_EQ(q[0], 40 + 17 * 4);
+  EXPECT_EQ(q[2], q[0]);
+  EXPECT_EQ(q[3], 40 + 17 * 4 + 60);
 }
 
 }  // namespace
