@@ -195,9 +195,13 @@ std::vector<TriangleSample> sampleTriangle(const glm::dvec3& a, const glm::dvec3
       const Vec2 p = mec.centre;
       double wc = p.y / f.height;
       double wb = (p.x * f.height - p.y * f.cx) / twiceArea;
-      wc = std::clamp(wc, 0.0, 1.0);
-      wb = std::clamp(wb, 0.0, 1.0 - wc);
-      const double wa = 1.0 - wb - wc;
+      wc = std::max(wc, 0.0);
+      wb = std::max(wb, 0.0);
+      double wa = std::max(1.0 - wb - wc, 0.0);
+      const double sum = wa + wb + wc;
+      wa /= sum;
+      wb /= sum;
+      wc /= sum;
       TriangleSample s;
       double bary[3] = {0.0, 0.0, 0.0};
       bary[f.corner[0]] = wa;
