@@ -3,6 +3,8 @@
 // properties (fixed seeds), and the verified bound: the sampled two-sided
 // Hausdorff distance of random cuts never exceeds the cut's stored bound, on
 // the bunny and on a generated multi-manifold model.
+#include "thinlod/simplifier/hybrid_graph.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,7 +15,6 @@
 #include <set>
 
 #include "thinlod/common/mesh/mesh_io.h"
-#include "thinlod/simplifier/hybrid_graph.h"
 #include "thinlod/simplifier/surface_error.h"
 
 namespace thinlod::simplifier {
@@ -36,7 +37,8 @@ IndexedMesh makeBumpyGrid(int cells) {
   for (int y = 0; y <= cells; ++y) {
     for (int x = 0; x <= cells; ++x) {
       const float fx = static_cast<float>(x) / cells, fy = static_cast<float>(y) / cells;
-      const float z = 0.2f * std::exp(-20.0f * ((fx - 0.5f) * (fx - 0.5f) + (fy - 0.4f) * (fy - 0.4f)));
+      const float z =
+          0.2f * std::exp(-20.0f * ((fx - 0.5f) * (fx - 0.5f) + (fy - 0.4f) * (fy - 0.4f)));
       m.positions.emplace_back(fx, fy, z);
     }
   }
@@ -98,8 +100,8 @@ HybridOptions options(double kappa, double tau, bool points = true) {
   const HybridNode& drain = nodes[HybridGraph::kDrain];
   for (std::uint32_t i = drain.producedBegin; i < drain.producedEnd; ++i) {
     if (!exactlyOnce(g.producedList()[i])) {
-      return ::testing::AssertionFailure() << "input primitive " << g.producedList()[i]
-                                           << " is missing or covered twice";
+      return ::testing::AssertionFailure()
+             << "input primitive " << g.producedList()[i] << " is missing or covered twice";
     }
   }
   // The applied flags agree with the primitives.
@@ -238,7 +240,8 @@ TEST(HybridCut, RandomCutsAreConsistentMonotoneAndIncremental) {
       HybridCut incremental(g);
       // A random walk of thresholds, up and down.
       for (int k = 0; k < 25; ++k) {
-        const double threshold = top * std::pow(10.0, -4.0 * static_cast<double>(rng() % 1000) / 1000.0);
+        const double threshold =
+            top * std::pow(10.0, -4.0 * static_cast<double>(rng() % 1000) / 1000.0);
         incremental.adaptToError(threshold);
         HybridCut scratch(g);
         scratch.adaptToError(threshold);
@@ -258,7 +261,8 @@ TEST(HybridCut, RandomCutsAreConsistentMonotoneAndIncremental) {
       }
       // Monotone in the threshold: nested applied sets, units non-increasing.
       std::vector<double> thresholds;
-      for (int k = 0; k < 30; ++k) thresholds.push_back(top * static_cast<double>(rng() % 10000) / 10000.0);
+      for (int k = 0; k < 30; ++k)
+        thresholds.push_back(top * static_cast<double>(rng() % 10000) / 10000.0);
       std::sort(thresholds.begin(), thresholds.end());
       HybridCut cut(g);
       std::set<std::uint32_t> previous = appliedSet(g, cut);
@@ -287,7 +291,8 @@ TEST(HybridCut, ScreenSpaceCutsRespectTheToleranceAndAreMonotone) {
   HybridCut incremental(g);
   for (int k = 0; k < 12; ++k) {
     HybridView view;
-    view.eye = glm::dvec3(static_cast<double>(rng() % 1000) / 250.0 - 2.0, 0.5, -1.0 - static_cast<double>(rng() % 100) / 50.0);
+    view.eye = glm::dvec3(static_cast<double>(rng() % 1000) / 250.0 - 2.0, 0.5,
+                          -1.0 - static_cast<double>(rng() % 100) / 50.0);
     view.pixelsPerRadian = 800.0;
     view.nearDistance = 0.01;
     double previousUnits = std::numeric_limits<double>::infinity();
@@ -305,7 +310,8 @@ TEST(HybridCut, ScreenSpaceCutsRespectTheToleranceAndAreMonotone) {
         const HybridPrimitive& prim = g.primitives()[p];
         if (prim.producer == HybridGraph::kDrain) continue;
         const HybridNode& node = g.nodes()[prim.producer];
-        const double z = std::max(glm::length(node.sphereCentre - view.eye) - node.sphereRadius, view.nearDistance);
+        const double z = std::max(glm::length(node.sphereCentre - view.eye) - node.sphereRadius,
+                                  view.nearDistance);
         EXPECT_LE(prim.error * view.pixelsPerRadian / z, tolerance * (1.0 + 1e-12));
       }
     }
@@ -371,7 +377,9 @@ TEST(HybridBounds, HoldOnAMultiManifoldModel) {
   checkBoundsHold(parts, options(3.0, 1.0, false), 5, 4);
 }
 
-TEST(HybridBounds, HoldOnAnOpenSheet) { checkBoundsHold(makeBumpyGrid(30), options(3.0, 5.0), 6, 8); }
+TEST(HybridBounds, HoldOnAnOpenSheet) {
+  checkBoundsHold(makeBumpyGrid(30), options(3.0, 5.0), 6, 8);
+}
 
 TEST(HybridSurfaceError, DiscDistanceIsExact) {
   IndexedMesh square = makeBumpyGrid(1);
@@ -387,9 +395,11 @@ TEST(HybridSurfaceError, DiscDistanceIsExact) {
   // Square corner (0,0,0) -> disc rim: in-plane 0.5*sqrt(2) - 0.25, height 0.3.
   const double inPlane = 0.5 * std::sqrt(2.0) - 0.25;
   EXPECT_NEAR(e->maxForward, std::sqrt(inPlane * inPlane + 0.09), 1e-9);
-  EXPECT_EQ(measureHybridSurfaceError(square, none, {}, {}).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(measureHybridSurfaceError(square, none, {}, {}).status().code(),
+            ErrorCode::kInvalidArgument);
   disc.normal = glm::dvec3(0.0);
-  EXPECT_EQ(measureHybridSurfaceError(square, none, {disc}, {}).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(measureHybridSurfaceError(square, none, {disc}, {}).status().code(),
+            ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

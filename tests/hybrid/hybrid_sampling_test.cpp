@@ -30,13 +30,17 @@ std::vector<Tri> randomTriangles(std::uint64_t seed, int count) {
     const double scale = std::pow(10.0, uniform(rng, -3.0, 4.0));
     const dvec3 offset(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     Tri t;
-    t.a = offset * scale + scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    t.b = offset * scale + scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    t.a = offset * scale +
+          scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    t.b = offset * scale +
+          scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     if (i % 4 == 0) {
       // Sliver: c close to segment ab.
-      t.c = 0.3 * t.a + 0.7 * t.b + 1e-3 * scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), 1.0);
+      t.c = 0.3 * t.a + 0.7 * t.b +
+            1e-3 * scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), 1.0);
     } else {
-      t.c = offset * scale + scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+      t.c = offset * scale +
+            scale * dvec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     }
     out.push_back(t);
   }
@@ -78,7 +82,8 @@ TEST(HybridSampling, SamplesCoverTheTriangleWithCentresInside) {
       }
       const dvec3 p = t.a + u * (t.b - t.a) + v * (t.c - t.a);
       double nearest = std::numeric_limits<double>::infinity();
-      for (const TriangleSample& s : samples) nearest = std::min(nearest, glm::length(p - s.centre));
+      for (const TriangleSample& s : samples)
+        nearest = std::min(nearest, glm::length(p - s.centre));
       ASSERT_LE(nearest, radius * (1.0 + 1e-9)) << "uncovered point, d = " << d;
     }
   }

@@ -162,6 +162,12 @@ struct HybridView {
   double nearDistance = 1e-3;
 };
 
+// Whole-object screen-space tolerance: the object-space error that appears
+// as `pixels` at distance `distance` (pass it to HybridCut::adaptToError).
+inline double hybridErrorForPixels(double pixels, double distance, double pixelsPerRadian) {
+  return pixels * distance / pixelsPerRadian;
+}
+
 // A cut through the graph: the set of applied nodes (the drain always, the
 // source never), closed under "children first", and the primitives produced
 // by applied nodes and consumed by unapplied ones. Adapting starts from the
