@@ -344,9 +344,20 @@ void checkBoundsHold(const IndexedMesh& mesh, const HybridOptions& o, std::uint6
   HybridCut cut(g);
   // Rounding of float inputs in double arithmetic: far below any bound.
   const double slack = 1e-6 * g.diagonal();
+  // The source's sphere holds the whole model: views from just outside it.
+  const HybridNode& all = g.nodes().back();
   for (int k = 0; k < cuts; ++k) {
     const double relative = std::pow(10.0, -3.5 + 3.0 * static_cast<double>(rng() % 1000) / 1000.0);
-    cut.adaptToError(relative * g.diagonal());
+    if (k % 3 == 2) {
+      // A view-dependent cut: fine near the eye, coarse far away.
+      HybridView view;
+      view.eye = all.sphereCentre + glm::dvec3(1.2 * all.sphereRadius, 0.3 * all.sphereRadius, 0.0);
+      view.pixelsPerRadian = 1000.0;
+      view.nearDistance = 0.01 * all.sphereRadius;
+      cut.adaptToScreen(view, 1000.0 * relative);
+    } else {
+      cut.adaptToError(relative * g.diagonal());
+    }
     const IndexedMesh triangles = cut.triangleMesh();
     const std::vector<HybridPoint> points = cut.pointList();
     Result<SurfaceError> measured = measureHybridSurfaceError(mesh, triangles, points, eo);
