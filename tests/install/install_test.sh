@@ -32,6 +32,7 @@ for d in "${daemons[@]}"; do
   expected+=("$bindir/thinlod-$d" "$datadir/thinlod/systemd/thinlod-$d.service"
              "$datadir/thinlod/examples/$d.toml")
 done
+expected+=("$bindir/thinlod-keys")  # CURVE key pairs (docs/deployment.md, "Keys")
 wanted=$(printf '%s\n' "${expected[@]}" | sort)
 echo "check: the installed files are exactly these ${#expected[@]}:"
 echo "$wanted" | sed 's/^/  /'
@@ -39,6 +40,15 @@ actual=$(cd "$prefix" && find . -type f -o -type l | sed 's|^\./||' | sort)
 if [[ "$actual" != "$wanted" ]]; then
   fail "installed file list differs (< expected, > installed):"
   diff <(echo "$wanted") <(echo "$actual") || true
+fi
+
+echo "check: the installed thinlod-keys writes a key pair it can load back"
+if ! "$prefix/$bindir/thinlod-keys" --dir "$work" installed-test >/dev/null ||
+   ! "$prefix/$bindir/thinlod-keys" --check "$work/installed-test.key" >/dev/null; then
+  fail "installed thinlod-keys could not write or load a key pair"
+fi
+if ldd "$prefix/$bindir/thinlod-keys" | grep -qF "$build"; then
+  fail "thinlod-keys loads a library from the build tree"
 fi
 
 for d in "${daemons[@]}"; do

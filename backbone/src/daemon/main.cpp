@@ -440,6 +440,15 @@ int main(int argc, char** argv) {
   Settings settings;
   addOptions(runtime, settings);
   if (auto exit = runtime.parse(argc, argv)) return *exit;
+  // CURVE keys beyond loopback (docs/protocol.md, "Security"): fail before loading the scene.
+  for (const std::string* address : {&settings.frontendAddress, &settings.simplifierAddress}) {
+    const Status secure =
+        protocol::checkLinkSecurity(*address, settings.transport.curve, protocol::LinkSide::kBind);
+    if (!secure.ok()) {
+      spdlog::error("event=bad_options error=\"{}\"", secure.toString());
+      return 2;
+    }
+  }
 
   thinlod::Result<CoreOptions> options = coreOptions(settings);
   if (!options.ok()) {

@@ -363,5 +363,12 @@ int main(int argc, char** argv) {
   frontend::daemon::DaemonOptions options;
   frontend::daemon::registerOptions(runtime, &options);
   if (auto exitCode = runtime.parse(argc, argv)) return *exitCode;
+  // CURVE keys beyond loopback (docs/protocol.md, "Security"): fail before loading the scene.
+  const Status secure = protocol::checkLinkSecurity(
+      options.backboneAddress, options.transport.curve, protocol::LinkSide::kConnect);
+  if (!secure.ok()) {
+    spdlog::error("event=bad_options error=\"{}\"", secure.toString());
+    return 2;
+  }
   return frontend::daemon::run(runtime, options);
 }

@@ -34,6 +34,9 @@ Result<std::unique_ptr<Channel>> Channel::connect(Options options) {
   THINLOD_RETURN_IF_ERROR(validate(options.hello));
   auto impl = std::make_unique<Impl>();
   impl->context = detail::sharedContext();
+  auto security = detail::prepareClientSecurity(options.address, options.transport.curve);
+  if (!security.ok()) return security.status();
+  impl->security = std::move(*security);
   impl->interval = options.transport.heartbeatInterval;
   impl->options = std::move(options);
   THINLOD_RETURN_IF_ERROR(impl->openSocket(Clock::now()));
@@ -46,6 +49,7 @@ Channel::~Channel() {
   if (!impl_->socket) return;
   if (impl_->ready)
     (void)impl_->sendMessage(Shutdown{impl_->options.hello.name + " is closing"}, Clock::now());
+  impl_->monitor.detach();
   try {
     impl_->socket->set(zmq::sockopt::linger, impl_->ready ? kCloseLingerMs : 0);
     impl_->socket->close();
@@ -65,6 +69,7 @@ std::vector<ChannelEvent> Channel::poll(std::chrono::milliseconds timeout) {
   }
   const auto now = Clock::now();
   s.drain(now);
+  s.stats.handshakesFailed += s.monitor.drain("channel=" + s.options.hello.name);
   s.checkTimers(now);
   std::vector<ChannelEvent> events;
   events.swap(s.events);
@@ -93,16 +98,20 @@ Status Channel::sendEncoded(const Bytes& encoded) {
 Status Channel::Impl::openSocket(Clock::time_point now) {
   try {
     if (socket) {
+      monitor.detach();
       socket->set(zmq::sockopt::linger, 0);  // drop what the old session queued
       socket->close();
     }
     socket = std::make_unique<zmq::socket_t>(*context, zmq::socket_type::dealer);
+    detail::applyClientSecurity(*socket, security);
+    if (security.curve) monitor.attach(*context, *socket);
     socket->set(zmq::sockopt::linger, 0);
     socket->set(zmq::sockopt::sndhwm, options.transport.sendHighWaterMark);
     socket->set(zmq::sockopt::rcvhwm, options.transport.sendHighWaterMark);
     socket->set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(kMaxMessageBytes + 4096));
     socket->connect(options.address);
   } catch (const zmq::error_t& e) {
+    monitor.detach();
     socket.reset();
     return Status(ErrorCode::kInvalidArgument,
                   "cannot connect to " + options.address + ": " + e.what());
@@ -116,7 +125,11 @@ Status Channel::Impl::openSocket(Clock::time_point now) {
 void Channel::Impl::sendHello(Clock::time_point now) {
   lastHello = now;
   const Status sent = sendMessage(options.hello, now);
-  if (!sent.ok()) {
+  if (!sent.ok() && stats.handshakesFailed > 0) {
+    // CURVE refused us (logged as handshake_failed); libzmq dropped the pipe.
+    spdlog::debug("event=hello_not_sent channel={} address={} error=\"{}\"", options.hello.name,
+                  options.address, sent.toString());
+  } else if (!sent.ok()) {
     spdlog::warn("event=hello_not_sent channel={} address={} error=\"{}\"", options.hello.name,
                  options.address, sent.toString());
   }

@@ -30,8 +30,14 @@ Result<std::unique_ptr<Endpoint>> Endpoint::bind(Options options) {
   }
   auto impl = std::make_unique<Impl>();
   impl->context = detail::sharedContext();
+  auto security = detail::prepareServerSecurity(impl->context, options.address,
+                                                options.transport.curve, options.name);
+  if (!security.ok()) return security.status();
+  impl->security = std::move(*security);
   try {
     impl->socket = zmq::socket_t(*impl->context, zmq::socket_type::router);
+    detail::applyServerSecurity(impl->socket, impl->security);
+    if (impl->security.curve) impl->monitor.attach(*impl->context, impl->socket);
     impl->socket.set(zmq::sockopt::linger, 0);
     impl->socket.set(zmq::sockopt::router_mandatory, 1);
     impl->socket.set(zmq::sockopt::sndhwm, options.transport.sendHighWaterMark);
@@ -40,6 +46,7 @@ Result<std::unique_ptr<Endpoint>> Endpoint::bind(Options options) {
     impl->socket.bind(portZeroToWildcard(options.address));
     impl->boundAddress = impl->socket.get(zmq::sockopt::last_endpoint);
   } catch (const zmq::error_t& e) {
+    impl->monitor.detach();
     const ErrorCode code =
         e.num() == EADDRINUSE ? ErrorCode::kUnavailable : ErrorCode::kInvalidArgument;
     return Status(code, "cannot bind " + options.address + ": " + e.what());
@@ -57,6 +64,7 @@ Endpoint::~Endpoint() {
   for (const std::string& routingId : routingIds) {
     (void)impl_->sendMessage(routingId, Shutdown{impl_->options.name + " is closing"});
   }
+  impl_->monitor.detach();
   try {
     impl_->socket.set(zmq::sockopt::linger, kCloseLingerMs);
     impl_->socket.close();
@@ -82,6 +90,7 @@ std::vector<EndpointEvent> Endpoint::poll(std::chrono::milliseconds timeout) {
   }
   const auto now = Clock::now();
   s.drain(now);
+  s.stats.handshakesFailed += s.monitor.drain("endpoint=" + s.options.name);
   s.checkTimers(now);
   std::vector<EndpointEvent> events;
   events.swap(s.events);

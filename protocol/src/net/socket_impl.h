@@ -9,6 +9,7 @@
 #include <zmq.hpp>
 
 #include "thinlod/protocol/codec.h"
+#include "thinlod/protocol/curve.h"
 #include "thinlod/protocol/transport.h"
 
 namespace thinlod::protocol::detail {
@@ -20,6 +21,59 @@ std::shared_ptr<zmq::context_t> sharedContext();
 std::int64_t steadyNowNs();
 // Printable routing id ("00 80 00 41 a7").
 std::string hexId(const std::string& routingId);
+
+// CURVE on a socket (curve_security.cpp). Server side: the keys, plus a
+// registration with the process's ZAP handler (inproc://zeromq.zap.01) that
+// lets in the authorized client keys of this socket's ZAP domain and logs
+// every refusal; it unregisters when destroyed.
+class ZapHandler;
+struct ZapRegistration {
+  std::shared_ptr<ZapHandler> handler;
+  std::string domain;
+  ~ZapRegistration();
+};
+struct ServerSecurity {
+  bool curve = false;
+  std::string secretKey;  // Z85
+  std::unique_ptr<ZapRegistration> zap;
+};
+struct ClientSecurity {
+  bool curve = false;
+  CurveKeyPair keys;
+  std::string serverKey;  // Z85
+};
+// Loads and checks the key files named by `curve` (the errors name the
+// option); a non-loopback address without keys is refused unless
+// plaintextRemote.
+Result<ServerSecurity> prepareServerSecurity(const std::shared_ptr<zmq::context_t>& context,
+                                             const std::string& address, const CurveOptions& curve,
+                                             const std::string& name);
+Result<ClientSecurity> prepareClientSecurity(const std::string& address, const CurveOptions& curve);
+Status serverSecurityCheck(const std::string& address, const CurveOptions& curve);
+// Socket options; before bind/connect. Throws zmq::error_t like the rest.
+void applyServerSecurity(zmq::socket_t& socket, const ServerSecurity& security);
+void applyClientSecurity(zmq::socket_t& socket, const ClientSecurity& security);
+
+// Reads the socket's handshake-failure events (zmq_socket_monitor) and logs
+// them: a peer with a wrong or missing key, or refused by ZAP.
+class HandshakeMonitor {
+ public:
+  HandshakeMonitor() = default;
+  ~HandshakeMonitor();
+  HandshakeMonitor(const HandshakeMonitor&) = delete;
+  HandshakeMonitor& operator=(const HandshakeMonitor&) = delete;
+  // Before the socket binds/connects.
+  void attach(zmq::context_t& context, zmq::socket_t& socket);
+  // Before the socket closes.
+  void detach();
+  // Events so far, logged with `who`; returns how many handshakes failed.
+  std::uint64_t drain(const std::string& who);
+
+ private:
+  void* monitored_ = nullptr;
+  std::unique_ptr<zmq::socket_t> events_;
+  std::uint64_t logged_ = 0;
+};
 
 }  // namespace thinlod::protocol::detail
 
@@ -36,7 +90,9 @@ struct Endpoint::Impl {
 
   Options options;
   std::shared_ptr<zmq::context_t> context;
+  detail::ServerSecurity security;  // before the socket: outlives it
   zmq::socket_t socket;
+  detail::HandshakeMonitor monitor;
   std::string boundAddress;
   Encoder encoder;
   std::map<std::uint64_t, Peer> peers;             // by PeerId
@@ -59,7 +115,9 @@ struct Endpoint::Impl {
 struct Channel::Impl {
   Options options;
   std::shared_ptr<zmq::context_t> context;
+  detail::ClientSecurity security;
   std::unique_ptr<zmq::socket_t> socket;  // rebuilt after the server is lost
+  detail::HandshakeMonitor monitor;       // re-attached to each new socket
   Encoder encoder;
   bool ready = false;
   bool rejected = false;  // the last HelloReply refused us: retry slowly

@@ -89,6 +89,8 @@ Result<std::uint64_t> WorkerPool::Impl::submit(Message request) {
   const std::uint64_t id = requestIdOf(request);
   THINLOD_RETURN_IF_ERROR(pending.add(id));
   ++nextRequestId;
+  spdlog::debug("event=request_queued request={} kind={}", id,
+                std::holds_alternative<SimplifyRequest>(request) ? "simplify" : "impostor");
   requests.emplace(id, std::move(request));
   dispatch(Clock::now());
   return id;
@@ -96,7 +98,11 @@ Result<std::uint64_t> WorkerPool::Impl::submit(Message request) {
 
 bool WorkerPool::cancel(std::uint64_t requestId) {
   impl_->requests.erase(requestId);
-  return impl_->pending.cancel(requestId);
+  const bool known = impl_->pending.cancel(requestId);
+  // Every queued request ends in a result, request_failed or this line
+  // (deploy/fault-campaign accounts for each).
+  if (known) spdlog::debug("event=request_cancelled request={}", requestId);
+  return known;
 }
 
 void WorkerPool::Impl::fail(const std::vector<std::uint64_t>& ids, ErrorCode code,

@@ -185,6 +185,16 @@ void DaemonRuntime::addTransportOptions(TransportOptions* target) {
             "missed heartbeats before a peer is gone");
   addOption("transport.send_hwm", &target->sendHighWaterMark,
             "messages queued per peer before sends fail");
+  // CURVE (docs/protocol.md, "Security"): required beyond loopback.
+  addOption("transport.curve_key_file", &target->curve.keyFile,
+            "this daemon's CURVE key pair (thinlod-keys NAME writes NAME.key, mode 0600); "
+            "required to bind or connect beyond loopback, turns CURVE on for loopback too");
+  addOption("transport.curve_server_key_file", &target->curve.serverKeyFile,
+            "connecting daemons: the server's public key (its NAME.pub)");
+  addOption("transport.curve_authorized_keys_file", &target->curve.authorizedKeysFile,
+            "binding daemons: the public keys of the clients let in (.pub files concatenated)");
+  addOption("transport.curve_plaintext_remote", &target->curve.plaintextRemote,
+            "allow plain text (no CURVE) beyond loopback: isolated test networks only");
   impl_->afterParse.push_back([target, heartbeatMs] {
     target->heartbeatInterval = std::chrono::milliseconds(*heartbeatMs);
   });

@@ -243,6 +243,13 @@ int runServe(const std::vector<std::string>& args) {
   std::vector<const char*> argv = {"thinlod-simplifier serve"};
   for (const std::string& arg : args) argv.push_back(arg.c_str());
   if (auto exitCode = runtime.parse(static_cast<int>(argv.size()), argv.data())) return *exitCode;
+  // CURVE keys beyond loopback (docs/protocol.md, "Security"): fail before loading anything.
+  const Status secure = protocol::checkLinkSecurity(config.address, config.transport.curve,
+                                                    protocol::LinkSide::kConnect);
+  if (!secure.ok()) {
+    spdlog::error("event=bad_options error=\"{}\"", secure.toString());
+    return 2;
+  }
 
   const std::optional<render::Backend> backend = parseBackend(config.backend);
   if (!backend) {

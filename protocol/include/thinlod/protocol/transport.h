@@ -21,7 +21,13 @@
 //   the shutdown fd, use a Poller and poll(0ms) each member after wait().
 // - Errors are Status: bind/connect failures kInvalidArgument/kUnavailable;
 //   send to an unknown peer kNotFound; queue full kResourceExhausted;
-//   Channel::send before the handshake kUnavailable.
+//   Channel::send before the handshake kUnavailable; a non-loopback address
+//   without CURVE keys kInvalidArgument (the message names the option).
+// - CURVE (TransportOptions::curve): peers with a wrong key, no key or a key
+//   not in the authorized list never complete the ZMTP handshake, so they
+//   never reach the Hello; the refusal is logged (event=peer_refused by the
+//   ZAP handler, event=handshake_failed on both sides) and counted in
+//   TransportStats::handshakesFailed.
 // - Thread-safety: every object belongs to one thread (ZeroMQ sockets are
 //   not thread-safe). Several objects may live in one process.
 #pragma once
@@ -44,10 +50,31 @@ namespace thinlod::protocol {
 inline constexpr const char* kDefaultFrontendAddress = "tcp://127.0.0.1:5555";
 inline constexpr const char* kDefaultSimplifierAddress = "tcp://127.0.0.1:5556";
 
+// CURVE authentication and encryption (docs/protocol.md, "Security"; key
+// files: curve.h). Beyond loopback a binding side needs keyFile and
+// authorizedKeysFile, a connecting side keyFile and serverKeyFile, or bind /
+// connect fails naming the missing option. On loopback the same files turn
+// CURVE on; with none the link stays plain text.
+struct CurveOptions {
+  std::string keyFile;             // this daemon's key pair (NAME.key, mode 0600)
+  std::string serverKeyFile;       // connecting side: the server's public key (NAME.pub)
+  std::string authorizedKeysFile;  // binding side: the clients' public keys let in
+  bool plaintextRemote = false;    // allow plain text beyond loopback (isolated test networks)
+  bool enabled() const { return !keyFile.empty(); }
+};
+
+// The CURVE rules of Endpoint::bind / Channel::connect for `address`, with
+// their messages, without opening a socket (key files are loaded and
+// checked). Daemons call it right after parsing options, so a missing or
+// bad key fails at once rather than after loading a scene.
+enum class LinkSide { kBind, kConnect };
+Status checkLinkSecurity(const std::string& address, const CurveOptions& curve, LinkSide side);
+
 struct TransportOptions {
   std::chrono::milliseconds heartbeatInterval{500};
   int livenessMisses = 4;        // silent for heartbeatInterval * livenessMisses => gone
   int sendHighWaterMark = 1000;  // messages queued per peer before send fails
+  CurveOptions curve;
   std::chrono::milliseconds livenessTimeout() const { return heartbeatInterval * livenessMisses; }
 };
 
@@ -58,6 +85,7 @@ struct TransportStats {
   std::uint64_t bytesOut = 0;
   std::uint64_t malformedDropped = 0;   // failed decode or bad framing
   std::uint64_t unexpectedDropped = 0;  // valid but not allowed here (e.g. before Hello)
+  std::uint64_t handshakesFailed = 0;   // CURVE: ZMTP handshakes refused (wrong key, no key)
 };
 
 // Opaque handle of a peer as seen by an Endpoint; a restarted peer gets a new one.
