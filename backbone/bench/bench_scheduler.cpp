@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -310,20 +311,53 @@ void scaling(std::size_t minObjects, std::size_t maxObjects, std::size_t maxBoth
   }
 }
 
+// Every method of the scheduler catalogue (scheduler_registry.cpp, so a new
+// method is compared without editing this file) plus two published variants
+// of the seed methods, on the same small scenes; brute force is the optimum.
 void comparison(int scenes) {
   std::printf(
       "# comparison: %d random scenes of 4-7 objects (4 options each), polygon budget; "
-      "accuracy = lowest guaranteed absolute accuracy over visible objects (rad^-1)\n",
+      "accuracy = lowest guaranteed absolute accuracy over visible objects (rad^-1); every "
+      "method of schedulerCatalogue() plus aslod (alpha 3) and span-of-level-changed "
+      "(farthest first)\n",
       scenes);
   std::printf(
       "section,scheduler,scenes,mean_accuracy_vs_brute_force,min_accuracy_vs_brute_force,"
       "mean_triangles_vs_budget,over_budget_plans,mean_cpu_us\n");
-  const SchedulerConfig config = exactConfig();
-  auto curve = makeAccuracyCurveScheduler(config).value();
-  auto greedy = makeGreedyScheduler(config, GreedyConfig{}).value();
-  auto vrml = makeVrmlStaticScheduler(config, VrmlStaticConfig{}).value();
-  auto brute = makeBruteForceScheduler(config, BruteForceConfig{1e7}).value();
-  const Scheduler* all[] = {curve.get(), greedy.get(), vrml.get(), brute.get()};
+  SchedulerOptions options;
+  options.config = exactConfig();
+  options.bruteForce.maxCombinations = 1e7;
+  std::vector<std::unique_ptr<Scheduler>> all;
+  std::vector<std::string> labels;
+  std::unique_ptr<Scheduler> brute;
+  for (const SchedulerEntry& entry : schedulerCatalogue()) {
+    auto made = makeScheduler(entry.name, options);
+    if (!made.ok()) {
+      std::fprintf(stderr, "%s: %s\n", entry.name, made.status().toString().c_str());
+      std::exit(1);
+    }
+    if (std::string(entry.name) == "brute-force") {
+      brute = std::move(made).value();
+      continue;
+    }
+    all.push_back(std::move(made).value());
+    labels.push_back(entry.name);
+  }
+  if (!brute || all.empty() || labels.front() != "accuracy-curve") {
+    std::fprintf(stderr, "comparison: the catalogue lacks accuracy-curve or brute-force\n");
+    std::exit(1);
+  }
+  AslodSchedulerConfig alpha3;
+  alpha3.alpha = 3.0;
+  all.push_back(makeAslodScheduler(options.config, alpha3).value());
+  labels.push_back("aslod (alpha 3)");
+  SpanOfLevelChangedConfig farthest;
+  farthest.coarsenFarthestFirst = true;
+  all.push_back(makeSpanOfLevelChangedScheduler(options.config, farthest).value());
+  labels.push_back("span-of-level-changed (farthest first)");
+  all.push_back(std::move(brute));  // last: the optimum the others are divided by
+  labels.push_back("brute-force");
+  const std::size_t n = all.size();
   struct Sum {
     double ratio = 0.0;
     double worst = kInf;
@@ -331,7 +365,8 @@ void comparison(int scenes) {
     int over = 0;
     double micros = 0.0;
     int count = 0;
-  } sums[4];
+  };
+  std::vector<Sum> sums(n);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int used = 0;
@@ -346,10 +381,9 @@ void comparison(int scenes) {
     Budget budget;
     budget.maxTriangles = 40.0 * std::pow(50.0, u(rng));
     const ViewerState v = viewer({0, 0, 6.0}, {0, 0, -1}, 0.0, 0);
-    double best = 0.0;
-    Plan plans[4];
+    std::vector<Plan> plans(n);
     bool ok = true;
-    for (int s = 0; s < 4; ++s) {
+    for (std::size_t s = 0; s < n; ++s) {
       PlannerState state;
       const double t0 = now();
       auto plan = all[s]->plan(scene, v, budget, state);
@@ -363,8 +397,8 @@ void comparison(int scenes) {
     }
     if (!ok || plans[0].decisions.empty()) continue;
     ++used;
-    best = plans[3].achievedMinAccuracy;
-    for (int s = 0; s < 4; ++s) {
+    const double best = plans[n - 1].achievedMinAccuracy;
+    for (std::size_t s = 0; s < n; ++s) {
       const double ratio = plans[s].achievedMinAccuracy / best;
       sums[s].ratio += ratio;
       sums[s].worst = std::min(sums[s].worst, ratio);
@@ -374,9 +408,9 @@ void comparison(int scenes) {
       ++sums[s].count;
     }
   }
-  for (int s = 0; s < 4; ++s) {
+  for (std::size_t s = 0; s < n; ++s) {
     const Sum& x = sums[s];
-    std::printf("comparison,%s,%d,%.4f,%.4f,%.3f,%d,%.1f\n", all[s]->name(), x.count,
+    std::printf("comparison,%s,%d,%.4f,%.4f,%.3f,%d,%.1f\n", labels[s].c_str(), x.count,
                 x.ratio / std::max(1, x.count), x.worst, x.load / std::max(1, x.count), x.over,
                 x.micros / std::max(1, x.count));
   }

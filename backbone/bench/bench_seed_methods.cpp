@@ -1,19 +1,18 @@
 // bench_seed_methods: the two seed selection methods of issue 15.
 //
-// 1. Yu-Liang-Chen's multi-type experiment (section VI): 120 objects, 50
-//    cow-sized (5 804 faces; LODs 100/50/25/12/6 %), 40 armadillo-sized
-//    (345 944; 25 % .. 0.18 %) and 30 happy-Buddha-sized (1 087 716; 25 % ..
-//    0.18 %), as synthetic stand-ins (the selection needs only face counts),
-//    spread over a square; a circular fly-through. Per frame: faces in view
-//    (finest LOD of every visible object), the span-of-level-changed
-//    selection's sum 2^l against the budget M (eq. 3, the paper's literal
-//    measure), its level changes and SLC by object type, its selection time,
-//    and in the same run two baselines on the same input: the same selection
-//    by linear scan (must give identical levels) and the ASLOD allocation
-//    (real faces). Per-frame rows go to --csv; the summary to stdout.
-// 2. The scheduler comparison of bench_scheduler (100 random small scenes,
-//    polygon budget, accuracy relative to brute force) with aslod and
-//    span-of-level-changed beside accuracy-curve and greedy-fs93.
+// Yu-Liang-Chen's multi-type experiment (section VI): 120 objects, 50
+//   cow-sized (5 804 faces; LODs 100/50/25/12/6 %), 40 armadillo-sized
+//   (345 944; 25 % .. 0.18 %) and 30 happy-Buddha-sized (1 087 716; 25 % ..
+//   0.18 %), as synthetic stand-ins (the selection needs only face counts),
+//   spread over a square; a circular fly-through. Per frame: faces in view
+//   (finest LOD of every visible object), the span-of-level-changed
+//   selection's sum 2^l against the budget M (eq. 3, the paper's literal
+//   measure), its level changes and SLC by object type, its selection time,
+//   and in the same run two baselines on the same input: the same selection
+//   by linear scan (must give identical levels) and the ASLOD allocation
+//   (real faces). Per-frame rows go to --csv; the summary to stdout.
+// The comparison of every scheduler on small scenes against brute force
+// (aslod and span-of-level-changed included) is bench_scheduler's.
 // Fixed seeds; thread CPU time (the machine is shared).
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -280,96 +279,6 @@ bool multiTypeExperiment(int frames, double budget, int repeats, const std::stri
   return over == 0 && mismatches == 0;
 }
 
-// ----------------------------------------------- comparison (bench_scheduler)
-
-void comparison(int scenes) {
-  std::printf(
-      "# comparison: %d random scenes of 4-7 objects (4 options each), polygon budget; "
-      "accuracy = lowest guaranteed absolute accuracy over visible objects (rad^-1)\n",
-      scenes);
-  std::printf(
-      "comparison,scheduler,scenes,mean_accuracy_vs_brute_force,min_accuracy_vs_brute_force,"
-      "mean_triangles_vs_budget,over_budget_plans,mean_cpu_us\n");
-  SchedulerConfig paper;
-  paper.maxSpeed = 0.1;
-  paper.maxAngularSpeed = 0.5;
-  paper.plannedLifetime = 1.0;
-  const SchedulerConfig config = withoutApproximations(paper);
-  SchedulerOptions options;
-  options.config = config;
-  options.bruteForce.maxCombinations = 1e7;
-  std::vector<std::unique_ptr<Scheduler>> all;
-  for (const char* name : {"accuracy-curve", "greedy-fs93", "aslod", "span-of-level-changed"})
-    all.push_back(makeScheduler(name, options).value());
-  AslodSchedulerConfig fs;
-  fs.alpha = 3.0;
-  all.push_back(makeAslodScheduler(config, fs).value());
-  SpanOfLevelChangedConfig far;
-  far.coarsenFarthestFirst = true;
-  all.push_back(makeSpanOfLevelChangedScheduler(config, far).value());
-  all.push_back(makeScheduler("brute-force", options).value());
-  const char* labels[] = {"accuracy-curve",  "greedy-fs93",
-                          "aslod (alpha 1)", "span-of-level-changed (literal d)",
-                          "aslod (alpha 3)", "span-of-level-changed (farthest first)",
-                          "brute-force"};
-  const std::size_t n = all.size();
-  struct Sum {
-    double ratio = 0.0, worst = kInf, load = 0.0, micros = 0.0;
-    int over = 0, count = 0;
-  };
-  std::vector<Sum> sums(n);
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  int used = 0;
-  for (int i = 0; i < scenes; ++i) {
-    SyntheticSceneOptions o;
-    o.seed = 1000 + i;
-    o.objects = 4 + i % 4;
-    o.worldSize = 6.0;
-    o.minRadius = 0.1;
-    o.maxRadius = 0.6;
-    SchedulingScene scene = makeSyntheticScene(o).value();
-    Budget budget;
-    budget.maxTriangles = 40.0 * std::pow(50.0, u(rng));
-    ViewerState v;
-    v.position = {0, 0, 6.0};
-    v.viewDirection = {0, 0, -1};
-    std::vector<Plan> plans(n);
-    bool ok = true;
-    for (std::size_t s = 0; s < n; ++s) {
-      PlannerState state;
-      const double t0 = now();
-      auto plan = all[s]->plan(scene, v, budget, state);
-      const double micros = (now() - t0) * 1e6;
-      if (!plan.ok()) {
-        ok = false;  // brute force: the cheapest plan is over budget
-        break;
-      }
-      plans[s] = std::move(plan).value();
-      plans[s].row.schedulingMicroseconds = micros;
-    }
-    if (!ok || plans[0].decisions.empty()) continue;
-    ++used;
-    const double best = plans[n - 1].achievedMinAccuracy;
-    for (std::size_t s = 0; s < n; ++s) {
-      const double ratio = plans[s].achievedMinAccuracy / best;
-      sums[s].ratio += ratio;
-      sums[s].worst = std::min(sums[s].worst, ratio);
-      sums[s].load += plans[s].predictedTriangles / *budget.maxTriangles;
-      sums[s].over += plans[s].predictedTriangles > *budget.maxTriangles * (1 + 1e-12);
-      sums[s].micros += plans[s].row.schedulingMicroseconds;
-      ++sums[s].count;
-    }
-  }
-  for (std::size_t s = 0; s < n; ++s) {
-    const Sum& x = sums[s];
-    std::printf("comparison,%s,%d,%.4f,%.4f,%.3f,%d,%.1f\n", labels[s], x.count,
-                x.ratio / std::max(1, x.count), x.worst, x.load / std::max(1, x.count), x.over,
-                x.micros / std::max(1, x.count));
-  }
-  std::printf("# %d of %d scenes had a feasible plan without dropping objects\n", used, scenes);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -377,19 +286,15 @@ int main(int argc, char** argv) {
   int frames = 240;
   double budget = 1e6;
   int repeats = 20;
-  int scenes = 100;
   std::string csvPath = "seed-methods-frames.csv";
   app.add_option("--frames", frames, "frames of the multi-type fly-through")
       ->check(CLI::Range(1, 100000));
   app.add_option("--budget", budget, "M of eq. 3: sum 2^l per frame")->check(CLI::Range(1.0, 1e15));
   app.add_option("--repeats", repeats, "timed repetitions of each selection per frame")
       ->check(CLI::Range(1, 100000));
-  app.add_option("--scenes", scenes, "small scenes in the scheduler comparison")
-      ->check(CLI::Range(1, 100000));
   app.add_option("--csv", csvPath, "per-frame rows of the fly-through");
   CLI11_PARSE(app, argc, argv);
   const bool ok = multiTypeExperiment(frames, budget, repeats, csvPath);
-  comparison(scenes);
   if (!ok) std::fprintf(stderr, "bench_seed_methods: budget broken or heap/scan mismatch\n");
   return ok ? 0 : 1;
 }

@@ -44,7 +44,11 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
 
   state.stepCandidates.reset();
   std::vector<LeafSelection> selections;
-  if (config.reuseLeafWork) selections.reserve(state.lastSelectionCount);  // no regrowth copies
+  if (config.reuseLeafWork) {
+    selections.swap(state.spareSelections);  // last step's storage: no allocation, no page faults
+    selections.clear();
+    selections.reserve(state.lastSelectionCount);  // no regrowth copies
+  }
   double target = budget.fixedAccuracy.value_or(kInf);
   bool useSolver = hard.useTriangles && hard.useLink;
   if (!useSolver) {

@@ -34,33 +34,23 @@ struct VisibleLeaf {
   double projectedArea;
 };
 
-// The leaves the methods decide on: LOD nodes resolved to their first
-// eligible level (as greedy-fs93 does: these methods know objects, not LOD
-// nodes); leaves without any eligible candidate are reported unrendered.
+// The leaves the methods decide on (visibleLeaves: LOD nodes resolved to
+// their first eligible level, as greedy-fs93 does); leaves without any
+// eligible candidate are reported unrendered.
 std::vector<VisibleLeaf> collectLeaves(const VisibleTree& tree, const SchedulingScene& scene,
                                        std::vector<LeafSelection>& unrendered) {
   std::vector<VisibleLeaf> leaves;
-  std::vector<std::uint32_t> stack;
-  if (!tree.nodes.empty()) stack.push_back(0);
-  while (!stack.empty()) {
-    const std::uint32_t k = stack.back();
-    stack.pop_back();
+  for (const std::uint32_t k : visibleLeaves(tree, ChildOrder::kFirstChildFirst)) {
     const VisibleNode& n = tree.nodes[k];
-    if (n.kind == SceneNodeKind::kLeaf) {
-      const std::uint32_t object = scene.nodes[n.sceneNode].object;
-      if (n.candidates.empty()) {
-        LeafSelection s;
-        s.node = n.sceneNode;
-        s.object = object;
-        unrendered.push_back(s);
-        continue;
-      }
-      leaves.push_back({k, object, sphereSolidAngle(0.5 * n.diameter, n.distance)});
-    } else if (n.kind == SceneNodeKind::kGroup) {
-      for (auto it = n.children.rbegin(); it != n.children.rend(); ++it) stack.push_back(*it);
-    } else if (!n.children.empty()) {
-      stack.push_back(n.children.front());
+    const std::uint32_t object = scene.nodes[n.sceneNode].object;
+    if (n.candidates.empty()) {
+      LeafSelection s;
+      s.node = n.sceneNode;
+      s.object = object;
+      unrendered.push_back(s);
+      continue;
     }
+    leaves.push_back({k, object, sphereSolidAngle(0.5 * n.diameter, n.distance)});
   }
   return leaves;
 }

@@ -166,27 +166,17 @@ Result<Selection> GreedyMethod::select(const SelectionStep& step) const {
   std::vector<LeafSelection>& selections = selection.leaves;
   std::vector<Item> items;
   // LOD nodes: FS93 has one object with levels; an LOD is resolved to its
-  // first eligible level here, whose leaves become objects.
-  std::vector<std::uint32_t> stack;
-  if (!tree.nodes.empty()) stack.push_back(0);
-  while (!stack.empty()) {
-    const std::uint32_t k = stack.back();
-    stack.pop_back();
+  // first eligible level, whose leaves become objects.
+  for (const std::uint32_t k : visibleLeaves(tree, ChildOrder::kLastChildFirst)) {
     const VisibleNode& n = tree.nodes[k];
-    if (n.kind == SceneNodeKind::kLeaf) {
-      if (n.candidates.empty()) {
-        reportUnrenderable(tree, scene, k, selections);
-        continue;
-      }
-      Item item;
-      item.treeNode = k;
-      addLevels(n, item);
-      items.push_back(std::move(item));
-    } else if (n.kind == SceneNodeKind::kGroup) {
-      for (std::uint32_t c : n.children) stack.push_back(c);
-    } else if (!n.children.empty()) {
-      stack.push_back(n.children.front());
+    if (n.candidates.empty()) {
+      reportUnrenderable(tree, scene, k, selections);
+      continue;
     }
+    Item item;
+    item.treeNode = k;
+    addLevels(n, item);
+    items.push_back(std::move(item));
   }
   const double cap = *step.budget.maxTriangles;
   double used = 0.0;

@@ -491,9 +491,15 @@ LeafSelection CurvePropagator::decideLeaf(std::uint32_t n, std::uint32_t object,
   }
   double need = std::min(absoluteAccuracy * diameter / distance, relativeCap);
   need = std::min(need, bestCandidateAccuracy(scratch_));
-  int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
+  if (!config_.reuseLeafWork) {  // reference path, as before
+    const int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles);
+    if (pick < 0) return unrenderedLeaf(n);
+    return makeSelection(n, object, scratch_[pick], need, distance, diameter);
+  }
+  CandidateCost cost;
+  const int pick = pickCandidate(scratch_, need, resource_ == Resource::kTriangles, &cost);
   if (pick < 0) return unrenderedLeaf(n);
-  return makeSelection(n, object, scratch_[pick], need, distance, diameter);
+  return makeSelection(n, object, scratch_[pick], need, distance, diameter, cost);
 }
 
 }  // namespace thinlod::backbone

@@ -26,6 +26,7 @@ JointSolver::JointSolver(const SchedulingScene& scene, const SchedulerConfig& co
   scalarT_.assign(nodes_.size(), 0.0);
   scalarL_.assign(nodes_.size(), 0.0);
   scalarPick_.assign(nodes_.size(), -1);
+  invariant_.assign(nodes_.size(), 0);
   costTriangles_.assign(candidates_.size(), 0.0);
   costLink_.assign(candidates_.size(), 0.0);
   levelOk_.assign(children_.size(), 0);
@@ -253,6 +254,13 @@ bool scalarBetter(double t1, double l1, double t2, double l2, double w) {
 }  // namespace
 
 void JointSolver::scalarPass(std::uint32_t k, double weight, double& triangles, double& link) {
+  if (invariantReady_ && invariant_[k]) {
+    // Same totals and pick for every weight (see markInvariant): the values
+    // the full recursion would compute again, bit for bit.
+    triangles = scalarT_[k];
+    link = scalarL_[k];
+    return;
+  }
   const Node& n = nodes_[k];
   double t = 0.0;
   double l = 0.0;
@@ -297,6 +305,42 @@ void JointSolver::scalarPass(std::uint32_t k, double weight, double& triangles, 
   scalarPick_[k] = pick;
   triangles = t;
   link = l;
+  if (config_.reuseLeafWork && !invariantReady_) markInvariant(k, t, l);
+}
+
+// A node's choice is the same for every weight w >= 0 (infinity included)
+// when its pick is at most every alternative in both resources: then
+// t + w l of the pick is <= that of each alternative in floating point too
+// (rounding is monotone), and scalarBetter's ties (triangles, then bytes,
+// then the earlier index) keep the same pick. A leaf: its picked candidate
+// against the others; a group: every child invariant (same sums in the
+// same order); an LOD: every qualifying level invariant and the picked
+// level dominating the others. Set by the first pass after prepareCosts
+// (the costs of one accuracy), read by the later passes of that accuracy.
+void JointSolver::markInvariant(std::uint32_t k, double t, double l) {
+  const Node& n = nodes_[k];
+  scalarT_[k] = t;
+  scalarL_[k] = l;
+  bool invariant = true;
+  if (n.maxAccuracy != -kInf) {
+    if (n.kind == SceneNodeKind::kLeaf) {
+      for (std::uint32_t i = 0; i < n.candidateCount && invariant; ++i) {
+        const std::uint32_t c = n.firstCandidate + i;
+        if (std::isnan(costTriangles_[c])) continue;
+        invariant = t <= costTriangles_[c] && l <= costLink_[c];
+      }
+    } else if (n.kind == SceneNodeKind::kLod) {
+      for (std::uint32_t c = 0; c < n.childCount && invariant; ++c) {
+        if (!levelOk_[n.firstChild + c]) continue;
+        const std::uint32_t child = children_[n.firstChild + c];
+        invariant = invariant_[child] && t <= scalarT_[child] && l <= scalarL_[child];
+      }
+    } else {
+      for (std::uint32_t c = 0; c < n.childCount && invariant; ++c)
+        invariant = invariant_[children_[n.firstChild + c]];
+    }
+  }
+  invariant_[k] = invariant;
 }
 
 JointSolver::Verdict JointSolver::lagrangianScreen(double& certificateWeight) {
@@ -307,6 +351,7 @@ JointSolver::Verdict JointSolver::lagrangianScreen(double& certificateWeight) {
   double t = 0.0;
   double l = 0.0;
   scalarPass(root, 0.0, t, l);  // fewest triangles
+  invariantReady_ = config_.reuseLeafWork;
   if (!(t <= bt)) return Verdict::kInfeasible;
   if (fits(t, l)) {
     certificateWeight = 0.0;
@@ -364,6 +409,7 @@ void JointSolver::extractScalar(std::uint32_t k, double accuracy, double weight,
   }
 }
 
+// Precondition: prepareCosts(root, accuracy) ran last (feasible() does it).
 bool JointSolver::paretoFeasible(double accuracy) {
   ++stats_.paretoPasses;
   ++paretoPasses_;
@@ -386,7 +432,17 @@ JointSolver::Span JointSolver::evaluate(std::uint32_t k, double accuracy, double
     const double x = clamped * n.diameter / n.distance;
     const std::uint32_t begin = static_cast<std::uint32_t>(arena_.size());
     for (std::uint32_t i = 0; i < n.candidateCount; ++i) {
-      const LeafCandidate& c = candidates_[n.firstCandidate + i];
+      const std::uint32_t at = n.firstCandidate + i;
+      const LeafCandidate& c = candidates_[at];
+      if (config_.reuseLeafWork) {
+        // feasible() prepared this accuracy's costs just before (same
+        // clamping down the tree, NaN exactly where the test below fails):
+        // the same numbers without two curve look-ups per candidate.
+        if (std::isnan(costTriangles_[at])) continue;
+        arena_.push_back({costTriangles_[at], costLink_[at], static_cast<std::int32_t>(i), -1,
+                          candidateSourceRank(c.source)});
+        continue;
+      }
       if (!(c.maxRelativeAccuracy >= x * (1.0 - kAccuracyTolerance))) continue;
       const CandidateCost cost = candidateCost(c, std::min(x, c.maxRelativeAccuracy));
       arena_.push_back({cost.triangles, cost.linkBytes, static_cast<std::int32_t>(i), -1,
@@ -475,6 +531,7 @@ bool JointSolver::feasible(double accuracy) {
   if (root_ < 0) return true;
   const std::uint32_t root = static_cast<std::uint32_t>(root_);
   prepareCosts(root, accuracy);
+  invariantReady_ = false;  // the next scalar pass marks the weight-invariant nodes anew
   computeMinima(root);
   if (budget_.useTriangles && !(minTriangles_[root] <= budget_.triangles)) return false;
   if (budget_.useLink && !(minLink_[root] <= budget_.linkBytes)) return false;

@@ -92,6 +92,9 @@ class JointSolver {
   // Totals of the choice minimising triangles + weight * link (weight
   // +infinity: link first); from prepared costs.
   void scalarPass(std::uint32_t k, double weight, double& triangles, double& link);
+  // reuseLeafWork: records node k's totals and whether its choice is the
+  // same for every weight (then later passes of this accuracy reuse them).
+  void markInvariant(std::uint32_t k, double t, double l);
   void extractScalar(std::uint32_t k, double accuracy, double weight,
                      std::vector<LeafSelection>& out);
   enum class Verdict : std::uint8_t { kFeasible, kInfeasible, kUnknown };
@@ -124,6 +127,8 @@ class JointSolver {
   std::vector<double> scalarT_;
   std::vector<double> scalarL_;
   std::vector<std::int32_t> scalarPick_;  // leaf: candidate; LOD: child position
+  std::vector<std::uint8_t> invariant_;   // per node: choice independent of the weight
+  bool invariantReady_ = false;           // invariant_ / scalarT_ / scalarL_ hold this accuracy's
   int paretoPasses_ = 0;
   // How the last feasible() call decided: a scalar weight, or Pareto.
   bool lastByScalar_ = false;

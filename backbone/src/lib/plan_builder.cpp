@@ -104,7 +104,8 @@ int candidateSourceRank(CandidateSource source) {
   return 4;
 }
 
-int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst) {
+int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst,
+                  CandidateCost* pickedCost) {
   int best = -1;
   CandidateCost bestCost;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
@@ -127,6 +128,7 @@ int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, boo
     best = static_cast<int>(i);
     bestCost = cost;
   }
+  if (pickedCost && best >= 0) *pickedCost = bestCost;
   return best;
 }
 
@@ -151,6 +153,13 @@ double lowestCandidateAccuracy(const std::vector<LeafCandidate>& candidates) {
 LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
                             const LeafCandidate& candidate, double need, double distance,
                             double diameter) {
+  return makeSelection(node, object, candidate, need, distance, diameter,
+                       candidateCost(candidate, need));
+}
+
+LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
+                            const LeafCandidate& candidate, double need, double distance,
+                            double diameter, const CandidateCost& cost) {
   LeafSelection s;
   s.node = node;
   s.object = object;
@@ -175,13 +184,17 @@ LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
                              ? candidate.representation->atBackbone.relativeAccuracy
                              : candidate.maxRelativeAccuracy;  // pending: credited value
   }
-  // Exactly what the solvers charged (flat left of the curve, so the same
-  // as at frameAccuracy when both curves share their domain).
-  s.cost = candidateCost(candidate, need);
+  // Exactly what the solvers charged, candidateCost(candidate, need) (flat
+  // left of the curve, so the same as at frameAccuracy when both curves
+  // share their domain).
+  s.cost = cost;
   return s;
 }
 
 const std::vector<PendingCopy>* pendingFor(const PlannerStateImpl& state, std::uint32_t object) {
+  // Nothing in flight (a standing or steadily served viewer): no hash and no
+  // bucket read per leaf (the bucket array keeps its size once grown).
+  if (state.pending.empty()) return nullptr;
   auto it = state.pending.find(object);
   return it == state.pending.end() ? nullptr : &it->second;
 }
@@ -258,7 +271,6 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
   const double belowLimit = targetAccuracy * (1.0 - 1e-9);
 
   for (LeafSelection& s : selections) {
-    const Sphere& bounds = ctx.scene.nodes[s.node].bounds;
     if (!s.rendered) {
       if (s.dropped) {
         plan.dropped.push_back(s.object);
@@ -319,7 +331,7 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
           ++sends;
           break;
         }
-        const CurrentCopy current = currentCopy(ctx, s.object, bounds);
+        const CurrentCopy current = currentCopy(ctx, s.object, ctx.scene.nodes[s.node].bounds);
         RepresentationRequest r;
         r.requestId = id;
         r.object = s.object;

@@ -1,4 +1,5 @@
 #include "planner_state_impl.h"
+#include "selection.h"  // LeafSelection, complete for spareSelections
 
 namespace thinlod::backbone {
 

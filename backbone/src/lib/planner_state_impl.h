@@ -11,6 +11,8 @@
 
 namespace thinlod::backbone {
 
+struct LeafSelection;  // selection.h (PlannerStateImpl is built and destroyed in planner_state.cpp)
+
 // Absolute curve of a node for exactly one predicted region (reused only
 // when the region, the subtree and the in-flight requests are unchanged).
 // Entries of a subtree are written in the same pass as their ancestor, so a
@@ -104,6 +106,10 @@ struct PlannerStateImpl {
   StepCandidates stepCandidates;
   EvaluatedCandidates evaluatedCandidates;
   std::size_t lastSelectionCount = 0;  // capacity hint for the next step's selections
+  // The previous step's selection vector, handed back by the frame after
+  // the plan is built (scheduler.cpp), so a method reusing leaf work does
+  // not allocate (and page-fault in) megabytes of selections every step.
+  std::vector<LeafSelection> spareSelections;  // complete in selection.h
   std::vector<DeferredLeaf> deferredLeaves;
   std::vector<DeferredLeaf> deferredSorted;  // radix-sort buffer
   std::uint64_t pendingGeneration = 1;

@@ -85,6 +85,8 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
 
   PlanContext context{scene, seen, viewer, region, state};
   finishPlan(context, selection.leaves, target, plan);
+  // The selections are consumed: keep their storage for the next step.
+  state.spareSelections = std::move(selection.leaves);
   plan.row.schedulingMicroseconds =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
   return plan;

@@ -35,7 +35,9 @@ struct LeafSelection {
 int candidateSourceRank(CandidateSource source);
 // Index of the cheapest candidate reaching `need` (primary resource first,
 // then the other, then copies before new ones, then option order), or -1.
-int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst);
+// `pickedCost` (optional) receives candidateCost(pick, need).
+int pickCandidate(const std::vector<LeafCandidate>& candidates, double need, bool trianglesFirst,
+                  CandidateCost* pickedCost = nullptr);
 // Highest maxRelativeAccuracy among candidates (-infinity when none).
 double bestCandidateAccuracy(const std::vector<LeafCandidate>& candidates);
 // Lowest accuracy any candidate is defined from (left end of its curve).
@@ -44,6 +46,11 @@ double lowestCandidateAccuracy(const std::vector<LeafCandidate>& candidates);
 LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
                             const LeafCandidate& candidate, double need, double distance,
                             double diameter);
+// The same with candidateCost(candidate, need) already known (pickCandidate
+// computed it): identical result, two curve look-ups fewer.
+LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
+                            const LeafCandidate& candidate, double need, double distance,
+                            double diameter, const CandidateCost& cost);
 
 // Book-keeping before planning: resets caches when the scene shape or the
 // config changed, retires confirmed/expired in-flight requests, trims the link

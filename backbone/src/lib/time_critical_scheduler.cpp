@@ -96,20 +96,8 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
                                 step.viewer.verticalFov};
 
   std::vector<Item> items;
-  std::vector<std::uint32_t> stack;
-  if (!tree.nodes.empty()) stack.push_back(0);
-  while (!stack.empty()) {
-    const std::uint32_t k = stack.back();
-    stack.pop_back();
+  for (const std::uint32_t k : visibleLeaves(tree, ChildOrder::kLastChildFirst)) {
     const VisibleNode& n = tree.nodes[k];
-    if (n.kind == SceneNodeKind::kGroup) {
-      for (std::uint32_t c : n.children) stack.push_back(c);
-      continue;
-    }
-    if (n.kind == SceneNodeKind::kLod) {
-      if (!n.children.empty()) stack.push_back(n.children.front());
-      continue;
-    }
     if (n.candidates.empty()) {
       reportUnrenderable(tree, scene, k, out);
       continue;

@@ -73,6 +73,30 @@ VisibleTree buildVisibleTree(const SchedulingScene& scene, const SchedulerConfig
   return tree;
 }
 
+std::vector<std::uint32_t> visibleLeaves(const VisibleTree& tree, ChildOrder order) {
+  std::vector<std::uint32_t> leaves;
+  leaves.reserve(tree.leafCount);
+  std::vector<std::uint32_t> stack;
+  if (!tree.nodes.empty()) stack.push_back(0);
+  while (!stack.empty()) {
+    const std::uint32_t k = stack.back();
+    stack.pop_back();
+    const VisibleNode& n = tree.nodes[k];
+    if (n.kind == SceneNodeKind::kLeaf) {
+      leaves.push_back(k);
+    } else if (n.kind == SceneNodeKind::kGroup) {
+      if (order == ChildOrder::kFirstChildFirst) {
+        stack.insert(stack.end(), n.children.rbegin(), n.children.rend());
+      } else {
+        stack.insert(stack.end(), n.children.begin(), n.children.end());
+      }
+    } else if (!n.children.empty()) {
+      stack.push_back(n.children.front());  // an LOD: its first eligible level
+    }
+  }
+  return leaves;
+}
+
 void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
                         std::vector<LeafSelection>& out) {
   const VisibleNode& n = tree.nodes[k];

@@ -28,6 +28,22 @@ VisibleTree buildVisibleTree(const SchedulingScene& scene, const SchedulerConfig
                              const PredictedRegion& region, const PlannerStateImpl& state,
                              PlanStats& stats);
 
+// The order in which a group's visible children are walked by
+// visibleLeaves (each method keeps the order its plans were made in: the
+// order decides ties and the order of the plan's decisions).
+enum class ChildOrder : std::uint8_t {
+  kFirstChildFirst,  // preorder
+  kLastChildFirst,   // a stack pushing children in order: last child first
+};
+
+// The leaves the object-level methods (greedy-fs93, aslod,
+// span-of-level-changed, active-set) decide on, as tree node indices in walk
+// order: a group descends into every visible child, an LOD only into its
+// first eligible level (these methods know objects with levels, not LOD
+// nodes). Leaves without any candidate are included; the caller reports
+// them unrendered. An LOD without an eligible level contributes nothing.
+std::vector<std::uint32_t> visibleLeaves(const VisibleTree& tree, ChildOrder order);
+
 // Every leaf below tree node k as an unrendered LeafSelection (a subtree
 // that renders nothing), groups recursively, LODs not descended.
 void reportUnrenderable(const VisibleTree& tree, const SchedulingScene& scene, std::uint32_t k,
