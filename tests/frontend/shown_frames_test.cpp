@@ -75,18 +75,22 @@ TEST(ShownFrames, AFrameShownLateIsScoredAgainstThePoseItWasDrawnFor) {
   // representations): scored against p2, it is not perfect.
   ASSERT_TRUE(log.record(2, p2, 260 * kMs, pictureOf(p1), nullptr));
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
+  Result<std::vector<FrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok()) << scores.status().toString();
   ASSERT_EQ(scores->size(), 3u);
   EXPECT_EQ(references.asked, (std::vector<double>{0.0, 0.1, 0.2}));
   EXPECT_EQ((*scores)[1].frame, 1u);
-  EXPECT_TRUE(std::isinf((*scores)[1].snrDb) && (*scores)[1].snrDb > 0) << (*scores)[1].snrDb;
+  EXPECT_TRUE(std::isinf((*scores)[1].quality.snrDb) && (*scores)[1].quality.snrDb > 0)
+      << (*scores)[1].quality.snrDb;
   const double staleVsOwnPose = compareFrames(pictureOf(p1), pictureOf(p2))->snrDb;
   EXPECT_TRUE(std::isfinite(staleVsOwnPose));
-  EXPECT_DOUBLE_EQ((*scores)[2].snrDb, staleVsOwnPose);
-  EXPECT_DOUBLE_EQ((*scores)[2].psnrDb, compareFrames(pictureOf(p1), pictureOf(p2))->psnrDb);
-  EXPECT_DOUBLE_EQ((*scores)[2].referenceMs, 7.5);
-  EXPECT_FALSE((*scores)[2].blank);
+  EXPECT_DOUBLE_EQ((*scores)[2].quality.snrDb, staleVsOwnPose);
+  EXPECT_DOUBLE_EQ((*scores)[2].quality.psnrDb,
+                   compareFrames(pictureOf(p1), pictureOf(p2))->psnrDb);
+  EXPECT_DOUBLE_EQ((*scores)[2].quality.referenceMs, 7.5);
+  EXPECT_EQ((*scores)[2].quality.blank, 0);
+  EXPECT_EQ((*scores)[2].quality.visibleObjects, -1);  // no coverage: not measured
+  EXPECT_EQ((*scores)[2].quality.missingObjects, -1);
 }
 
 TEST(ShownFrames, TheSinkSeesEachShownFrameWithItsOwnReference) {
@@ -98,7 +102,7 @@ TEST(ShownFrames, TheSinkSeesEachShownFrameWithItsOwnReference) {
   std::vector<std::uint64_t> frames;
   std::vector<bool> referenceIsOwnPose;
   const auto sink = [&](const ShownFrame& shown, const RgbaImage& reference,
-                        const ShownFrameScore& score) {
+                        const FrameScore& score) {
     frames.push_back(shown.frame);
     EXPECT_EQ(score.frame, shown.frame);
     referenceIsOwnPose.push_back(reference.pixels == pictureOf(shown.pose).pixels);
@@ -128,7 +132,7 @@ TEST(ShownFrames, AReferenceFailureNamesTheFrame) {
   log.record(5, poseAt(0.3, 1.0f), 0, pictureOf(poseAt(0.3, 1.0f)), nullptr);
   FakeReferences references;
   references.failAtTime = 0.3;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
+  Result<std::vector<FrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_FALSE(scores.ok());
   EXPECT_EQ(scores.status().code(), ErrorCode::kInternal);
   EXPECT_NE(scores.status().message().find("shown frame 5"), std::string::npos)
@@ -139,7 +143,7 @@ TEST(ShownFrames, AShownFrameOfADifferentSizeIsAnError) {
   ShownFrameLog log(std::size_t{1} << 20);
   log.record(3, poseAt(0.0, 1.0f), 0, RgbaImage(kW + 1, kH), nullptr);
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
+  Result<std::vector<FrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_FALSE(scores.ok());
   EXPECT_EQ(scores.status().code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(scores.status().message().find("frame 3"), std::string::npos);
@@ -149,15 +153,15 @@ TEST(ShownFrames, AUniformFrameIsBlankOnlyWhenTheReferenceIsNot) {
   ShownFrameLog log(std::size_t{1} << 20);
   log.record(0, poseAt(0.0, 1.0f), 0, RgbaImage(kW, kH), nullptr);  // all black
   FakeReferences references;
-  Result<std::vector<ShownFrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
+  Result<std::vector<FrameScore>> scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok());
-  EXPECT_TRUE((*scores)[0].blank);
-  EXPECT_TRUE(std::isinf((*scores)[0].snrDb) && (*scores)[0].snrDb < 0);
+  EXPECT_EQ((*scores)[0].quality.blank, 1);
+  EXPECT_TRUE(std::isinf((*scores)[0].quality.snrDb) && (*scores)[0].quality.snrDb < 0);
   references.uniform = true;  // nothing in view: a black frame is right
   scores = scoreShownFrames(log.frames(), references, {}, 16);
   ASSERT_TRUE(scores.ok());
-  EXPECT_FALSE((*scores)[0].blank);
-  EXPECT_EQ((*scores)[0].snrDb, 0.0);
+  EXPECT_EQ((*scores)[0].quality.blank, 0);
+  EXPECT_EQ((*scores)[0].quality.snrDb, 0.0);
 }
 
 TEST(ShownFrames, CoverageColoursRoundTripThroughAnRgba8Image) {
@@ -212,11 +216,10 @@ TEST(ShownFrames, CompletenessCountsCoveredGroupsWithNothingHeld) {
   log.record(0, poseAt(0.0, 1.0f), 0, pictureOf(poseAt(0.0, 1.0f)), held({1, 2, 4}));
   FakeReferences references;
   references.coverage = covered;
-  Result<std::vector<ShownFrameScore>> scores =
-      scoreShownFrames(log.frames(), references, objects, 16);
+  Result<std::vector<FrameScore>> scores = scoreShownFrames(log.frames(), references, objects, 16);
   ASSERT_TRUE(scores.ok());
-  EXPECT_EQ((*scores)[0].completeness.visibleGroups, 3u);
-  EXPECT_EQ((*scores)[0].completeness.missingGroups, 0u);
+  EXPECT_EQ((*scores)[0].quality.visibleObjects, 3);
+  EXPECT_EQ((*scores)[0].quality.missingObjects, 0);
 }
 
 TEST(ShownFrames, DifferenceImageIsTheAbsoluteDifferencePerChannel) {

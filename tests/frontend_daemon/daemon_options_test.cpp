@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace thinlod::frontend::daemon {
 namespace {
 
@@ -41,9 +43,9 @@ TEST(DaemonOptions, APoseStreamCannotBeUnpaced) {
   DaemonOptions options = validOptions();
   options.tracePath.clear();
   options.poseStreamPath = "poses.fifo";
-  options.rate = -1.0;
+  options.replay.rate = -1.0;
   expectRejected(options, "rate");
-  options.rate = 30.0;
+  options.replay.rate = 30.0;
   EXPECT_TRUE(validateOptions(options).ok());
 }
 
@@ -57,16 +59,16 @@ TEST(DaemonOptions, SceneIsRequiredOnlyForTheReference) {
 
 TEST(DaemonOptions, OutOfRangeValuesAreNamed) {
   DaemonOptions options = validOptions();
-  options.width = 0;
+  options.gl.width = 0;
   expectRejected(options, "width");
   options = validOptions();
-  options.height = 20000;
+  options.gl.height = 20000;
   expectRejected(options, "height");
   options = validOptions();
   options.backend = "vulkan";
   expectRejected(options, "backend");
   options = validOptions();
-  options.rate = std::nan("");
+  options.replay.rate = std::nan("");
   expectRejected(options, "rate");
   options = validOptions();
   options.lockstepTimeoutMs = 0;
@@ -87,6 +89,42 @@ TEST(DaemonOptions, BackendNames) {
   EXPECT_EQ(parseBackend("egl").value(), render::Backend::kEgl);
   EXPECT_EQ(parseBackend("osmesa").value(), render::Backend::kOsMesa);
   EXPECT_FALSE(parseBackend("EGL").ok());
+}
+
+TEST(DaemonOptions, FinishingConvertsEachOptionIntoTheStructItConfigures) {
+  DaemonOptions options = validOptions();
+  // Untouched, the converted values are the structs' own defaults.
+  DaemonOptions defaults = options;
+  finishOptions(defaults);
+  EXPECT_EQ(defaults.gl.backend, GlProducerOptions{}.backend);
+  EXPECT_EQ(defaults.gl.uploadBytesPerFrame, GlProducerOptions{}.uploadBytesPerFrame);
+  EXPECT_EQ(defaults.gl.maxKeptBytes, GlProducerOptions{}.maxKeptBytes);
+  EXPECT_EQ(defaults.gl.visibleMinPixels, GlProducerOptions{}.visibleMinPixels);
+  EXPECT_EQ(defaults.replay.lockstepTimeout, ReplayOptions{}.lockstepTimeout);
+  EXPECT_EQ(defaults.replay.maxFrames, ReplayOptions{}.maxFrames);
+  EXPECT_EQ(defaults.replay.measure, ReplayOptions{}.measure);
+  EXPECT_EQ(defaults.replay.viewportWidth, static_cast<std::uint32_t>(GlProducerOptions{}.width));
+
+  options.backend = "osmesa";
+  options.maxUploadBytesPerFrame = 0;  // unbounded
+  options.deferredReferenceMaxMb = 3;
+  options.visibleMinPixels = 40;
+  options.lockstepTimeoutMs = 250;
+  options.frames = 7;
+  options.noReference = true;
+  options.gl.width = 320;
+  options.gl.height = 200;
+  ASSERT_TRUE(validateOptions(options).ok());
+  finishOptions(options);
+  EXPECT_EQ(options.gl.backend, render::Backend::kOsMesa);
+  EXPECT_EQ(options.gl.uploadBytesPerFrame, std::numeric_limits<std::size_t>::max());
+  EXPECT_EQ(options.gl.maxKeptBytes, std::size_t{3} << 20);
+  EXPECT_EQ(options.gl.visibleMinPixels, 40u);
+  EXPECT_EQ(options.replay.lockstepTimeout, std::chrono::milliseconds(250));
+  EXPECT_EQ(options.replay.maxFrames, 7u);
+  EXPECT_FALSE(options.replay.measure);
+  EXPECT_EQ(options.replay.viewportWidth, 320u);
+  EXPECT_EQ(options.replay.viewportHeight, 200u);
 }
 
 }  // namespace

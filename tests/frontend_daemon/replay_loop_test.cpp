@@ -125,6 +125,8 @@ class SceneProducer final : public FrameProducer {
   FakeClock& clock_;
 };
 
+// Collects the records the loop hands on; deferred scores are merged by a
+// real FrameLog (no CSV), as the daemon does.
 class RecordingObserver final : public ReplayObserver {
  public:
   void onUpdateRejected(const protocol::SceneUpdate& update, const Status& why) override {
@@ -132,14 +134,54 @@ class RecordingObserver final : public ReplayObserver {
     reasons.push_back(why.message());
   }
   void onLockstepTimeout(std::uint64_t frame, double) override { timeouts.push_back(frame); }
-  void onFrame(const FrameRecord& record, const FrameExtras&) override {
+  void onFrame(const FrameRecord& record, bool scorePending) override {
     frames.push_back(record.frame);
+    pendingDuringReplay.push_back(scorePending);
+    snrDuringReplay.push_back(record.quality.snrDb);
+    if (scorePending) {
+      EXPECT_TRUE(log->addPending(record).ok());
+    } else {
+      records.push_back(record);
+    }
+  }
+  void onFramesScored(const std::vector<FrameScore>& scores) override {
+    ++scoredCalls;
+    EXPECT_TRUE(log->applyScores(scores,
+                                 [this](const FrameRecord& record) {
+                                   records.push_back(record);
+                                   scoredFrames.push_back(record.frame);
+                                   scoredSnr.push_back(record.quality.snrDb);
+                                   missing.push_back(record.quality.missingObjects);
+                                 })
+                    .ok());
   }
   std::vector<std::uint64_t> rejectedPlans;
   std::vector<std::string> reasons;
   std::vector<std::uint64_t> timeouts;
   std::vector<std::uint64_t> frames;
+  std::vector<FrameRecord> records;  // finished: scored or never pending
+  std::vector<bool> pendingDuringReplay;
+  std::vector<double> snrDuringReplay;
+  int scoredCalls = 0;
+  std::vector<std::uint64_t> scoredFrames;
+  std::vector<double> scoredSnr;
+  std::vector<long> missing;
+  std::unique_ptr<FrameLog> log = std::move(FrameLog::open("")).value();
 };
+using ScoreObserver = RecordingObserver;
+
+// The loop's result with the records its observer collected.
+struct Replayed : ReplayResult {
+  std::vector<FrameRecord> records;
+};
+
+Replayed collect(ReplayResult result, const RecordingObserver& observer) {
+  Replayed replayed;
+  static_cast<ReplayResult&>(replayed) = std::move(result);
+  replayed.records = observer.records;
+  EXPECT_EQ(replayed.frames, replayed.records.size());
+  return replayed;
+}
 
 Trace traceAt(const std::vector<double>& times) {
   Trace trace;
@@ -211,8 +253,15 @@ const std::size_t kSphereTriangles = sphereMesh(1.0f, 8, 4).triangleCount();
 
 class ReplayLoopTest : public ::testing::Test {
  protected:
-  ReplayResult run(const Trace& trace) {
-    return runReplay(trace, options, clock, link, producer, observer, [this] { return stop(); });
+  Replayed run(const Trace& trace) {
+    return collect(
+        runReplay(trace, options, clock, link, producer, observer, [this] { return stop(); }),
+        observer);
+  }
+  Replayed run(PoseSource& stream) {
+    return collect(
+        runReplay(stream, options, clock, link, producer, observer, [] { return false; }),
+        observer);
   }
   FakeClock clock;
   FakeLink link{clock};
@@ -233,7 +282,7 @@ TEST_F(ReplayLoopTest, LockstepAppliesEachAnswerInTheFrameOfItsPose) {
                                              pose.sequence % 2 + 1, 10.0 * (pose.sequence + 1))));
   };
   const Trace trace = traceAt({0.0, 0.1, 0.2, 0.35});
-  ReplayResult result = run(trace);
+  Replayed result = run(trace);
   ASSERT_TRUE(result.status.ok()) << result.status.toString();
   ASSERT_EQ(result.records.size(), 4u);
   EXPECT_EQ(result.updatesReceived, 4u);
@@ -251,10 +300,10 @@ TEST_F(ReplayLoopTest, LockstepAppliesEachAnswerInTheFrameOfItsPose) {
     // latency includes the wait, and the update shown is this pose's answer.
     EXPECT_DOUBLE_EQ(r.poseToFrameMs, 8.0);
     EXPECT_DOUBLE_EQ(r.updateLatencyMs, 8.0);
-    EXPECT_DOUBLE_EQ(result.extras[i].waitMs, 3.0);
+    EXPECT_DOUBLE_EQ(result.records[i].waitMs, 3.0);
     EXPECT_DOUBLE_EQ(r.renderMs, 5.0);
-    EXPECT_DOUBLE_EQ(r.snrDb, 12.0);
-    EXPECT_DOUBLE_EQ(result.extras[i].referenceMs, 20.0);
+    EXPECT_DOUBLE_EQ(r.quality.snrDb, 12.0);
+    EXPECT_DOUBLE_EQ(result.records[i].quality.referenceMs, 20.0);
     EXPECT_GT(r.linkBytes, 1000u);
     // The pose on the wire.
     const protocol::ViewerPose& pose = link.poses[i];
@@ -284,13 +333,13 @@ TEST_F(ReplayLoopTest, LockstepTimeoutRendersWhatItHolds) {
     if (pose.sequence == 0) reply = std::make_pair(2 * kMs, sphereUpdate(1, 0, 1, 5.0));
     return reply;
   };
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
   ASSERT_EQ(result.records.size(), 3u);
   EXPECT_EQ(result.lockstepTimeouts, 2u);
   EXPECT_EQ(observer.timeouts, (std::vector<std::uint64_t>{1, 2}));
   for (std::size_t i = 1; i < 3; ++i) {
-    EXPECT_TRUE(result.extras[i].lockstepTimedOut);
-    EXPECT_DOUBLE_EQ(result.extras[i].waitMs, 40.0);
+    EXPECT_TRUE(result.records[i].lockstepTimedOut);
+    EXPECT_DOUBLE_EQ(result.records[i].waitMs, 40.0);
     EXPECT_EQ(result.records[i].polygons, kSphereTriangles);
     EXPECT_EQ(result.records[i].plan, 1u);
     EXPECT_DOUBLE_EQ(result.records[i].targetAccuracy, 5.0);
@@ -307,7 +356,7 @@ TEST_F(ReplayLoopTest, LiveModeAppliesALateAnswerWhenItArrivesWithItsTrueLatency
     return reply;
   };
   const std::int64_t start = clock.now;
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
   ASSERT_EQ(result.records.size(), 4u);
   ASSERT_EQ(producer.renderStartNs.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {
@@ -333,7 +382,7 @@ TEST_F(ReplayLoopTest, ATraceGivesWaitsNoDescriptorToWakeOn) {
 
 TEST_F(ReplayLoopTest, DefaultPacingFollowsTheTraceTimes) {
   const std::int64_t start = clock.now;
-  ReplayResult result = run(traceAt({2.0, 2.25, 2.3, 3.0}));
+  Replayed result = run(traceAt({2.0, 2.25, 2.3, 3.0}));
   ASSERT_EQ(producer.renderStartNs.size(), 4u);
   // Each frame takes 25 ms (render + reference), less than every gap.
   const std::vector<std::int64_t> expected = {0, 250, 300, 1000};
@@ -346,7 +395,7 @@ TEST_F(ReplayLoopTest, DefaultPacingFollowsTheTraceTimes) {
 TEST_F(ReplayLoopTest, LateFramesStartAtOnceWithoutSkippingPoses) {
   options.rate = 100.0;  // 10 ms slots, but a frame takes 25 ms
   const std::int64_t start = clock.now;
-  ReplayResult result = run(traceAt({0.0, 1.0, 2.0}));
+  Replayed result = run(traceAt({0.0, 1.0, 2.0}));
   ASSERT_EQ(result.records.size(), 3u);
   EXPECT_EQ(producer.renderStartNs[1] - start, 25 * kMs);
   EXPECT_EQ(producer.renderStartNs[2] - start, 50 * kMs);
@@ -357,7 +406,7 @@ TEST_F(ReplayLoopTest, BackboneDownKeepsRenderingWithoutWaiting) {
   options.lockstep = true;
   options.rate = -1.0;
   const std::int64_t start = clock.now;
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
   ASSERT_TRUE(result.status.ok());
   EXPECT_EQ(result.records.size(), 3u);
   EXPECT_EQ(result.posesNotSent, 3u);
@@ -371,11 +420,11 @@ TEST_F(ReplayLoopTest, LockstepWaitEndsWhenTheLinkDrops) {
   options.lockstepTimeout = std::chrono::milliseconds(5000);
   options.rate = -1.0;
   link.dropAtNs = clock.now + 10 * kMs;
-  ReplayResult result = run(traceAt({0.0, 0.1}));
+  Replayed result = run(traceAt({0.0, 0.1}));
   ASSERT_EQ(result.records.size(), 2u);
-  EXPECT_DOUBLE_EQ(result.extras[0].waitMs, 10.0);
+  EXPECT_DOUBLE_EQ(result.records[0].waitMs, 10.0);
   EXPECT_EQ(result.lockstepTimeouts, 0u);
-  EXPECT_FALSE(result.extras[1].poseSent);
+  EXPECT_EQ(link.poses.size(), 1u);  // frame 1's pose was not sent (link down)
 }
 
 TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
@@ -392,18 +441,18 @@ TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
     }
     return std::make_optional(std::make_pair(kMs, update));
   };
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
   ASSERT_EQ(result.records.size(), 3u);
   EXPECT_EQ(result.updatesReceived, 3u);
   EXPECT_EQ(result.updatesRejected, 1u);
   EXPECT_EQ(observer.rejectedPlans, (std::vector<std::uint64_t>{2}));
   EXPECT_NE(observer.reasons[0].find("operation 1 (object 2): mesh:"), std::string::npos)
       << observer.reasons[0];
-  EXPECT_EQ(result.extras[1].updatesRejected, 1u);
+  EXPECT_EQ(result.records[1].updatesRejected, 1u);
   // Frame 1 still shows frame 0's state; no half-applied replacement of object 1.
   EXPECT_EQ(result.records[1].polygons, kSphereTriangles);
   EXPECT_EQ(result.records[1].plan, 1u);
-  EXPECT_FALSE(result.extras[1].lockstepTimedOut);  // the answer came, it was just bad
+  EXPECT_FALSE(result.records[1].lockstepTimedOut);  // the answer came, it was just bad
   EXPECT_EQ(result.records[2].plan, 3u);
   EXPECT_EQ(producer.scene.objects().size(), 1u);
   // The backbone hears of the refusal once, in the FrameStats of that frame.
@@ -416,7 +465,7 @@ TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
 TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {
   options.rate = -1.0;
   stop = [this] { return observer.frames.size() >= 2; };
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
   EXPECT_TRUE(result.interrupted);
   EXPECT_TRUE(result.status.ok());
   EXPECT_EQ(result.records.size(), 2u);
@@ -425,7 +474,7 @@ TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {
 TEST_F(ReplayLoopTest, StopRequestEndsAPacingWaitWithoutRenderingTheFrame) {
   const std::int64_t start = clock.now;
   stop = [this, start] { return clock.now - start >= 500 * kMs; };
-  ReplayResult result = run(traceAt({0.0, 10.0}));
+  Replayed result = run(traceAt({0.0, 10.0}));
   EXPECT_TRUE(result.interrupted);
   EXPECT_EQ(result.records.size(), 1u);
   EXPECT_LT(clock.now - start, 600 * kMs);  // within one poll slice of the request
@@ -434,7 +483,7 @@ TEST_F(ReplayLoopTest, StopRequestEndsAPacingWaitWithoutRenderingTheFrame) {
 TEST_F(ReplayLoopTest, MaxFramesLimitsTheReplay) {
   options.rate = -1.0;
   options.maxFrames = 2;
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
   EXPECT_FALSE(result.interrupted);
   EXPECT_EQ(result.records.size(), 2u);
   EXPECT_EQ(link.poses.size(), 2u);
@@ -443,21 +492,21 @@ TEST_F(ReplayLoopTest, MaxFramesLimitsTheReplay) {
 TEST_F(ReplayLoopTest, InfiniteSnrIsSentAsNoSnr) {
   options.rate = -1.0;
   producer.snrDb = std::numeric_limits<double>::infinity();
-  ReplayResult result = run(traceAt({0.0}));
+  Replayed result = run(traceAt({0.0}));
   ASSERT_EQ(link.frameStats.size(), 1u);
   EXPECT_FALSE(link.frameStats[0].hasSnr);
   EXPECT_EQ(link.frameStats[0].snrDb, 0.0);
-  EXPECT_TRUE(std::isinf(result.records[0].snrDb));
+  EXPECT_TRUE(std::isinf(result.records[0].quality.snrDb));
 }
 
 TEST_F(ReplayLoopTest, WithoutMeasurementSnrIsMissing) {
   options.rate = -1.0;
   options.measure = false;
   const std::int64_t start = clock.now;
-  ReplayResult result = run(traceAt({0.0, 0.1}));
+  Replayed result = run(traceAt({0.0, 0.1}));
   ASSERT_EQ(result.records.size(), 2u);
-  EXPECT_TRUE(std::isnan(result.records[0].snrDb));
-  EXPECT_TRUE(std::isnan(result.extras[0].referenceMs));
+  EXPECT_TRUE(std::isnan(result.records[0].quality.snrDb));
+  EXPECT_TRUE(std::isnan(result.records[0].quality.referenceMs));
   EXPECT_FALSE(link.frameStats[0].hasSnr);
   EXPECT_EQ(clock.now - start, 2 * 5 * kMs);  // no reference work
 }
@@ -465,7 +514,7 @@ TEST_F(ReplayLoopTest, WithoutMeasurementSnrIsMissing) {
 TEST_F(ReplayLoopTest, RenderFailureEndsTheReplayWithItsStatus) {
   options.rate = -1.0;
   producer.failAtFrame = 1;
-  ReplayResult result = run(traceAt({0.0, 0.1, 0.2}));
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
   EXPECT_EQ(result.status.code(), ErrorCode::kInternal);
   EXPECT_EQ(result.records.size(), 1u);
 }
@@ -476,8 +525,7 @@ TEST_F(ReplayLoopTest, LiveStreamAtRateZeroDrawsEachPoseWhenItArrives) {
   options.pollSlice = std::chrono::milliseconds(1);
   const std::int64_t start = clock.now;
   ScriptedStream stream(clock, {30, 40, 100});
-  ReplayResult result =
-      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  Replayed result = run(stream);
   ASSERT_TRUE(result.status.ok()) << result.status.toString();
   ASSERT_EQ(result.records.size(), 3u);
   const std::vector<std::int64_t> expectedStartMs = {30, 40, 100};
@@ -498,8 +546,7 @@ TEST_F(ReplayLoopTest, LiveStreamAtARateTakesTheNewestPoseOrDrawsTheLastOneAgain
   const std::int64_t start = clock.now;
   // Nothing until 25 ms; then two poses within one frame; then one more at 52 ms.
   ScriptedStream stream(clock, {25, 27, 52});
-  ReplayResult result =
-      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  Replayed result = run(stream);
   ASSERT_TRUE(result.status.ok()) << result.status.toString();
   // Frame 0 waits for the first pose and starts at 25 ms; frame 1 (slot 10 ms,
   // late) takes pose 27 at 30 ms; frames 2-5 (35, 40, 45, 50 ms) find nothing
@@ -533,8 +580,7 @@ TEST_F(ReplayLoopTest, LiveStreamSkipsPosesOvertakenBeforeAFrameTakesThem) {
   options.measure = false;
   options.pollSlice = std::chrono::milliseconds(1);
   ScriptedStream stream(clock, {0, 10, 20, 30, 60});
-  ReplayResult result =
-      runReplay(stream, options, clock, link, producer, observer, [] { return false; });
+  Replayed result = run(stream);
   ASSERT_TRUE(result.status.ok());
   ASSERT_EQ(result.records.size(),
             3u);  // 0 ms: pose 0; 50 ms: pose 30 (10, 20 skipped); 100 ms: 60
@@ -573,14 +619,14 @@ class DeferringProducer final : public FrameProducer {
     kept.push_back({frame, pose.time, shownAtNs});
     return true;
   }
-  Result<std::vector<KeptFrameQuality>> scoreKept() override {
+  Result<std::vector<FrameScore>> scoreKept() override {
     ++scoreCalls;
     scoredAtFrames = renderStartNs.size();
     // The score of a frame is a function of the pose it was kept with (what
     // the real producer does: the reference of that pose), here 100 x time.
-    std::vector<KeptFrameQuality> out;
+    std::vector<FrameScore> out;
     for (const Kept& k : kept) {
-      KeptFrameQuality q;
+      FrameScore q;
       q.frame = k.frame;
       q.quality.snrDb = 100.0 * k.poseTime;
       q.quality.psnrDb = 40.0;
@@ -608,24 +654,6 @@ class DeferringProducer final : public FrameProducer {
   FakeClock& clock_;
 };
 
-class ScoreObserver final : public ReplayObserver {
- public:
-  void onFrame(const FrameRecord& record, const FrameExtras& extras) override {
-    pendingDuringReplay.push_back(extras.scorePending);
-    snrDuringReplay.push_back(record.snrDb);
-  }
-  void onFrameScored(const FrameRecord& record, const FrameExtras& extras) override {
-    scoredFrames.push_back(record.frame);
-    scoredSnr.push_back(record.snrDb);
-    missing.push_back(extras.missingObjects);
-  }
-  std::vector<bool> pendingDuringReplay;
-  std::vector<double> snrDuringReplay;
-  std::vector<std::uint64_t> scoredFrames;
-  std::vector<double> scoredSnr;
-  std::vector<long> missing;
-};
-
 TEST_F(ReplayLoopTest, DeferredScoringKeepsEachFrameWithThePoseItWasDrawnForEvenWhenLate) {
   DeferringProducer deferring(clock);
   ScoreObserver scores;
@@ -635,8 +663,9 @@ TEST_F(ReplayLoopTest, DeferredScoringKeepsEachFrameWithThePoseItWasDrawnForEven
   // 200 ms and after pose 3's slot at 300 ms).
   deferring.renderNs = {5 * kMs, 250 * kMs, 5 * kMs, 5 * kMs};
   const std::int64_t start = clock.now;
-  ReplayResult result = runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link, deferring,
-                                  scores, [] { return false; });
+  Replayed result = collect(runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link,
+                                      deferring, scores, [] { return false; }),
+                            scores);
   ASSERT_TRUE(result.status.ok()) << result.status.toString();
   ASSERT_EQ(result.records.size(), 4u);
   ASSERT_EQ(deferring.kept.size(), 4u);
@@ -645,12 +674,12 @@ TEST_F(ReplayLoopTest, DeferredScoringKeepsEachFrameWithThePoseItWasDrawnForEven
     EXPECT_EQ(deferring.kept[i].frame, i);
     // Kept with the pose it was drawn for, not the pose due when it was shown.
     EXPECT_DOUBLE_EQ(deferring.kept[i].poseTime, 0.1 * static_cast<double>(i));
-    EXPECT_DOUBLE_EQ(result.records[i].snrDb, 100.0 * 0.1 * static_cast<double>(i));
-    EXPECT_EQ(result.extras[i].missingObjects, i == 0 ? 1 : 0);
-    EXPECT_DOUBLE_EQ(result.extras[i].referenceMs, 80.0);
+    EXPECT_DOUBLE_EQ(result.records[i].quality.snrDb, 100.0 * 0.1 * static_cast<double>(i));
+    EXPECT_EQ(result.records[i].quality.missingObjects, i == 0 ? 1 : 0);
+    EXPECT_DOUBLE_EQ(result.records[i].quality.referenceMs, 80.0);
   }
   EXPECT_EQ(deferring.kept[2].shownAtNs - start, 355 * kMs);
-  EXPECT_DOUBLE_EQ(result.extras[2].shownAtMs, 355.0);
+  EXPECT_DOUBLE_EQ(result.records[2].shownAtMs, 355.0);
   // Scored once, after the last frame; nothing scored during the replay.
   EXPECT_EQ(deferring.scoreCalls, 1);
   EXPECT_EQ(deferring.scoredAtFrames, 4u);
@@ -669,14 +698,16 @@ TEST_F(ReplayLoopTest, DeferredScoringScoresTheFramesKeptBeforeAStop) {
   ScoreObserver scores;
   options.deferMeasure = true;
   options.rate = 10.0;
-  ReplayResult result = runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link, deferring,
-                                  scores, [&] { return deferring.renderStartNs.size() >= 2; });
+  Replayed result =
+      collect(runReplay(traceAt({0.0, 0.1, 0.2, 0.3}), options, clock, link, deferring, scores,
+                        [&] { return deferring.renderStartNs.size() >= 2; }),
+              scores);
   EXPECT_TRUE(result.interrupted);
   ASSERT_EQ(result.records.size(), 2u);
   EXPECT_EQ(deferring.scoreCalls, 1);
   EXPECT_EQ(scores.scoredFrames.size(), result.records.size());
   for (std::size_t i = 0; i < result.records.size(); ++i) {
-    EXPECT_DOUBLE_EQ(result.records[i].snrDb, 10.0 * static_cast<double>(i));
+    EXPECT_DOUBLE_EQ(result.records[i].quality.snrDb, 10.0 * static_cast<double>(i));
   }
 }
 
@@ -684,14 +715,14 @@ TEST_F(ReplayLoopTest, AFrameThatCannotBeKeptIsCountedAndStaysUnscored) {
   // SceneProducer keeps nothing (FrameProducer's default keepShown).
   options.deferMeasure = true;
   options.rate = -1.0;
-  ReplayResult result = run(traceAt({0.0, 0.1}));
+  Replayed result = run(traceAt({0.0, 0.1}));
   ASSERT_EQ(result.records.size(), 2u);
   EXPECT_EQ(result.framesNotKept, 2u);
-  for (const FrameRecord& record : result.records) EXPECT_TRUE(std::isnan(record.snrDb));
+  for (const FrameRecord& record : result.records) EXPECT_TRUE(std::isnan(record.quality.snrDb));
 }
 
 TEST_F(ReplayLoopTest, EmptyTraceIsAnError) {
-  ReplayResult result = run(Trace{});
+  Replayed result = run(Trace{});
   EXPECT_EQ(result.status.code(), ErrorCode::kInvalidArgument);
   EXPECT_TRUE(result.records.empty());
 }

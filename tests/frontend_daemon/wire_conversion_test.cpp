@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <random>
 
 #include "daemon_test_util.h"
@@ -58,8 +59,7 @@ TEST(WireConversion, MeshedImpostorDecodesTextureAndStaysWhite) {
   ConversionOptions options;
   options.meshColors = &colours;
   const RgbaImage expected = gradientTexture(32, 32);
-  for (TextureCodec codec :
-       {TextureCodec::kPng, TextureCodec::kZstd, TextureCodec::kRawRgba8}) {
+  for (TextureCodec codec : {TextureCodec::kPng, TextureCodec::kZstd, TextureCodec::kRawRgba8}) {
     SCOPED_TRACE(static_cast<int>(codec));
     auto rep = convertRepresentation(impostorRepresentation(codec), 3, options, "op");
     ASSERT_TRUE(rep.ok()) << rep.status().toString();
@@ -271,6 +271,38 @@ TEST(WireConversion, OneBadOperationRejectsTheWholeUpdateAndNothingIsApplied) {
   EXPECT_EQ(scene.polygons(), heldPolygons);
   EXPECT_EQ(scene.objects().size(), 1u);
   EXPECT_EQ(scene.lastAppliedPlan(), 1u);
+}
+
+TEST(FrameStatsOfARecord, CopiesTheRecordAndSendsOnlyAFiniteSnr) {
+  FrameRecord record;
+  record.frame = 9;
+  record.plan = 4;
+  record.polygons = 348;
+  record.linkBytes = 1234;
+  record.renderMs = 2.5;
+  record.quality.snrDb = 11.0;
+  protocol::FrameStats stats = toFrameStats(record, 42, {7, 8});
+  EXPECT_EQ(stats.frame, 9u);
+  EXPECT_EQ(stats.plan, 4u);
+  EXPECT_EQ(stats.timestampNs, 42);
+  EXPECT_EQ(stats.polygons, 348u);
+  EXPECT_EQ(stats.linkBytes, 1234u);
+  EXPECT_FLOAT_EQ(stats.renderMs, 2.5f);
+  EXPECT_TRUE(stats.hasSnr);
+  EXPECT_EQ(stats.snrDb, 11.0);
+  EXPECT_EQ(stats.rejectedPlans, (std::vector<std::uint64_t>{7, 8}));
+  for (double snr : {std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity(), FrameRecord::kMissing}) {
+    record.quality.snrDb = snr;
+    stats = toFrameStats(record, 0, {});
+    EXPECT_FALSE(stats.hasSnr);
+    EXPECT_EQ(stats.snrDb, 0.0);
+  }
+  record.renderMs = FrameRecord::kMissing;
+  record.polygons = std::size_t{1} << 40;
+  stats = toFrameStats(record, 0, {});
+  EXPECT_EQ(stats.renderMs, 0.0f);
+  EXPECT_EQ(stats.polygons, std::numeric_limits<std::uint32_t>::max());  // saturated
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "daemon_options.h"
 
+#include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace thinlod::frontend::daemon {
 namespace {
@@ -21,14 +23,14 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("pose-stream", &o->poseStreamPath,
                     "live poses instead of --trace: trace lines read as they arrive from this "
                     "file or FIFO ('-' = stdin); each frame takes the newest pose");
-  runtime.addOption("width", &o->width, "frame width, pixels");
-  runtime.addOption("height", &o->height, "frame height, pixels");
+  runtime.addOption("width", &o->gl.width, "frame width, pixels");
+  runtime.addOption("height", &o->gl.height, "frame height, pixels");
   runtime.addOption("backend", &o->backend, "offscreen GL: auto|egl|osmesa");
-  runtime.addOption("rate", &o->rate,
+  runtime.addOption("rate", &o->replay.rate,
                     "replay speed, frames per second; 0 = the trace's own timing (a pose stream: "
                     "a frame per arriving pose); negative = unpaced (each frame as soon as the "
                     "previous one is done)");
-  runtime.addOption("lockstep", &o->lockstep,
+  runtime.addOption("lockstep", &o->replay.lockstep,
                     "wait for the backbone's SceneUpdate of each frame before rendering it");
   runtime.addOption("lockstep-timeout-ms", &o->lockstepTimeoutMs,
                     "longest lockstep wait per frame, ms");
@@ -41,7 +43,7 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("dump-every", &o->dumpEvery, "dump every Nth frame (with --frames-dir)");
   runtime.addOption("no-reference", &o->noReference,
                     "skip the full-quality reference and SNR (pure latency runs)");
-  runtime.addOption("deferred-reference", &o->deferredReference,
+  runtime.addOption("deferred-reference", &o->replay.deferMeasure,
                     "live scoring: keep every shown frame with the pose it was drawn for and "
                     "render the references and SNR after the replay, so the reference never "
                     "delays the client (frames.csv and the PNG dumps are written then)");
@@ -79,18 +81,18 @@ Status validateOptions(const DaemonOptions& o) {
                    "a scene file is required for the reference frames (or --no-reference)");
   }
   if (o.backboneAddress.empty()) return invalid("backbone.address", "empty");
-  if (o.width < 1 || o.width > 16384) return invalid("width", "outside 1..16384");
-  if (o.height < 1 || o.height > 16384) return invalid("height", "outside 1..16384");
+  if (o.gl.width < 1 || o.gl.width > 16384) return invalid("width", "outside 1..16384");
+  if (o.gl.height < 1 || o.gl.height > 16384) return invalid("height", "outside 1..16384");
   if (!parseBackend(o.backend).ok()) return parseBackend(o.backend).status();
-  if (!std::isfinite(o.rate)) return invalid("rate", "not finite");
-  if (!o.poseStreamPath.empty() && o.rate < 0.0) {
+  if (!std::isfinite(o.replay.rate)) return invalid("rate", "not finite");
+  if (!o.poseStreamPath.empty() && o.replay.rate < 0.0) {
     return invalid("rate",
                    "unpaced (negative) with --pose-stream would redraw the last pose "
                    "back to back; use 0 (a frame per pose) or a positive rate");
   }
   if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
   if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");
-  if (o.deferredReference && o.noReference) {
+  if (o.replay.deferMeasure && o.noReference) {
     return invalid("deferred-reference", "needs the reference (drop --no-reference)");
   }
   if (o.deferredReferenceMaxMb < 1 || o.deferredReferenceMaxMb > (std::int64_t{1} << 30)) {
@@ -104,6 +106,20 @@ Status validateOptions(const DaemonOptions& o) {
   if (o.frames < 0) return invalid("frames", "negative");
   if (o.connectTimeoutMs < 0) return invalid("connect-timeout-ms", "negative");
   return Status();
+}
+
+void finishOptions(DaemonOptions& o) {
+  o.gl.backend = parseBackend(o.backend).value();
+  o.gl.uploadBytesPerFrame = o.maxUploadBytesPerFrame == 0
+                                 ? std::numeric_limits<std::size_t>::max()
+                                 : static_cast<std::size_t>(o.maxUploadBytesPerFrame);
+  o.gl.maxKeptBytes = static_cast<std::size_t>(o.deferredReferenceMaxMb) << 20;
+  o.gl.visibleMinPixels = static_cast<std::uint32_t>(o.visibleMinPixels);
+  o.replay.lockstepTimeout = std::chrono::milliseconds(o.lockstepTimeoutMs);
+  o.replay.maxFrames = static_cast<std::size_t>(o.frames);
+  o.replay.measure = !o.noReference;
+  o.replay.viewportWidth = static_cast<std::uint32_t>(o.gl.width);
+  o.replay.viewportHeight = static_cast<std::uint32_t>(o.gl.height);
 }
 
 }  // namespace thinlod::frontend::daemon

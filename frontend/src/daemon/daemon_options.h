@@ -1,10 +1,16 @@
 // Options of thinlod-frontend (TOML keys = flags, see DaemonRuntime) and
-// their validation. Pure apart from registering with the runtime.
+// their validation. Each option is registered once, on the field it
+// configures: straight on ReplayOptions / GlProducerOptions where the type
+// fits (their defaults are the only ones), else on a shell field below whose
+// default is taken from those structs and which finishOptions() converts.
+// Pure apart from registering with the runtime.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "gl_frame_producer.h"
+#include "replay_loop.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/protocol/daemon_runtime.h"
@@ -13,28 +19,33 @@
 namespace thinlod::frontend::daemon {
 
 struct DaemonOptions {
+  // Bound directly: replay.lockstep, replay.rate, replay.deferMeasure,
+  // gl.width, gl.height.
+  ReplayOptions replay;
+  GlProducerOptions gl;
+
+  // Converted into `replay` / `gl` by finishOptions(); defaults from them.
+  std::string backend = render::backendName(GlProducerOptions{}.backend);
+  int lockstepTimeoutMs = static_cast<int>(ReplayOptions{}.lockstepTimeout.count());
+  std::int64_t maxUploadBytesPerFrame =  // 0 = unbounded
+      static_cast<std::int64_t>(GlProducerOptions{}.uploadBytesPerFrame);
+  std::int64_t deferredReferenceMaxMb =
+      static_cast<std::int64_t>(GlProducerOptions{}.maxKeptBytes >> 20);
+  int visibleMinPixels = static_cast<int>(GlProducerOptions{}.visibleMinPixels);
+  std::int64_t frames = static_cast<std::int64_t>(ReplayOptions{}.maxFrames);  // 0 = all
+  bool noReference = !ReplayOptions{}.measure;
+
+  // The daemon's own.
   std::string backboneAddress = protocol::kDefaultFrontendAddress;
   std::string scenePath;
   std::string modelsDir;
   std::string tracePath;
   std::string poseStreamPath;  // "-" = stdin
-  int width = 640;
-  int height = 480;
-  std::string backend = "auto";
-  double rate = 0.0;  // frames/s; 0 = the trace's timing; < 0 = unpaced
-  bool lockstep = false;
-  int lockstepTimeoutMs = 5000;
-  std::int64_t maxUploadBytesPerFrame = 600 * 1024;  // 0 = unbounded
   std::string csvPath;
   std::string summaryJsonPath;
   std::string framesDir;
   int dumpEvery = 10;
-  bool noReference = false;
-  bool deferredReference = false;  // keep shown frames, score after the replay
-  std::int64_t deferredReferenceMaxMb = 4096;
   bool completeness = false;  // coverage pass: visible / missing objects per frame
-  int visibleMinPixels = 16;  // completeness: pixels an object group must cover
-  std::int64_t frames = 0;    // 0 = the whole trace
   std::string label;
   int connectTimeoutMs = 10000;
   protocol::TransportOptions transport;
@@ -44,5 +55,8 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* options);
 Result<render::Backend> parseBackend(const std::string& name);
 // kInvalidArgument naming the option.
 Status validateOptions(const DaemonOptions& options);
+// After validateOptions: the shell fields into `replay` and `gl` (and the
+// viewport from the frame size).
+void finishOptions(DaemonOptions& options);
 
 }  // namespace thinlod::frontend::daemon

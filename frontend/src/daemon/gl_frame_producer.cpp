@@ -205,35 +205,19 @@ class GlFrameProducer::References final : public ReferenceSource {
   GlFrameProducer& producer_;
 };
 
-Result<std::vector<KeptFrameQuality>> GlFrameProducer::scoreKept() {
+Result<std::vector<FrameScore>> GlFrameProducer::scoreKept() {
   References references(*this);
   const ScoredFrameSink sink = [this](const ShownFrame& shown, const RgbaImage&,
-                                      const ShownFrameScore&) {
+                                      const FrameScore&) {
     if (!scoredSink_) return;
     frame_ = shown.image;  // referenceFrame_ already holds its reference
     scoredSink_(shown.frame);
   };
-  Result<std::vector<ShownFrameScore>> scores =
+  Result<std::vector<FrameScore>> scores =
       scoreShownFrames(kept_.frames(), references, extents_, options_.visibleMinPixels, sink);
-  if (!scores.ok()) return scores.status();
-  std::vector<KeptFrameQuality> out;
-  out.reserve(scores->size());
-  for (const ShownFrameScore& score : *scores) {
-    KeptFrameQuality kept;
-    kept.frame = score.frame;
-    kept.quality.snrDb = score.snrDb;
-    kept.quality.psnrDb = score.psnrDb;
-    kept.quality.referenceMs = score.referenceMs;
-    if (!extents_.empty()) {
-      kept.quality.visibleObjects = static_cast<long>(score.completeness.visibleGroups);
-      kept.quality.missingObjects = static_cast<long>(score.completeness.missingGroups);
-    }
-    kept.quality.blank = score.blank ? 1 : 0;
-    out.push_back(kept);
-  }
   keptPeakBytes_ = kept_.bytes();
   kept_ = ShownFrameLog(0);  // the images are no longer needed
-  return out;
+  return scores;
 }
 
 std::string GlFrameProducer::describe() const {

@@ -23,14 +23,15 @@
 
 namespace thinlod::frontend::daemon {
 
+// The defaults of the daemon's options (daemon_options.h binds them here).
 struct GlProducerOptions {
   int width = 640;
   int height = 480;
   render::Backend backend = render::Backend::kAuto;
   std::size_t uploadBytesPerFrame = FrontendRendererOptions{}.uploadBytesPerFrame;
   std::size_t maxKeptBytes = std::size_t{4} << 30;  // deferred measurement: pixels kept
-  std::uint32_t visibleMinPixels =
-      16;  // completeness: an object group covering fewer is not visible
+  // Completeness: an object group covering fewer pixels is not visible.
+  std::uint32_t visibleMinPixels = 16;
 };
 
 class GlFrameProducer final : public FrameProducer {
@@ -46,7 +47,7 @@ class GlFrameProducer final : public FrameProducer {
   Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose& pose) override;
   Result<FrameQuality> measure(std::uint64_t frame, const Pose& pose) override;
   bool keepShown(std::uint64_t frame, const Pose& pose, std::int64_t shownAtNs) override;
-  Result<std::vector<KeptFrameQuality>> scoreKept() override;
+  Result<std::vector<FrameScore>> scoreKept() override;
   // Called for every frame scoreKept() scores (after which frame() is that
   // shown frame and referenceFrame() its reference).
   void setScoredSink(std::function<void(std::uint64_t frame)> sink) {

@@ -67,30 +67,35 @@ class RejectionLog {
 constexpr double kMaxPoseStreamJumpSeconds = 60.0;
 constexpr int kPoseStreamRestartAfter = 10;
 
-// Logs, the CSV and the PNG dumps, frame by frame.
+// Logs, frames.csv with the summary (FrameLog) and the PNG dumps, frame by frame.
 class DaemonObserver final : public ReplayObserver {
  public:
-  DaemonObserver(CsvOutput* csv, const GlFrameProducer& producer, const DaemonOptions& options)
-      : csv_(csv), producer_(producer), options_(options) {}
+  DaemonObserver(FrameLog& log, const GlFrameProducer& producer, const DaemonOptions& options)
+      : log_(log), producer_(producer), options_(options) {}
 
-  void onFrame(const FrameRecord& record, const FrameExtras& extras) override {
+  void onFrame(const FrameRecord& record, bool scorePending) override {
     spdlog::debug(
         "event=frame frame={} polygons={} link_bytes={} snr_db={:.2f} render_ms={:.2f} "
         "reference_ms={:.2f} pose_to_frame_ms={:.2f} update_latency_ms={:.2f} plan={}",
-        record.frame, record.polygons, record.linkBytes, record.snrDb, record.renderMs,
-        extras.referenceMs, record.poseToFrameMs, record.updateLatencyMs, record.plan);
+        record.frame, record.polygons, record.linkBytes, record.quality.snrDb, record.renderMs,
+        record.quality.referenceMs, record.poseToFrameMs, record.updateLatencyMs, record.plan);
     if (record.frame % kProgressEveryFrames == 0) {
       spdlog::info("event=progress frame={} polygons={} snr_db={:.2f} render_ms={:.2f} plan={}",
-                   record.frame, record.polygons, record.snrDb, record.renderMs, record.plan);
+                   record.frame, record.polygons, record.quality.snrDb, record.renderMs,
+                   record.plan);
     }
-    // Deferred scoring: the row and the dumps come with the score (onFrameScored).
-    if (extras.scorePending) return;
-    writeRow(record, extras);
+    // Deferred scoring: the row comes with the score (onFramesScored), the
+    // dumps while scoring (onKeptFrameScored).
+    if (scorePending) {
+      report(log_.addPending(record));
+      return;
+    }
+    report(log_.add(record));
     if (!options_.framesDir.empty() && record.frame % options_.dumpEvery == 0) dump(record.frame);
   }
 
-  void onFrameScored(const FrameRecord& record, const FrameExtras& extras) override {
-    writeRow(record, extras);
+  void onFramesScored(const std::vector<FrameScore>& scores) override {
+    report(log_.applyScores(scores));
   }
 
   // Deferred scoring: called while the kept frame and its reference are in the producer.
@@ -116,16 +121,12 @@ class DaemonObserver final : public ReplayObserver {
                   why.toString());
   }
 
-  const Status& outputError() const { return outputError_; }
-
  private:
-  void writeRow(const FrameRecord& record, const FrameExtras& extras) {
-    if (csv_ == nullptr || !outputError_.ok()) return;
-    const Status written = csv_->append(record, extras);
-    if (!written.ok()) {
-      outputError_ = written;
-      spdlog::error("event=csv_failed error=\"{}\"", written.toString());
-    }
+  // The first output error is logged; FrameLog keeps it for the exit code.
+  void report(const Status& status) {
+    if (status.ok() || reported_) return;
+    reported_ = true;
+    spdlog::error("event=csv_failed error=\"{}\"", status.toString());
   }
 
   void dump(std::uint64_t frame) {
@@ -141,18 +142,19 @@ class DaemonObserver final : public ReplayObserver {
     if (!written.ok()) spdlog::warn("event=dump_failed error=\"{}\"", written.toString());
   }
 
-  CsvOutput* csv_;
+  FrameLog& log_;
   const GlFrameProducer& producer_;
   const DaemonOptions& options_;
-  Status outputError_;
+  bool reported_ = false;
 };
 
-int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
+int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
   const Status valid = validateOptions(options);
   if (!valid.ok()) {
     spdlog::error("event=bad_options error=\"{}\"", valid.toString());
     return 2;
   }
+  finishOptions(options);
   // Poses: a trace loaded whole, or a live stream read as it arrives.
   SteadyClock clock;
   Trace trace;
@@ -217,16 +219,7 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     spdlog::warn("event=no_scene note=\"meshes from the backbone are drawn white\"");
   }
 
-  GlProducerOptions glOptions;
-  glOptions.width = options.width;
-  glOptions.height = options.height;
-  glOptions.backend = parseBackend(options.backend).value();
-  glOptions.uploadBytesPerFrame = options.maxUploadBytesPerFrame == 0
-                                      ? std::numeric_limits<std::size_t>::max()
-                                      : static_cast<std::size_t>(options.maxUploadBytesPerFrame);
   const render::Lighting lighting = scene ? scene->lighting : render::Lighting{};
-  glOptions.maxKeptBytes = static_cast<std::size_t>(options.deferredReferenceMaxMb) << 20;
-  glOptions.visibleMinPixels = static_cast<std::uint32_t>(options.visibleMinPixels);
   std::vector<ReferenceItem> reference;
   std::vector<ObjectExtent> extents;
   if (scene && !options.noReference) {
@@ -235,22 +228,18 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
     if (options.completeness) extents = scene->extents;
   }
   Result<std::unique_ptr<GlFrameProducer>> producer =
-      GlFrameProducer::create(glOptions, lighting, std::move(reference), std::move(extents));
+      GlFrameProducer::create(options.gl, lighting, std::move(reference), std::move(extents));
   if (!producer.ok()) {
     spdlog::error("event=gl_failed error=\"{}\"", producer.status().toString());
     return 1;
   }
   spdlog::info("event=gl_ready backend=\"{}\" width={} height={}", (*producer)->describe(),
-               options.width, options.height);
+               options.gl.width, options.gl.height);
 
-  std::unique_ptr<CsvOutput> csv;
-  if (!options.csvPath.empty()) {
-    Result<std::unique_ptr<CsvOutput>> opened = CsvOutput::open(options.csvPath);
-    if (!opened.ok()) {
-      spdlog::error("event=csv_failed error=\"{}\"", opened.status().toString());
-      return 1;
-    }
-    csv = std::move(opened).value();
+  Result<std::unique_ptr<FrameLog>> log = FrameLog::open(options.csvPath);
+  if (!log.ok()) {
+    spdlog::error("event=csv_failed error=\"{}\"", log.status().toString());
+    return 1;
   }
   if (!options.framesDir.empty()) {
     std::error_code error;
@@ -286,20 +275,13 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
       "event=ready address={} connected={} trace={} poses={} pose_stream={} lockstep={} "
       "reference={} deferred_reference={}",
       options.backboneAddress, connected, options.tracePath, trace.poses.size(),
-      options.poseStreamPath, options.lockstep, !options.noReference, options.deferredReference);
+      options.poseStreamPath, options.replay.lockstep, !options.noReference,
+      options.replay.deferMeasure);
 
-  ReplayOptions replay;
-  replay.lockstep = options.lockstep;
-  replay.lockstepTimeout = std::chrono::milliseconds(options.lockstepTimeoutMs);
-  replay.rate = options.rate;
-  replay.maxFrames = static_cast<std::size_t>(options.frames);
-  replay.measure = !options.noReference;
-  replay.deferMeasure = options.deferredReference;
-  replay.viewportWidth = static_cast<std::uint32_t>(options.width);
-  replay.viewportHeight = static_cast<std::uint32_t>(options.height);
+  ReplayOptions replay = options.replay;
   if (scene) replay.conversion.meshColors = &scene->meshColors;
 
-  DaemonObserver observer(csv.get(), **producer, options);
+  DaemonObserver observer(**log, **producer, options);
   (*producer)->setScoredSink(
       [&observer](std::uint64_t frame) { observer.onKeptFrameScored(frame); });
   ReplayResult result = runReplay(*source, replay, clock, **link, **producer, observer, stop);
@@ -315,38 +297,39 @@ int run(protocol::DaemonRuntime& runtime, const DaemonOptions& options) {
   }
   info.scenePath = options.scenePath;
   info.backend = (*producer)->describe();
-  info.width = options.width;
-  info.height = options.height;
-  info.lockstep = options.lockstep;
-  info.rate = options.rate;
+  info.width = options.gl.width;
+  info.height = options.gl.height;
+  info.lockstep = options.replay.lockstep;
+  info.rate = options.replay.rate;
   info.reference = !options.noReference;
-  info.deferredReference = options.deferredReference && !options.noReference;
+  info.deferredReference = options.replay.deferMeasure && !options.noReference;
   info.keptBytes = (*producer)->keptBytes();
   info.connectedAtStart = connected;
   info.referenceTriangles = scene && !options.noReference ? scene->referenceTriangles : 0;
   if (!result.status.ok()) {
     info.error = result.status.toString();
-    spdlog::error("event=replay_failed frame={} error=\"{}\"", result.records.size(), info.error);
+    spdlog::error("event=replay_failed frame={} error=\"{}\"", result.frames, info.error);
     exitCode = 1;
   }
-  if (csv != nullptr) {
-    const Status closed = csv->close();
-    if (!closed.ok()) spdlog::error("event=csv_failed error=\"{}\"", closed.toString());
-    if (!closed.ok() || !observer.outputError().ok()) exitCode = 1;
+  const Status closed = (*log)->close();
+  if (!closed.ok()) {
+    spdlog::error("event=csv_failed error=\"{}\"", closed.toString());
+    exitCode = 1;
   }
+  const ReplaySummary summary = (*log)->summary().summarize();
   if (!options.summaryJsonPath.empty()) {
-    const Status written = writeTextFile(options.summaryJsonPath, runSummaryJson(result, info));
+    const Status written =
+        writeTextFile(options.summaryJsonPath, runSummaryJson(summary, result, info));
     if (!written.ok()) {
       spdlog::error("event=summary_failed error=\"{}\"", written.toString());
       exitCode = 1;
     }
   }
-  const ReplaySummary summary = summarizeFrames(result.records);
   spdlog::info(
       "event=finished frames={} interrupted={} updates_received={} updates_applied={} "
       "updates_rejected={} lockstep_timeouts={} render_ms_median={:.2f} snr_db_median={:.2f} "
       "polygons_max={}",
-      result.records.size(), result.interrupted, result.updatesReceived, result.updatesApplied,
+      result.frames, result.interrupted, result.updatesReceived, result.updatesApplied,
       result.updatesRejected, result.lockstepTimeouts, summary.renderMs.median, summary.snrMedianDb,
       summary.polygonsMax);
   return exitCode;

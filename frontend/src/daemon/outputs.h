@@ -1,13 +1,10 @@
-// The daemon's files: the per-frame CSV (the library's columns plus the
-// daemon's extra columns at the end), the run summary JSON (the library's
-// summary plus the run's settings and counters), PNG frame dumps (OIIO).
-// File errors are kIoError naming the path. Not thread-safe.
+// The daemon's files besides frames.csv (FrameLog, frame_record.h): the run
+// summary JSON (the library's summary plus the run's settings and counters),
+// PNG frame dumps (OIIO). File errors are kIoError naming the path.
 #pragma once
 
-#include <cstdio>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "replay_loop.h"
 #include "thinlod/common/core/rgba_image.h"
@@ -15,25 +12,6 @@
 #include "thinlod/frontend/frame_record.h"
 
 namespace thinlod::frontend::daemon {
-
-// Extra columns after the library's: reference_ms, wait_ms, updates_received,
-// updates_rejected, lockstep_timeout (0/1), shown_at_ms, visible_objects,
-// missing_objects, blank (0/1; the last three empty when not measured).
-std::string daemonCsvHeader();
-std::string daemonCsvRow(const FrameRecord& record, const FrameExtras& extras);
-
-class CsvOutput {
- public:
-  static Result<std::unique_ptr<CsvOutput>> open(const std::string& path);
-  ~CsvOutput();
-  Status append(const FrameRecord& record, const FrameExtras& extras);  // flushed per row
-  Status close();
-
- private:
-  CsvOutput(std::string path, std::FILE* file) : path_(std::move(path)), file_(file) {}
-  std::string path_;
-  std::FILE* file_;
-};
 
 // What the summary adds to the library's ReplaySummary.
 struct RunInfo {
@@ -56,7 +34,8 @@ struct RunInfo {
   std::string error;  // empty when the replay ended normally
 };
 
-std::string runSummaryJson(const ReplayResult& result, const RunInfo& info);
+std::string runSummaryJson(const ReplaySummary& frames, const ReplayResult& result,
+                           const RunInfo& info);
 Status writeTextFile(const std::string& path, const std::string& text);
 Status writePng(const std::string& path, const RgbaImage& image);
 // "<dir>/<prefix>_0042.png"

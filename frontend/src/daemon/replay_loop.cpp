@@ -56,7 +56,8 @@ class Replay {
         result_.interrupted = true;
         break;
       }
-      extras_ = FrameExtras{};
+      record_ = FrameRecord{};
+      poseSent_ = false;
       source_.refresh();
       if (source_.ended()) break;  // every pose drawn: no slot to wait for
       // The frame's slot: a fixed rate, or the source's own timing at rate 0.
@@ -90,16 +91,16 @@ class Replay {
           fresh ? source_.lastArrivalNs().value_or(clock_.nowNs()) : clock_.nowNs();
       const std::int64_t sentNs = fresh ? sendPose(pose, i) : clock_.nowNs();
       absorb(link_.poll(std::chrono::milliseconds(0)));
-      if (options_.lockstep && extras_.poseSent) {
+      if (options_.lockstep && poseSent_) {
         waitUntil(sentNs + options_.lockstepTimeout.count() * 1'000'000LL,
                   [&] { return answered_[i] || !link_.connected(); });
         if (!answered_[i] && link_.connected() && !stop_()) {
-          extras_.lockstepTimedOut = true;
+          record_.lockstepTimedOut = true;
           ++result_.lockstepTimeouts;
           observer_.onLockstepTimeout(i, (clock_.nowNs() - sentNs) / kNsPerMs);
         }
       }
-      extras_.waitMs = (clock_.nowNs() - sentNs) / kNsPerMs;
+      record_.waitMs = (clock_.nowNs() - sentNs) / kNsPerMs;
 
       Result<ProducedFrame> produced = producer_.renderFrame(i, pose);
       if (!produced.ok()) {
@@ -107,14 +108,14 @@ class Replay {
         break;
       }
       const std::int64_t frameDoneNs = clock_.nowNs();
-      FrameRecord record = recordOf(i, pose, *produced, frameDoneNs);
-      if (fresh) record.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
+      recordDrawn(i, pose, *produced, frameDoneNs);
+      if (fresh) record_.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
 
       if (!firstSampledNs_) firstSampledNs_ = sampledNs;
-      extras_.shownAtMs = (frameDoneNs - *firstSampledNs_) / kNsPerMs;
-      if (options_.measure && options_.deferMeasure) {
+      record_.shownAtMs = (frameDoneNs - *firstSampledNs_) / kNsPerMs;
+      const bool deferred = options_.measure && options_.deferMeasure;
+      if (deferred) {
         // The image and the pose it was drawn for; scored after the replay.
-        extras_.scorePending = true;
         if (!producer_.keepShown(i, pose, frameDoneNs)) ++result_.framesNotKept;
       } else if (options_.measure) {
         Result<FrameQuality> quality = producer_.measure(i, pose);
@@ -122,15 +123,14 @@ class Replay {
           result_.status = quality.status();
           break;
         }
-        applyQuality(record, extras_, *quality);
+        record_.quality = *quality;
       }
       const std::uint64_t bytesNow = link_.bytesReceived();
-      record.linkBytes = bytesNow - bytesBefore;
+      record_.linkBytes = bytesNow - bytesBefore;
       bytesBefore = bytesNow;
-      sendStats(record, pose);
-      result_.records.push_back(record);
-      result_.extras.push_back(extras_);
-      observer_.onFrame(record, extras_);
+      sendStats(pose);
+      ++result_.frames;
+      observer_.onFrame(record_, deferred);
     }
     result_.posesSkipped = source_.skipped();
     if (options_.measure && options_.deferMeasure) scoreDeferred();
@@ -138,32 +138,16 @@ class Replay {
   }
 
  private:
-  static void applyQuality(FrameRecord& record, FrameExtras& extras, const FrameQuality& quality) {
-    record.snrDb = quality.snrDb;
-    record.psnrDb = quality.psnrDb;
-    extras.referenceMs = quality.referenceMs;
-    extras.visibleObjects = quality.visibleObjects;
-    extras.missingObjects = quality.missingObjects;
-    extras.blank = quality.blank;
-  }
-
-  // Deferred measurement: every kept frame scored against its own pose's
-  // reference, merged into its record by frame number.
+  // Deferred measurement: the kept frames' scores, for the observer to merge
+  // into the records it holds (by frame number).
   void scoreDeferred() {
-    Result<std::vector<KeptFrameQuality>> scores = producer_.scoreKept();
+    Result<std::vector<FrameScore>> scores = producer_.scoreKept();
     if (!scores.ok()) {
       if (result_.status.ok()) result_.status = scores.status();
-    } else {
-      for (const KeptFrameQuality& kept : *scores) {
-        // Records are numbered 0, 1, ... in order, so the frame is the index.
-        if (kept.frame >= result_.records.size()) continue;
-        applyQuality(result_.records[kept.frame], result_.extras[kept.frame], kept.quality);
-      }
+      observer_.onFramesScored({});
+      return;
     }
-    for (std::size_t k = 0; k < result_.records.size(); ++k) {
-      result_.extras[k].scorePending = false;
-      observer_.onFrameScored(result_.records[k], result_.extras[k]);
-    }
+    observer_.onFramesScored(*scores);
   }
 
   // Polls the link in slices until `done()`, the deadline, or a stop request.
@@ -194,21 +178,21 @@ class Replay {
       return now;
     }
     poseSentNs_[frame] = now;
-    extras_.poseSent = true;
+    poseSent_ = true;
     return now;
   }
 
   void absorb(std::vector<protocol::SceneUpdate> updates) {
     for (protocol::SceneUpdate& update : updates) {
       ++result_.updatesReceived;
-      ++extras_.updatesReceived;
+      ++record_.updatesReceived;
       if (update.frame < answered_.size()) answered_[update.frame] = true;
       Result<SceneBatch> batch = convertUpdate(update, options_.conversion);
       const Status submitted =
           batch.ok() ? producer_.submit(std::move(batch).value()) : batch.status();
       if (!submitted.ok()) {
         ++result_.updatesRejected;
-        ++extras_.updatesRejected;
+        ++record_.updatesRejected;
         observer_.onUpdateRejected(update, submitted);
         refusedPlans_.push_back(update.plan);  // the backbone corrects its mirror
         continue;
@@ -217,9 +201,10 @@ class Replay {
     }
   }
 
-  FrameRecord recordOf(std::size_t frame, const Pose& pose, const ProducedFrame& produced,
-                       std::int64_t frameDoneNs) {
-    FrameRecord record;
+  // The frame's identity and what was drawn, into record_.
+  void recordDrawn(std::size_t frame, const Pose& pose, const ProducedFrame& produced,
+                   std::int64_t frameDoneNs) {
+    FrameRecord& record = record_;
     record.frame = frame;
     record.timeS = pose.time;
     record.polygons = produced.triangles;
@@ -245,29 +230,20 @@ class Replay {
       }
     }
     record.targetAccuracy = targetAccuracy_;
-    return record;
   }
 
-  void sendStats(const FrameRecord& record, const Pose& pose) {
+  void sendStats(const Pose& pose) {
     if (!link_.connected()) return;
-    protocol::FrameStats stats;
-    stats.frame = record.frame;
-    stats.plan = record.plan;
-    stats.timestampNs = secondsToNanoseconds(pose.time);
-    stats.polygons = static_cast<std::uint32_t>(
-        std::min<std::size_t>(record.polygons, std::numeric_limits<std::uint32_t>::max()));
-    stats.linkBytes = record.linkBytes;
-    stats.hasSnr = std::isfinite(record.snrDb);
-    stats.snrDb = stats.hasSnr ? record.snrDb : 0.0;
-    stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
     // Oldest first; a flood beyond the message's limit keeps the newest.
     const std::size_t skip = refusedPlans_.size() > protocol::kMaxRejectedPlans
                                  ? refusedPlans_.size() - protocol::kMaxRejectedPlans
                                  : 0;
-    stats.rejectedPlans.assign(refusedPlans_.begin() + skip, refusedPlans_.end());
-    const Status sent = link_.send(stats);
+    const Status sent = link_.send(toFrameStats(
+        record_, secondsToNanoseconds(pose.time),
+        std::vector<std::uint64_t>(refusedPlans_.begin() + static_cast<std::ptrdiff_t>(skip),
+                                   refusedPlans_.end())));
     if (sent.ok()) refusedPlans_.clear();
-    if (!sent.ok()) observer_.onSendFailed("FrameStats", record.frame, sent);
+    if (!sent.ok()) observer_.onSendFailed("FrameStats", record_.frame, sent);
   }
 
   PoseSource& source_;
@@ -282,9 +258,10 @@ class Replay {
   std::deque<SubmittedUpdate> submitted_;
   // Plans of updates refused or dropped since the last FrameStats.
   std::vector<std::uint64_t> refusedPlans_;
-  double targetAccuracy_ = FrameRecord::kMissing;
+  double targetAccuracy_ = kMissingValue;
   std::optional<std::int64_t> firstSampledNs_;  // frame 0's pose
-  FrameExtras extras_;
+  FrameRecord record_;                          // the frame being made
+  bool poseSent_ = false;                       // this frame's pose went out
   ReplayResult result_;
 };
 

@@ -9,16 +9,21 @@
 //   link has (0 ms) or, in lockstep, wait up
 //   to lockstepTimeout for the SceneUpdate with frame == i; convert and submit
 //   every update in arrival order (a bad update is rejected whole); render
-//   the frame; then measure it against the reference; emit a FrameRecord and
-//   send FrameStats.
+//   the frame; then measure it against the reference (FrameProducer::measure
+//   fills FrameRecord::quality), hand the frame's FrameRecord to
+//   ReplayObserver::onFrame and send FrameStats (toFrameStats, wire_conversion.h).
+// - Memory: the loop keeps no records (the observer streams them, e.g. into a
+//   FrameLog); per frame it keeps 8 bytes (when the pose was sent, for
+//   update_latency_ms of a later answer) and 1 bit (answered), whatever the
+//   run length.
 // - Deferred measurement (measure && deferMeasure, the live workbench mode):
 //   instead of rendering the reference inline, the frame just shown is kept
 //   with the pose it was drawn for (FrameProducer::keepShown) and nothing
 //   else delays the client. After the last frame (also after a stop),
 //   FrameProducer::scoreKept scores every kept frame against the reference of
-//   its own pose; the scores are merged into the records and
-//   ReplayObserver::onFrameScored is called once per record, in frame order.
-//   Meanwhile onFrame sees FrameExtras::scorePending = true.
+//   its own pose and ReplayObserver::onFramesScored gets the scores once
+//   (ascending by frame; empty when scoring failed) to merge into the records
+//   it was given with scorePending = true (FrameLog::applyScores).
 // - Waiting is always link.poll(timeout, source.wakeFd()) in slices of at
 //   most pollSlice, then source.refresh(), so updates and poses keep flowing
 //   (a pose is stamped when it is read) and a stop request ends the wait
@@ -44,8 +49,8 @@
 //   that the newest visible update answered (SceneUpdate.frame) was sent;
 //   NaN on other frames or when that pose was not sent by this process.
 // - link_bytes: link.bytesReceived() since the previous frame.
-// - Errors: a failed render or measurement ends the replay; the records so
-//   far are kept and the Status is in ReplayResult::status.
+// - Errors: a failed render or measurement ends the replay; the frames so
+//   far have been handed on and the Status is in ReplayResult::status.
 // - Single-threaded; the interfaces are called from the caller's thread.
 #pragma once
 
@@ -103,22 +108,6 @@ struct ProducedFrame {
   std::size_t uploadedBytes = 0;
 };
 
-struct FrameQuality {
-  double snrDb = FrameRecord::kMissing;
-  double psnrDb = FrameRecord::kMissing;
-  double referenceMs = FrameRecord::kMissing;
-  // Completeness (shown_frames.h): -1 = not measured.
-  long visibleObjects = -1;  // object groups in the view volume
-  long missingObjects = -1;  // of those, groups the frontend held nothing of
-  int blank = -1;            // 1: the shown frame is uniform, the reference is not
-};
-
-// A kept frame's score (deferred measurement).
-struct KeptFrameQuality {
-  std::uint64_t frame = 0;
-  FrameQuality quality;
-};
-
 // Renders the frontend frame and its reference.
 class FrameProducer {
  public:
@@ -135,39 +124,27 @@ class FrameProducer {
     return false;
   }
   // Scores every kept frame against the reference of its own pose.
-  virtual Result<std::vector<KeptFrameQuality>> scoreKept() {
-    return std::vector<KeptFrameQuality>{};
-  }
-};
-
-// Per-frame values beyond FrameRecord (extra CSV columns).
-struct FrameExtras {
-  double referenceMs = FrameRecord::kMissing;
-  double waitMs = 0.0;  // after sending the pose, waiting for the update (lockstep) or polling
-  bool poseSent = false;
-  bool lockstepTimedOut = false;
-  std::size_t updatesReceived = 0;           // this frame
-  std::size_t updatesRejected = 0;           // this frame
-  double shownAtMs = FrameRecord::kMissing;  // readback done, ms after frame 0's pose was sampled
-  long visibleObjects = -1;                  // FrameQuality's, -1 = not measured
-  long missingObjects = -1;
-  int blank = -1;
-  bool scorePending = false;  // deferred measurement: scored after the replay
+  // Ascending by frame.
+  virtual Result<std::vector<FrameScore>> scoreKept() { return std::vector<FrameScore>{}; }
 };
 
 // Hooks for logs and outputs; every method has a no-op default.
 class ReplayObserver {
  public:
   virtual ~ReplayObserver() = default;
-  virtual void onFrame(const FrameRecord&, const FrameExtras&) {}
-  // Deferred measurement only: each record again once scored, in frame order.
-  virtual void onFrameScored(const FrameRecord&, const FrameExtras&) {}
+  // Every frame, in order, once drawn (and measured inline). scorePending:
+  // deferred measurement, the record's quality comes with onFramesScored.
+  virtual void onFrame(const FrameRecord&, bool /*scorePending*/) {}
+  // Deferred measurement only, once after the replay (also after a stop or
+  // an error): the kept frames' scores, ascending by frame.
+  virtual void onFramesScored(const std::vector<FrameScore>&) {}
   virtual void onUpdateRejected(const protocol::SceneUpdate&, const Status&) {}
   virtual void onLockstepTimeout(std::uint64_t /*frame*/, double /*waitedMs*/) {}
   virtual void onUploadDropped(std::uint64_t /*frame*/, const std::string& /*error*/) {}
   virtual void onSendFailed(const char* /*what*/, std::uint64_t /*frame*/, const Status&) {}
 };
 
+// The defaults of the daemon's options (daemon_options.h binds them here).
 struct ReplayOptions {
   bool lockstep = false;
   std::chrono::milliseconds lockstepTimeout{5000};
@@ -182,8 +159,7 @@ struct ReplayOptions {
 };
 
 struct ReplayResult {
-  std::vector<FrameRecord> records;
-  std::vector<FrameExtras> extras;
+  std::size_t frames = 0;  // handed to ReplayObserver::onFrame
   std::size_t updatesReceived = 0;
   std::size_t updatesApplied = 0;  // became visible
   std::size_t updatesRejected = 0;

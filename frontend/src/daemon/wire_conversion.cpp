@@ -1,6 +1,7 @@
 #include "wire_conversion.h"
 
 #include <algorithm>
+#include <cmath>
 #include <glm/common.hpp>
 #include <limits>
 #include <memory>
@@ -182,6 +183,22 @@ std::size_t payloadBytes(const protocol::SceneUpdate& update) {
     bytes += op.representation.mesh.size() + op.representation.texture.data.size();
   }
   return bytes;
+}
+
+protocol::FrameStats toFrameStats(const FrameRecord& record, std::int64_t timestampNs,
+                                  std::vector<std::uint64_t> rejectedPlans) {
+  protocol::FrameStats stats;
+  stats.frame = record.frame;
+  stats.plan = record.plan;
+  stats.timestampNs = timestampNs;
+  stats.polygons = static_cast<std::uint32_t>(
+      std::min<std::size_t>(record.polygons, std::numeric_limits<std::uint32_t>::max()));
+  stats.linkBytes = record.linkBytes;
+  stats.hasSnr = std::isfinite(record.quality.snrDb);
+  stats.snrDb = stats.hasSnr ? record.quality.snrDb : 0.0;
+  stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
+  stats.rejectedPlans = std::move(rejectedPlans);
+  return stats;
 }
 
 }  // namespace thinlod::frontend::daemon

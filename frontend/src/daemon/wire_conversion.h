@@ -1,6 +1,7 @@
-// Wire -> frontend: turns a protocol::SceneUpdate (Draco meshes, codec-framed
+// Wire <-> frontend: turns a protocol::SceneUpdate (Draco meshes, codec-framed
 // textures, docs/protocol.md) into a frontend::SceneBatch the renderer can
-// submit. Pure: no I/O, no logging, no globals; thread-safe.
+// submit, and a FrameRecord into the FrameStats sent back (the only place
+// that does). Pure: no I/O, no logging, no globals; thread-safe.
 //
 // Contract:
 // - The update is converted whole or not at all: the first bad operation
@@ -26,9 +27,11 @@
 #include <cstdint>
 #include <glm/vec4.hpp>
 #include <map>
+#include <vector>
 
 #include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/frontend/frame_record.h"
 #include "thinlod/frontend/frontend_scene.h"
 #include "thinlod/protocol/messages.h"
 
@@ -50,6 +53,14 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
 // The whole update as one batch (plan copied), or the first error.
 Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
                                  const ConversionOptions& options);
+
+// FrameStats of a frame: frame, plan, polygons (saturated to 32 bits),
+// linkBytes and renderMs (0 when not finite) from the record; hasSnr only for
+// a finite SNR (snrDb 0 otherwise: identical frames' +inf and a uniform
+// frame's -inf are not sent); `timestampNs` = the pose's trace time;
+// `rejectedPlans` at most protocol::kMaxRejectedPlans (the caller trims).
+protocol::FrameStats toFrameStats(const FrameRecord& record, std::int64_t timestampNs,
+                                  std::vector<std::uint64_t> rejectedPlans);
 
 // Bytes of mesh and texture payload in an update (what decoding has to chew).
 std::size_t payloadBytes(const protocol::SceneUpdate& update);

@@ -86,13 +86,13 @@ bool ShownFrameLog::record(std::uint64_t frame, const Pose& pose, std::int64_t s
   return true;
 }
 
-Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
-                                                      ReferenceSource& references,
-                                                      const std::vector<ObjectExtent>& objects,
-                                                      std::uint32_t minPixels,
-                                                      const ScoredFrameSink& sink) {
+Result<std::vector<FrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
+                                                 ReferenceSource& references,
+                                                 const std::vector<ObjectExtent>& objects,
+                                                 std::uint32_t minPixels,
+                                                 const ScoredFrameSink& sink) {
   static const std::vector<std::uint64_t> kNothingHeld;
-  std::vector<ShownFrameScore> scores;
+  std::vector<FrameScore> scores;
   scores.reserve(frames.size());
   RgbaImage reference;
   std::vector<std::uint32_t> covered;
@@ -110,12 +110,12 @@ Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFra
       return Status(comparison.status().code(), "shown frame " + std::to_string(shown.frame) +
                                                     ": " + comparison.status().message());
     }
-    ShownFrameScore score;
+    FrameScore score;
     score.frame = shown.frame;
-    score.snrDb = comparison->snrDb;
-    score.psnrDb = comparison->psnrDb;
-    score.referenceMs = *renderMs;
-    score.blank = comparison->variance == 0.0 && !uniformRgb(reference);
+    score.quality.snrDb = comparison->snrDb;
+    score.quality.psnrDb = comparison->psnrDb;
+    score.quality.referenceMs = *renderMs;
+    score.quality.blank = comparison->variance == 0.0 && !uniformRgb(reference) ? 1 : 0;
     if (!covered.empty()) {
       Result<Completeness> completeness = frameCompleteness(
           objects, covered, shown.held != nullptr ? *shown.held : kNothingHeld, minPixels);
@@ -123,7 +123,8 @@ Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFra
         return Status(completeness.status().code(), "shown frame " + std::to_string(shown.frame) +
                                                         ": " + completeness.status().message());
       }
-      score.completeness = *completeness;
+      score.quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
+      score.quality.missingObjects = static_cast<long>(completeness->missingGroups);
     }
     if (sink) sink(shown, reference, score);
     scores.push_back(score);

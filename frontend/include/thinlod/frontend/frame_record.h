@@ -1,103 +1,186 @@
-// Replay bookkeeping: one record per rendered frame, a CSV row formatter with
-// a thin file wrapper, and a run summary as a struct and JSON text.
+// One frame's numbers and the one writer of a run's per-frame CSV
+// (frames.csv) and summary (docs/frontend.md, "Per-frame CSV and summary").
 //
 // Contract:
+// - FrameRecord is the only per-frame record: it holds every column of
+//   frames.csv, in frameCsvHeader() order. FrameQuality (what measuring the
+//   frame against its reference gives) is one member of it, filled whole by
+//   the producer or a deferred FrameScore; protocol::FrameStats is made from a
+//   record in one place (daemon, wire_conversion.h).
 // - Units: time_s = trace time of the frame's pose (seconds); *_ms =
 //   milliseconds of wall-clock time; link_bytes = bytes received from the
 //   backbone since the previous frame; target_accuracy = the plan's target
 //   (1/rad, as the backbone defines it); snr_db/psnr_db as frame_metrics.h.
-// - pose_to_frame_ms: the pose was sampled -> the frame drawn for it, with the
-//   newest state held then, was read back (the thin client's own latency, the
-//   paper's 8 ms). update_latency_ms: the pose was sent -> the backbone's
-//   update answering it became visible (the round trip through the backbone,
-//   and the simplifier when it waited for one); only on frames that show one.
-// - Missing values are NaN: written as an empty CSV field and JSON null.
+//   Each column's meaning: docs/frontend.md, "Columns and their exact meaning".
+// - Missing values are NaN (counts: -1): an empty CSV field and JSON null.
 //   Infinite SNR/PSNR (identical frames) is written "inf" / "-inf" in both.
 // - Percentiles are nearest-rank over the finite values: the p-th of n
 //   sorted values is element ceil(p/100 * n) - 1; the median is p = 50 (the
-//   lower middle for even n). min/median of SNR include infinities.
-// - formatFrameCsvRow / frameCsvHeader / summarizeFrames / summaryJson are
-//   pure and thread-safe. FrameCsvWriter owns one file (not thread-safe);
-//   I/O failures are kIoError naming the path.
+//   lower middle for even n). min/median of SNR and PSNR include infinities.
+// - Memory: FrameSummary keeps no records, only the values its quantiles
+//   need: at most 7 doubles per frame (render, pose-to-frame, update-latency,
+//   reference and wait ms when finite; SNR and PSNR when measured), i.e.
+//   <= 56 bytes per frame plus vector slack (< 2x), and O(1) counters. Its
+//   summary equals summarizing all records at once. FrameLog adds nothing per
+//   frame: rows go to the file as they come, and records awaiting a deferred
+//   score go to an anonymous temporary file (sizeof(FrameRecord) bytes each on
+//   disk, none in memory) until applyScores().
+// - formatFrameCsvRow / frameCsvHeader / summaryJson / percentiles are pure and
+//   thread-safe. FrameSummary and FrameLog are not thread-safe; FrameLog's I/O
+//   failures are kIoError naming the path (the first one sticks).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
-#include <utility>
+#include <type_traits>
 #include <vector>
 
 #include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend {
 
+inline constexpr double kMissingValue = std::numeric_limits<double>::quiet_NaN();
+
+// A frame measured against the full-quality reference of its pose.
+struct FrameQuality {
+  double snrDb = kMissingValue;
+  double psnrDb = kMissingValue;
+  double referenceMs = kMissingValue;  // the reference's render time
+  // Completeness (shown_frames.h): -1 = not measured.
+  long visibleObjects = -1;  // object groups in the view volume
+  long missingObjects = -1;  // of those, groups the frontend held nothing of
+  int blank = -1;            // 1: the shown frame is uniform, the reference is not
+};
+
+// A deferred measurement: the quality of frame `frame`, known after the replay.
+struct FrameScore {
+  std::uint64_t frame = 0;
+  FrameQuality quality;
+};
+
 struct FrameRecord {
-  static constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
+  static constexpr double kMissing = kMissingValue;
   std::uint64_t frame = 0;
   double timeS = 0.0;
   std::size_t polygons = 0;
   std::uint64_t linkBytes = 0;
   double targetAccuracy = kMissing;
-  double snrDb = kMissing;
-  double psnrDb = kMissing;
   double renderMs = kMissing;
   double poseToFrameMs = kMissing;
   double updateLatencyMs = kMissing;
   std::uint64_t plan = 0;  // last applied SceneUpdate plan
   std::size_t drawCalls = 0;
   std::size_t uploadedBytes = 0;  // representation bytes uploaded to the GPU this frame
+  double waitMs = 0.0;            // pose sent -> render started (lockstep wait or poll)
+  std::size_t updatesReceived = 0;
+  std::size_t updatesRejected = 0;
+  bool lockstepTimedOut = false;
+  double shownAtMs = kMissing;  // readback done, ms after frame 0's pose was sampled
+  FrameQuality quality;         // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
+// FrameLog spills pending records as raw bytes.
+static_assert(std::is_trivially_copyable_v<FrameRecord>);
 
 // "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,
-//  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes\n"
+//  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,
+//  reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,
+//  shown_at_ms,visible_objects,missing_objects,blank\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);
 
 struct Percentiles {
   std::size_t count = 0;  // finite values used
-  double median = FrameRecord::kMissing;
-  double p99 = FrameRecord::kMissing;
-  double max = FrameRecord::kMissing;
+  double median = kMissingValue;
+  double p99 = kMissingValue;
+  double max = kMissingValue;
 };
+// Drops non-finite values.
+Percentiles percentiles(std::vector<double> values);
 
 struct ReplaySummary {
   std::size_t frames = 0;
   Percentiles renderMs;
   Percentiles poseToFrameMs;
   Percentiles updateLatencyMs;
+  Percentiles referenceMs;
+  Percentiles waitMs;
   std::size_t snrFrames = 0;  // frames with a measured SNR (infinite included)
-  double snrMedianDb = FrameRecord::kMissing;
-  double snrMinDb = FrameRecord::kMissing;
-  double psnrMedianDb = FrameRecord::kMissing;
-  double polygonsMean = FrameRecord::kMissing;
+  double snrMedianDb = kMissingValue;
+  double snrMinDb = kMissingValue;
+  double psnrMedianDb = kMissingValue;
+  double polygonsMean = kMissingValue;
   std::size_t polygonsMax = 0;
   std::uint64_t linkBytesTotal = 0;
 };
 
-Percentiles percentiles(std::vector<double> values);  // drops non-finite values
-ReplaySummary summarizeFrames(const std::vector<FrameRecord>& records);
-// A JSON object (nlohmann_json), indented by 2.
+// A run's summary, accumulated frame by frame (memory: see the contract).
+class FrameSummary {
+ public:
+  void add(const FrameRecord& record);
+  // Sorts the kept values in place; add() may go on afterwards.
+  ReplaySummary summarize();
+  std::size_t frames() const { return frames_; }
+  // Heap bytes held for the quantiles (vector capacities).
+  std::size_t heldBytes() const;
+
+ private:
+  std::size_t frames_ = 0;
+  double polygonSum_ = 0.0;
+  std::size_t polygonsMax_ = 0;
+  std::uint64_t linkBytesTotal_ = 0;
+  std::vector<double> renderMs_, poseToFrameMs_, updateLatencyMs_, referenceMs_, waitMs_;
+  std::vector<double> snrDb_, psnrDb_;  // measured: infinities kept, NaN dropped
+};
+
+// A JSON object (nlohmann_json), indented by 2: frames, render_ms,
+// pose_to_frame_ms, update_latency_ms, reference_ms, wait_ms ({count, median,
+// p99, max}), snr_db {count, median, min}, psnr_db {median}, polygons {mean,
+// max}, link_bytes_total.
 std::string summaryJson(const ReplaySummary& summary);
 
-class FrameCsvWriter {
+// frames.csv and the summary of one run.
+class FrameLog {
  public:
-  // Creates/truncates `path` and writes the header.
-  static Result<std::unique_ptr<FrameCsvWriter>> open(const std::string& path);
-  ~FrameCsvWriter();
-  Status append(const FrameRecord& record);  // flushed per row so a crash loses little
+  // Creates/truncates `csvPath` and writes the header; "" = no CSV (summary only).
+  static Result<std::unique_ptr<FrameLog>> open(const std::string& csvPath);
+  ~FrameLog();
+  FrameLog(const FrameLog&) = delete;
+  FrameLog& operator=(const FrameLog&) = delete;
+
+  // A finished record: its row (flushed, so a crash loses little) and the summary.
+  Status add(const FrameRecord& record);
+  // A record whose quality comes later (deferred scoring): spilled to a
+  // temporary file. Pending records must come in frame order.
+  Status addPending(const FrameRecord& record);
+  // Reads the pending records back in order, sets each one's quality from the
+  // score with its frame number (scores ascending by frame; records without
+  // one keep theirs), calls `onRecord` with it and add()s it.
+  Status applyScores(const std::vector<FrameScore>& scores,
+                     const std::function<void(const FrameRecord&)>& onRecord = {});
+  std::size_t pendingRecords() const { return pending_; }
+
+  FrameSummary& summary() { return summary_; }
+  // The first I/O error so far (ok when none).
+  const Status& error() const { return error_; }
+  // Closes the CSV (pending records are dropped); returns error() or the close's error.
   Status close();
 
  private:
-  FrameCsvWriter(std::string path, std::FILE* file) : path_(std::move(path)), file_(file) {}
+  FrameLog(std::string path, std::FILE* csv) : path_(std::move(path)), csv_(csv) {}
+  Status fail(Status status);
   std::string path_;
-  std::FILE* file_;
+  std::FILE* csv_;
+  std::FILE* spill_ = nullptr;  // pending records (tmpfile), opened on first use
+  std::size_t pending_ = 0;
+  std::uint64_t lastPendingFrame_ = 0;
+  FrameSummary summary_;
+  Status error_;
 };
-
-// Writes summaryJson(summary) to `path` (kIoError on failure).
-Status writeSummaryJson(const std::string& path, const ReplaySummary& summary);
 
 }  // namespace thinlod::frontend

@@ -17,7 +17,7 @@
 //   thread-safe.
 // - ReferenceSource renders the full-quality frame of a pose (GL in the
 //   daemon, a fake in tests). scoreShownFrames() calls it once per kept
-//   frame, in frame order, and returns one ShownFrameScore per kept frame.
+//   frame, in frame order, and returns one FrameScore per kept frame.
 // - Visibility is by coverage of the reference: an object group is visible
 //   when it covers at least minPixels pixels of the pose's reference (an id
 //   render: occlusion included); objects of one LOD share a group (any level
@@ -37,6 +37,7 @@
 #include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/core/trace.h"
+#include "thinlod/frontend/frame_record.h"
 
 namespace thinlod::frontend {
 
@@ -111,27 +112,20 @@ class ReferenceSource {
                                 std::vector<std::uint32_t>& covered) = 0;
 };
 
-struct ShownFrameScore {
-  std::uint64_t frame = 0;
-  double snrDb = 0.0;
-  double psnrDb = 0.0;
-  double referenceMs = 0.0;
-  // The shown frame is one uniform colour while the reference is not.
-  bool blank = false;
-  Completeness completeness;
-};
-
 // Called after each frame is scored with the shown frame and its reference
 // (e.g. to write them out); may be empty.
 using ScoredFrameSink =
-    std::function<void(const ShownFrame&, const RgbaImage& reference, const ShownFrameScore&)>;
+    std::function<void(const ShownFrame&, const RgbaImage& reference, const FrameScore&)>;
 
-// Completeness is left at zero when the source returns no coverage.
-Result<std::vector<ShownFrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
-                                                      ReferenceSource& references,
-                                                      const std::vector<ObjectExtent>& objects,
-                                                      std::uint32_t minPixels,
-                                                      const ScoredFrameSink& sink = {});
+// One FrameScore per kept frame (frame_record.h: the record's quality whole).
+// blank: 1 when the shown frame is one uniform grey (all RGB bytes equal)
+// while the reference is not one uniform colour. Completeness (visible /
+// missing objects) stays -1 when the source returns no coverage.
+Result<std::vector<FrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
+                                                 ReferenceSource& references,
+                                                 const std::vector<ObjectExtent>& objects,
+                                                 std::uint32_t minPixels,
+                                                 const ScoredFrameSink& sink = {});
 
 // |a - b| per RGB channel, alpha 255 (for difference images). Sizes must match
 // (kInvalidArgument otherwise).
