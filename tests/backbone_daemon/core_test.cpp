@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <deque>
+#include <map>
 #include <random>
 #include <set>
 
@@ -503,6 +504,53 @@ TEST(BackboneCoreLink, ShaperDefersWhatTheEstimatesMissedAndSendsItLater) {
   EXPECT_GT(run.adds, 3u);
 }
 
+// The scheduler's link log holds what the shaper let through: after every
+// pose the bytes it logged as sent within its window equal the shaped bytes
+// of the poses in that window, and over the whole flight the shaper's total
+// equals the bytes of the updates.
+TEST(BackboneCoreLink, SchedulerLogAndShaperAgreeOnTheBytesSent) {
+  for (const double meshBytesPerTriangle : {1.5, 40.0}) {  // estimates right, estimates short
+    CoreOptions options;
+    options.config.maxSpeed = 0.1;
+    options.budget.maxLinkBytesPerSecond = 8000.0;
+    options.linkBurstBytes = 12000.0;
+    auto core = makeCore(options);
+    ASSERT_NE(core, nullptr);
+    deliverCurves(*core);
+    FakeSimplifier fake(*core);
+    fake.meshBytesPerTriangle = meshBytesPerTriangle;
+    fake.texturebytes = 9000;
+    const double window = core->options().config.plannedLifetime;
+    std::vector<std::pair<double, double>> sent;  // (pose time, shaped bytes)
+    double total = 0.0;
+    std::size_t deferred = 0;
+    std::mt19937_64 random(21);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double t = 0.0;
+    for (int step = 0; step < 90; ++step) {
+      t += 0.05 + 0.3 * unit(random);  // irregular pose spacing
+      const glm::vec3 position(2.0f, 1.1f, 3.4f - 0.02f * step);
+      ASSERT_TRUE(core->beginPose(poseAt(step, t, position, kCow)).ok());
+      std::vector<OutgoingRequest> requests = submitAll(*core);
+      if (step % 3 != 2) answer(*core, fake, requests);  // some replies never come
+      PoseOutcome outcome = core->finishPose();
+      ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+      sent.emplace_back(t, double(outcome.linkBytes));
+      total += double(outcome.linkBytes);
+      deferred += outcome.deferredByLink;
+      double inWindow = 0.0;
+      for (const auto& [time, bytes] : sent)
+        if (time > t - window) inWindow += bytes;
+      const backbone::PlannerState::LinkLogTotals logged = core->linkLogAfter(t - window);
+      ASSERT_DOUBLE_EQ(logged.settledBytes, inWindow) << "step " << step;
+      ASSERT_GE(logged.reservedBytes, 0.0);
+      ASSERT_EQ(double(core->shapedLinkBytes()), total) << "step " << step;
+    }
+    EXPECT_GT(total, 0.0);
+    if (meshBytesPerTriangle > 10.0) EXPECT_GT(deferred, 0u);  // the shaper had work to do
+  }
+}
+
 // ------------------------------------------------------------ convergence
 
 void standStill(const CoreOptions& options) {
@@ -561,8 +609,12 @@ class BackboneCoreResults : public ::testing::Test {
   void expectRejected(const protocol::SimplifyResult& result, ErrorCode code) {
     const Status status = core_->onSimplifyResult(result);
     EXPECT_EQ(status.code(), code) << status.toString();
-    // The request is forgotten: the good answer now is unknown too.
-    EXPECT_EQ(core_->onSimplifyResult(goodMeshResult()).code(), ErrorCode::kNotFound);
+    // The request is closed as failed: the good answer now is a late reply.
+    const std::uint64_t id = goodMeshResult().requestId;
+    EXPECT_EQ(core_->requestLedger().state(id), RequestState::kFailed);
+    const Status late = core_->onSimplifyResult(goodMeshResult());
+    EXPECT_EQ(late.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(late.message().find("late reply"), std::string::npos) << late.toString();
     // And the core keeps planning.
     EXPECT_TRUE(core_->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
     EXPECT_TRUE(core_->finishPose().planned);
@@ -578,7 +630,7 @@ TEST_F(BackboneCoreResults, UnknownRequestIdIsNotFound) {
   result.requestId = 987654321;
   EXPECT_EQ(core_->onSimplifyResult(result).code(), ErrorCode::kNotFound);
   protocol::ImpostorResult impostor;
-  impostor.requestId = 5;
+  impostor.requestId = 987654322;
   impostor.objectIds = {1};
   EXPECT_EQ(core_->onImpostorResult(impostor).code(), ErrorCode::kNotFound);
   EXPECT_TRUE(core_->onSimplifyResult(goodMeshResult()).ok());  // the real one still counts
@@ -621,7 +673,8 @@ TEST_F(BackboneCoreResults, ImpostorResultForAMeshRequestIsRejected) {
   result.requestId = goodMeshResult().requestId;
   result.objectIds = {goodMeshResult().objectId};
   EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(core_->onSimplifyResult(goodMeshResult()).code(), ErrorCode::kNotFound);
+  EXPECT_EQ(core_->onSimplifyResult(goodMeshResult()).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(core_->requestLedger().state(result.requestId), RequestState::kFailed);
 }
 
 TEST(BackboneCoreCurve, MalformedCurveSamplesKeepTheFallbackCurve) {
@@ -727,7 +780,8 @@ TEST_F(BackboneCoreImpostors, WrongKindIsRejected) {
   protocol::ImpostorResult result = good();
   result.representation.kind = protocol::RepresentationKind::kMeshedImpostor;
   EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(core_->onImpostorResult(good()).code(), ErrorCode::kNotFound);
+  EXPECT_EQ(core_->onImpostorResult(good()).code(), ErrorCode::kInvalidArgument);  // late
+  EXPECT_EQ(core_->requestLedger().state(result.requestId), RequestState::kFailed);
 }
 
 TEST_F(BackboneCoreImpostors, InvertedValidityIsRejected) {
@@ -747,6 +801,165 @@ TEST_F(BackboneCoreImpostors, ForeignObjectIdsAreRejected) {
   protocol::ImpostorResult result = good();
   result.objectIds = {1, 2};
   EXPECT_EQ(core_->onImpostorResult(result).code(), ErrorCode::kInvalidArgument);
+}
+
+// ------------------------------------------------------- one request id
+
+// The id the plan gives a missing representation is the id on the wire,
+// the reply's, the backbone copy's and the one the frontend receives.
+TEST(BackboneCoreRequestIds, OneIdFromThePlanToTheFrontend) {
+  CoreOptions options = polygonBudget(400);
+  options.firstRequestId = 5000;
+  auto core = makeCore(options);
+  ASSERT_NE(core, nullptr);
+  std::vector<OutgoingRequest> startup = submitAll(*core);
+  ASSERT_EQ(startup.size(), 1u);           // the cow's curve
+  EXPECT_EQ(startup[0].requestId, 5000u);  // startup requests draw from the same counter
+  answer(*core, FakeSimplifier(*core), startup);
+  FakeSimplifier fake(*core);
+
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  const backbone::Plan* plan = core->latestPlan();
+  ASSERT_NE(plan, nullptr);
+  ASSERT_FALSE(plan->requests.empty());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  ASSERT_EQ(requests.size(), plan->requests.size());
+  std::map<std::uint64_t, std::uint32_t> optionOfId;
+  for (std::size_t i = 0; i < requests.size(); ++i) {
+    const std::uint64_t planned = plan->requests[i].requestId;
+    EXPECT_GT(planned, 5000u);
+    EXPECT_EQ(requests[i].requestId, planned);
+    const std::uint64_t onWire =
+        std::visit([](const auto& m) { return m.requestId; }, requests[i].message);
+    EXPECT_EQ(onWire, planned);
+    EXPECT_EQ(core->requestLedger().state(planned), RequestState::kInFlight);
+    optionOfId[planned] = plan->requests[i].option;
+  }
+  answer(*core, fake, requests);  // replies carry the same ids
+  for (const auto& [id, option] : optionOfId) {
+    EXPECT_EQ(core->requestLedger().state(id), RequestState::kAnswered);
+    EXPECT_EQ(core->schedulingScene().options[option].atBackbone.id, id);
+  }
+  ASSERT_TRUE(core->replan().ok());  // as the daemon's sync wait does
+  PoseOutcome outcome = core->finishPose();
+  std::size_t delivered = 0;
+  for (const auto& op : outcome.update.operations) {
+    if (op.type != protocol::SceneOperation::Type::kAddOrReplace) continue;
+    EXPECT_EQ(optionOfId.count(op.representation.representationId), 1u)
+        << "representation id " << op.representation.representationId;
+    ++delivered;
+  }
+  EXPECT_EQ(delivered, requests.size());
+}
+
+// The pool gives up on a request (its kTimeout reply after the last
+// attempt); the worker's real reply comes later and is dropped cleanly.
+TEST(BackboneCoreRequestIds, LateReplyAfterTimeoutIsRefusedAndNothingIsStored) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  (void)core->finishPose();
+  const OutgoingRequest* mesh = nullptr;
+  for (const OutgoingRequest& r : requests)
+    if (std::holds_alternative<protocol::SimplifyRequest>(r.message)) mesh = &r;
+  ASSERT_NE(mesh, nullptr);
+  const auto& request = std::get<protocol::SimplifyRequest>(mesh->message);
+  const std::size_t openBefore = core->outstandingRequests();
+
+  protocol::SimplifyResult timedOut;
+  timedOut.requestId = mesh->requestId;
+  timedOut.objectId = request.objectId;
+  timedOut.status = Status(ErrorCode::kTimeout, "no worker answered in 3 attempts");
+  EXPECT_EQ(core->onSimplifyResult(timedOut).code(), ErrorCode::kTimeout);
+  EXPECT_EQ(core->requestLedger().state(mesh->requestId), RequestState::kTimedOut);
+  EXPECT_EQ(core->outstandingRequests(), openBefore - 1);
+
+  const Status late = core->onSimplifyResult(fake.simplify(request));
+  EXPECT_EQ(late.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(late.message().find("late reply"), std::string::npos) << late.toString();
+  EXPECT_EQ(core->requestLedger().state(mesh->requestId), RequestState::kTimedOut);
+  for (const backbone::RepresentationOption& option : core->schedulingScene().options)
+    EXPECT_FALSE(option.atBackbone.present && option.atBackbone.id == mesh->requestId);
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+  EXPECT_TRUE(core->finishPose().planned);
+}
+
+TEST(BackboneCoreRequestIds, DuplicateReplyIsRefusedAndChangesNothing) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  answer(*core, fake, requests);
+  ASSERT_TRUE(core->replan().ok());
+  ASSERT_TRUE(submitAll(*core).empty());
+  PoseOutcome first = core->finishPose();
+  ASSERT_GT(first.adds, 0u);
+  const double triangles = core->frontendTriangles();
+  for (const OutgoingRequest& r : requests) {
+    Status again;
+    if (const auto* s = std::get_if<protocol::SimplifyRequest>(&r.message)) {
+      protocol::SimplifyResult result = fake.simplify(*s);
+      result.triangleCount += 1;  // a different payload must not replace the stored one
+      again = core->onSimplifyResult(result);
+    } else {
+      again = core->onImpostorResult(fake.impostor(std::get<protocol::ImpostorRequest>(r.message)));
+    }
+    EXPECT_EQ(again.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(again.message().find("duplicate reply"), std::string::npos) << again.toString();
+    EXPECT_EQ(core->requestLedger().state(r.requestId), RequestState::kAnswered);
+  }
+  EXPECT_EQ(core->requestLedger().closedCount(RequestState::kAnswered),
+            requests.size() + 1);  // + the curve
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.5, kEntrance, kCow)).ok());
+  PoseOutcome second = core->finishPose();
+  EXPECT_EQ(second.adds, 0u);  // nothing new arrived
+  EXPECT_EQ(core->frontendTriangles(), triangles);
+}
+
+// A request the scheduler stops waiting for and asks again: the new id
+// replaces the old, which is cancelled on the wire; the old reply is late.
+TEST(BackboneCoreRequestIds, AskingAgainRetriesUnderTheNewIdAndCancelsTheOld) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> first = submitAll(*core);
+  (void)core->finishPose();
+  ASSERT_FALSE(first.empty());
+  // Unanswered past the scheduler's in-flight timeout (lifetime + delays).
+  ASSERT_TRUE(core->beginPose(poseAt(1, 5.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> second = submitAll(*core);
+  (void)core->finishPose();
+  ASSERT_FALSE(second.empty());
+  const std::vector<std::uint64_t> cancelled = core->takeCancellations();
+  const std::set<std::uint64_t> cancelledSet(cancelled.begin(), cancelled.end());
+  std::size_t retried = 0;
+  for (const OutgoingRequest& r : second) {
+    const LedgerRequest* open = core->requestLedger().open(r.requestId);
+    ASSERT_NE(open, nullptr);
+    if (open->retryOf == 0) continue;
+    ++retried;
+    EXPECT_EQ(open->attempt, 2);
+    EXPECT_EQ(core->requestLedger().state(open->retryOf), RequestState::kRetried);
+    EXPECT_EQ(cancelledSet.count(open->retryOf), 1u);
+  }
+  EXPECT_GT(retried, 0u);
+  for (const OutgoingRequest& r : first) {
+    if (core->requestLedger().state(r.requestId) != RequestState::kRetried) continue;
+    Status late;
+    if (const auto* s = std::get_if<protocol::SimplifyRequest>(&r.message)) {
+      late = core->onSimplifyResult(fake.simplify(*s));
+    } else {
+      late = core->onImpostorResult(fake.impostor(std::get<protocol::ImpostorRequest>(r.message)));
+    }
+    EXPECT_NE(late.message().find("late reply"), std::string::npos) << late.toString();
+  }
 }
 
 // ------------------------------------------------------------ sessions

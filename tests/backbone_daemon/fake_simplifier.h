@@ -115,14 +115,16 @@ class FakeSimplifier {
   const BackboneCore& core_;
 };
 
-// Submits every queued request (wire id = ticket + 1000) and returns them.
+// Submits every queued request (under its own id, as the WorkerPool does)
+// and returns them.
 inline std::vector<OutgoingRequest> submitAll(BackboneCore& core) {
   std::vector<OutgoingRequest> requests = core.takeRequests();
-  for (const OutgoingRequest& r : requests) core.requestSubmitted(r.ticket, r.ticket + 1000);
+  for (const OutgoingRequest& r : requests) core.requestSubmitted(r.requestId);
   return requests;
 }
 
-inline std::uint64_t wireIdOf(const OutgoingRequest& r) { return r.ticket + 1000; }
+// The id on the wire: the request's one id.
+inline std::uint64_t wireIdOf(const OutgoingRequest& r) { return r.requestId; }
 
 // Answers requests (already submitted) through the core's result handlers.
 inline void answer(BackboneCore& core, const FakeSimplifier& fake,

@@ -29,20 +29,38 @@ TEST(PendingRequests, WaitsWithoutWorkers) {
   EXPECT_TRUE(t.expire(kT0 + std::chrono::hours(1)).retry.empty());
 }
 
+// Oldest first means in the order add() saw them, whatever the ids (the
+// backbone's ids are its scheduler's and need not grow with submission).
 TEST(PendingRequests, OldestFirstUpToCapacity) {
   auto t = table();
   for (std::uint64_t id : {3, 1, 2}) ASSERT_TRUE(t.add(id).ok());
   auto sent = t.dispatch({{10, 2}}, kT0);
   ASSERT_EQ(sent.size(), 2u);
-  EXPECT_EQ(sent[0].requestId, 1u);
-  EXPECT_EQ(sent[1].requestId, 2u);
+  EXPECT_EQ(sent[0].requestId, 3u);
+  EXPECT_EQ(sent[1].requestId, 1u);
   EXPECT_EQ(sent[0].attempt, 1);
   EXPECT_EQ(t.inFlightOn(10), 2u);
   EXPECT_TRUE(t.dispatch({{10, 2}}, kT0).empty());  // full
-  ASSERT_TRUE(t.complete(1));
+  ASSERT_TRUE(t.complete(3));
   auto next = t.dispatch({{10, 2}}, kT0);
   ASSERT_EQ(next.size(), 1u);
-  EXPECT_EQ(next[0].requestId, 3u);
+  EXPECT_EQ(next[0].requestId, 2u);
+}
+
+TEST(PendingRequests, ARetryKeepsItsPlaceInTheQueue) {
+  auto t = table();
+  for (std::uint64_t id : {9, 4}) ASSERT_TRUE(t.add(id).ok());
+  auto sent = t.dispatch({{10, 1}}, kT0);
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].requestId, 9u);
+  ASSERT_TRUE(t.add(1).ok());  // added after 9 and 4
+  EXPECT_EQ(t.workerLost(10).retry, std::vector<std::uint64_t>{9});
+  auto again = t.dispatch({{20, 3}}, kT0);
+  ASSERT_EQ(again.size(), 3u);
+  EXPECT_EQ(again[0].requestId, 9u);
+  EXPECT_EQ(again[0].attempt, 2);
+  EXPECT_EQ(again[1].requestId, 4u);
+  EXPECT_EQ(again[2].requestId, 1u);
 }
 
 TEST(PendingRequests, BalancesAcrossWorkers) {

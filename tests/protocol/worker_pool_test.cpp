@@ -107,6 +107,35 @@ TEST(WorkerPool, RequestReachesAWorkerAndTheResultComesBack) {
   EXPECT_EQ(pool->pendingRequests(), 0u);
 }
 
+// The caller's id goes on the wire as it is (the backbone's one id end to
+// end); 0 asks the pool for a fresh one above every id it has seen.
+TEST(WorkerPool, RequestKeepsTheCallersIdOnTheWire) {
+  auto pool = bindPool();
+  ASSERT_TRUE(pool);
+  FakeWorker worker(pool->endpoint().address(), "simplifier-a");
+  PoolRecorder r;
+  auto step = [&] {
+    r.poll(*pool);
+    worker.poll();
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return pool->liveWorkers() == 1; }));
+  SimplifyRequest mine = simplifyRequest(3);
+  mine.requestId = 0x5000000001ull;
+  auto id = pool->submit(mine);
+  ASSERT_TRUE(id.ok()) << id.status().toString();
+  EXPECT_EQ(*id, 0x5000000001ull);
+  EXPECT_EQ(pool->submit(mine).status().code(), ErrorCode::kInvalidArgument);  // pending
+  auto fresh = pool->submit(simplifyRequest(4));
+  ASSERT_TRUE(fresh.ok());
+  EXPECT_GT(*fresh, *id);
+  ASSERT_TRUE(pumpUntil(step, [&] { return !worker.simplify.empty(); }));
+  EXPECT_EQ(worker.simplify[0].requestId, 0x5000000001ull);
+  ASSERT_TRUE(worker.answer(worker.simplify[0], 10).ok());
+  ASSERT_TRUE(
+      pumpUntil(step, [&] { return r.count(WorkerPoolEvent::Kind::kSimplifyResult) == 1; }));
+  EXPECT_EQ(r.events.back().simplify.requestId, 0x5000000001ull);
+}
+
 TEST(WorkerPool, ImpostorRequestsUseTheSameMachinery) {
   auto pool = bindPool();
   ASSERT_TRUE(pool);

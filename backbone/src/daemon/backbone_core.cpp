@@ -95,6 +95,8 @@ Status validateCoreOptions(const CoreOptions& o) {
     return invalid("link burst must be in [0, 4e9] bytes (0: automatic)");
   if (!std::isfinite(o.defaultAspect) || o.defaultAspect <= 0.0)
     return invalid("default aspect must be > 0");
+  if (o.firstRequestId == 0 || o.firstRequestId >= (std::uint64_t(1) << 62))
+    return invalid("first request id must be in [1, 2^62)");
   return Status();
 }
 
@@ -212,7 +214,7 @@ Status BackboneCore::initialize() {
   }
   // ImpostorRequests carry no scene path: the simplifier renders from the
   // scene it loaded last. Without a mesh curve request, make it load ours.
-  if (byTicket_.empty() && !scene_.objects.empty()) queueStartupRequest(0, 0, true);
+  if (ledger_.openCount() == 0 && !scene_.objects.empty()) queueStartupRequest(0, 0, true);
   backbone::updateSubtreeVersions(scene_);
   dirty_ = false;
   return backbone::validateScene(scene_);
@@ -220,24 +222,23 @@ Status BackboneCore::initialize() {
 
 void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t option, bool warmup) {
   const ObjectRecord& record = converted_.records[object];
-  Outstanding request;
-  request.ticket = nextTicket_++;
+  LedgerRequest request;
+  request.id = planner_.allocateRequestId();
+  request.purpose = warmup ? RequestPurpose::kWarmup : RequestPurpose::kCurve;
   request.object = object;
   request.option = option;
-  request.curve = true;
-  request.warmup = warmup;
   request.targetTriangles = static_cast<std::uint32_t>(std::clamp<double>(
       record.fullTriangles, 1.0, warmup ? 12.0 : double(options_.curveRequestTriangles)));
   protocol::SimplifyRequest message;
-  message.requestId = request.ticket;
+  message.requestId = request.id;
   message.objectId = record.id;
   message.sourcePath = scenePath_;
   message.sceneFingerprint = sceneGraph_.fingerprint;
   message.target = protocol::SimplifyRequest::Target::kTriangles;
   message.targetTriangles = request.targetTriangles;
   message.curvePoints = warmup ? 0 : options_.curvePoints;
-  byTicket_.emplace(request.ticket, request);
-  queued_.push_back({request.ticket, std::move(message)});
+  // Fresh ids from the planner's counter are never known to the ledger.
+  if (ledger_.ask(request).ok()) queued_.push_back({request.id, std::move(message)});
 }
 
 void BackboneCore::rebuildCurves(std::uint32_t index) {
@@ -282,35 +283,26 @@ std::vector<std::uint64_t> BackboneCore::takeCancellations() {
   return out;
 }
 
-void BackboneCore::requestSubmitted(std::uint64_t ticket, std::uint64_t wireId) {
-  auto it = byTicket_.find(ticket);
-  if (it == byTicket_.end()) return;
-  if (it->second.wireId != 0) ticketOfWire_.erase(it->second.wireId);
-  it->second.wireId = wireId;
-  ticketOfWire_[wireId] = ticket;
+void BackboneCore::requestSubmitted(std::uint64_t requestId) { ledger_.submitted(requestId); }
+
+void BackboneCore::requestNotSubmitted(std::uint64_t requestId) {
+  const LedgerRequest* request = ledger_.open(requestId);
+  if (request == nullptr) return;
+  const LedgerRequest copy = *request;
+  ledger_.close(requestId, RequestState::kFailed);
+  withdraw(copy);
 }
 
-void BackboneCore::requestNotSubmitted(std::uint64_t ticket) { forgetTicket(ticket); }
-
-void BackboneCore::forgetTicket(std::uint64_t ticket) {
-  auto it = byTicket_.find(ticket);
-  if (it == byTicket_.end()) return;
-  if (it->second.wireId != 0) ticketOfWire_.erase(it->second.wireId);
-  if (!it->second.curve) {
-    auto byOption = ticketOfOption_.find(it->second.option);
-    if (byOption != ticketOfOption_.end() && byOption->second == ticket)
-      ticketOfOption_.erase(byOption);
-  }
-  byTicket_.erase(it);
+void BackboneCore::withdraw(const LedgerRequest& request) {
+  if (request.state == RequestState::kInFlight) cancellations_.push_back(request.id);
   queued_.erase(std::remove_if(queued_.begin(), queued_.end(),
-                               [&](const OutgoingRequest& r) { return r.ticket == ticket; }),
+                               [&](const OutgoingRequest& r) { return r.requestId == request.id; }),
                 queued_.end());
+  planner_.releaseLinkReservation(request.id);
 }
 
 std::size_t BackboneCore::curvesPending() const {
-  std::size_t n = 0;
-  for (const auto& entry : byTicket_) n += entry.second.curve ? 1 : 0;
-  return n;
+  return ledger_.openCount(RequestPurpose::kCurve) + ledger_.openCount(RequestPurpose::kWarmup);
 }
 
 std::vector<std::uint64_t> BackboneCore::objectsWithoutMeasuredCurve() const {
@@ -323,29 +315,23 @@ std::vector<std::uint64_t> BackboneCore::objectsWithoutMeasuredCurve() const {
 }
 
 std::size_t BackboneCore::awaitedResults() const {
-  std::size_t n = 0;
-  for (const auto& entry : byTicket_)
-    n += (!entry.second.curve && entry.second.pose == poseCounter_) ? 1 : 0;
-  return n;
+  return ledger_.openPlanRequestsOfPose(poseCounter_);
 }
 
-void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
-  if (r.object >= converted_.records.size() || r.option >= scene_.options.size()) return;
+Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
+  if (r.object >= converted_.records.size() || r.option >= scene_.options.size())
+    return Status(ErrorCode::kInternal,
+                  "plan request " + idText(r.requestId) + " names no object/option of the scene");
   const ObjectRecord& record = converted_.records[r.object];
   const backbone::RepresentationOption& option = scene_.options[r.option];
   const OptionState& state = optionStates_[r.option];
 
-  Outstanding* existing = nullptr;
-  if (auto found = ticketOfOption_.find(r.option); found != ticketOfOption_.end()) {
-    auto entry = byTicket_.find(found->second);
-    if (entry != byTicket_.end()) existing = &entry->second;
-  }
-
-  Outstanding request;
+  LedgerRequest request;
+  request.id = r.requestId;
+  request.purpose = RequestPurpose::kPlan;
   request.object = r.object;
   request.option = r.option;
   request.kind = state.wireKind;
-  request.schedulerId = r.requestId;
   request.viewRegion = r.viewRegion;
   request.pose = poseCounter_;
   std::variant<protocol::SimplifyRequest, protocol::ImpostorRequest> message;
@@ -355,15 +341,6 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     request.targetTriangles = static_cast<std::uint32_t>(
         std::clamp(std::isfinite(wanted) ? wanted : 1.0, 1.0, double(protocol::kMaxTriangleCount)));
     request.requestedAccuracy = r.relativeAccuracy;
-    if (existing != nullptr && !existing->impostor &&
-        existing->targetTriangles == request.targetTriangles) {
-      // The same mesh is on its way: its result now answers this request.
-      existing->schedulerId = request.schedulerId;
-      existing->requestedAccuracy = request.requestedAccuracy;
-      existing->viewRegion = request.viewRegion;
-      existing->pose = poseCounter_;
-      return;
-    }
     protocol::SimplifyRequest simplify;
     simplify.objectId = record.id;
     simplify.sourcePath = scenePath_;
@@ -385,15 +362,6 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
       absolute = std::min(absolute, *options_.budget.fixedAccuracy);
     if (!std::isfinite(absolute) || absolute <= 0.0) absolute = 1.0;
     request.requestedAccuracy = absolute * record.diameter / distance;
-    if (existing != nullptr && existing->impostor && existing->kind == request.kind &&
-        glm::length(existing->viewRegion.center - r.viewRegion.center) <=
-            0.25 * r.viewRegion.radius &&
-        std::fabs(existing->requestedAccuracy - request.requestedAccuracy) <=
-            0.05 * request.requestedAccuracy) {
-      existing->schedulerId = request.schedulerId;
-      existing->pose = poseCounter_;
-      return;
-    }
     protocol::ImpostorRequest impostor;
     impostor.sceneFingerprint = sceneGraph_.fingerprint;
     impostor.objectIds = {record.id};
@@ -407,32 +375,29 @@ void BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     impostor.textureCodec = options_.textureCodec;
     message = std::move(impostor);
   }
-  if (existing != nullptr) {
-    // Superseded: the older request's result would no longer be wanted.
-    if (existing->wireId != 0) cancellations_.push_back(existing->wireId);
-    forgetTicket(existing->ticket);
-  }
-  request.ticket = nextTicket_++;
-  std::visit([&](auto& m) { m.requestId = request.ticket; }, message);
-  byTicket_.emplace(request.ticket, request);
-  ticketOfOption_[request.option] = request.ticket;
-  queued_.push_back({request.ticket, std::move(message)});
+  // The scheduler asks again for an option whose request is open (the same
+  // target under its new id, or another one): the new request replaces the
+  // old, whose reply would carry an id the scheduler no longer awaits.
+  Result<std::optional<LedgerRequest>> asked = ledger_.ask(request);
+  if (!asked.ok()) return Status(ErrorCode::kInternal, "plan request: " + asked.status().message());
+  if (asked->has_value()) withdraw(**asked);
+  std::visit([&](auto& m) { m.requestId = request.id; }, message);
+  queued_.push_back({request.id, std::move(message)});
+  return Status();
 }
 
-Result<BackboneCore::Outstanding> BackboneCore::claim(std::uint64_t wireId, const char* what) {
-  auto wire = ticketOfWire_.find(wireId);
-  if (wire == ticketOfWire_.end())
-    return Status(ErrorCode::kNotFound,
-                  std::string(what) + ": unknown request id " + idText(wireId));
-  auto it = byTicket_.find(wire->second);
-  if (it == byTicket_.end()) {
-    ticketOfWire_.erase(wire);
-    return Status(ErrorCode::kNotFound,
-                  std::string(what) + ": unknown request id " + idText(wireId));
-  }
-  Outstanding request = it->second;
-  forgetTicket(request.ticket);
-  return request;
+Result<LedgerRequest> BackboneCore::claim(std::uint64_t id, const char* what) {
+  Result<LedgerRequest> claimed = ledger_.claim(id);
+  if (!claimed.ok())
+    return Status(claimed.status().code(), std::string(what) + ": " + claimed.status().message());
+  return claimed;
+}
+
+void BackboneCore::refuse(const LedgerRequest& request, const Status& replyStatus) {
+  const bool timedOut =
+      replyStatus.code() == ErrorCode::kTimeout || replyStatus.code() == ErrorCode::kUnavailable;
+  ledger_.reclassify(request.id, timedOut ? RequestState::kTimedOut : RequestState::kFailed);
+  planner_.releaseLinkReservation(request.id);
 }
 
 void BackboneCore::learnMeshBytes(std::uint32_t object, double meshBytes, double triangles) {
@@ -456,9 +421,15 @@ void BackboneCore::storeBackboneCopy(std::uint32_t option, backbone::Representat
 }
 
 Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
-  Result<Outstanding> claimed = claim(result.requestId, "SimplifyResult");
+  Result<LedgerRequest> claimed = claim(result.requestId, "SimplifyResult");
   if (!claimed.ok()) return claimed.status();
-  const Outstanding& request = *claimed;
+  const Status used = useSimplifyResult(*claimed, result);
+  if (!used.ok()) refuse(*claimed, result.status);
+  return used;
+}
+
+Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
+                                       const protocol::SimplifyResult& result) {
   const ObjectRecord& record = converted_.records[request.object];
   const std::string where =
       "SimplifyResult " + idText(result.requestId) + " (object " + idText(record.id) + ")";
@@ -473,9 +444,9 @@ Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
   if (!std::isfinite(result.accuracy) || result.accuracy <= 0.0)
     return invalid(where + ": accuracy must be finite and > 0");
 
-  if (request.warmup) return Status();  // the scene is loaded; nothing to keep
+  if (request.purpose == RequestPurpose::kWarmup) return Status();  // the scene is loaded
   OptionState& state = optionStates_[request.option];
-  if (request.curve) {
+  if (request.purpose == RequestPurpose::kCurve) {
     if (result.curve.empty()) return invalid(where + ": no curve samples");
     std::vector<AccuracySample> samples;
     samples.reserve(result.curve.size());
@@ -505,7 +476,7 @@ Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
     rebuildCurves(request.option);
   }
   protocol::Representation rep;
-  rep.representationId = request.schedulerId;
+  rep.representationId = request.id;
   rep.kind = protocol::RepresentationKind::kMesh;
   rep.mesh = result.mesh;
   rep.transform = record.object->objectToWorld;
@@ -514,7 +485,7 @@ Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
   rep.triangleCount = result.triangleCount;
   backbone::RepresentationCopy copy;
   copy.present = true;
-  copy.id = request.schedulerId;
+  copy.id = request.id;
   copy.relativeAccuracy = relative;
   copy.triangles = result.triangleCount;
   copy.encodedBytes = payloadBytes(rep);
@@ -523,9 +494,15 @@ Status BackboneCore::onSimplifyResult(const protocol::SimplifyResult& result) {
 }
 
 Status BackboneCore::onImpostorResult(const protocol::ImpostorResult& result) {
-  Result<Outstanding> claimed = claim(result.requestId, "ImpostorResult");
+  Result<LedgerRequest> claimed = claim(result.requestId, "ImpostorResult");
   if (!claimed.ok()) return claimed.status();
-  const Outstanding& request = *claimed;
+  const Status used = useImpostorResult(*claimed, result);
+  if (!used.ok()) refuse(*claimed, result.status);
+  return used;
+}
+
+Status BackboneCore::useImpostorResult(const LedgerRequest& request,
+                                       const protocol::ImpostorResult& result) {
   const ObjectRecord& record = converted_.records[request.object];
   const std::string where =
       "ImpostorResult " + idText(result.requestId) + " (object " + idText(record.id) + ")";
@@ -575,10 +552,10 @@ Status BackboneCore::onImpostorResult(const protocol::ImpostorResult& result) {
     rebuildCurves(request.option);
 
   protocol::Representation stored = rep;
-  stored.representationId = request.schedulerId;
+  stored.representationId = request.id;
   backbone::RepresentationCopy copy;
   copy.present = true;
-  copy.id = request.schedulerId;
+  copy.id = request.id;
   copy.relativeAccuracy = request.requestedAccuracy > 0.0
                               ? std::min(textureRelative, request.requestedAccuracy)
                               : textureRelative;
@@ -615,7 +592,7 @@ Status BackboneCore::runPlan() {
   const std::vector<backbone::RepresentationRequest> requests = plan_->requests;
   for (const backbone::RepresentationRequest& r : requests) {
     promised_[r.requestId] = now;
-    issueRequest(r);
+    THINLOD_RETURN_IF_ERROR(issueRequest(r));
   }
   return Status();
 }
@@ -819,8 +796,11 @@ PoseOutcome BackboneCore::finishPose() {
         ++out.deferredByLink;
         continue;
       }
+      shapedBytes_ += bytes;
     }
     out.linkBytes += bytes;
+    // What the shaper let through is what the scheduler's log holds.
+    planner_.settleLinkSend(back.id, viewer_.timeSeconds, double(bytes));
     protocol::SceneOperation op;
     op.type = protocol::SceneOperation::Type::kAddOrReplace;
     op.objectId = converted_.records[add.object].id;
@@ -865,6 +845,7 @@ void BackboneCore::resetFrontend() {
   planner_.reset();
   promised_.clear();
   shaper_.reset();
+  shapedBytes_ = 0;
   lastTime_ = -1e300;
   lastPoseNs_.reset();
   posesBeyondStep_ = 0;

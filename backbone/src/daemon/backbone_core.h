@@ -9,13 +9,21 @@
 //   simple impostors (point curves from the texture size, learned from
 //   results). Link bytes are estimated from the results' encoded sizes
 //   (docs/backbone.md, "Link estimates").
-// - Requests: the core queues protocol requests with a local ticket as
-//   requestId; the shell submits them (WorkerPool assigns the wire id) and
-//   reports requestSubmitted(ticket, wireId). Results are matched by wire id;
-//   unknown ids, mismatched objects/kinds and malformed payloads are rejected
-//   with a Status (the request, if known, is forgotten). One request per
-//   (object, option) is outstanding at a time: a newer one supersedes it (the
-//   older wire id appears in takeCancellations()).
+// - Requests: one id end to end (request_ledger.h). The scheduler's request
+//   id is the wire requestId, the reply's and the copy's; startup requests
+//   draw from the same counter (ids start at CoreOptions::firstRequestId).
+//   The core queues the requests; the shell submits them under that id and
+//   reports requestSubmitted(id) / requestNotSubmitted(id). Replies are
+//   matched by id in the RequestLedger: unknown ids, duplicate and late
+//   replies, mismatched objects/kinds and malformed payloads are rejected
+//   with a Status. One plan request per option is open at a time: a newer
+//   one (the scheduler asking again) replaces it, and the older id appears
+//   in takeCancellations().
+// - Link: the LinkShaper is the one model of the link. Every byte it lets
+//   through is settled in the scheduler's link log under the copy's id
+//   (PlannerState::settleLinkSend), and a request that will never be shipped
+//   releases its reservation, so the budget the scheduler plans against is
+//   what the shaper sent (docs/backbone.md, "Link").
 // - Poses: beginPose() plans (queues requests); replan() plans the same pose
 //   again (after results arrived); finishPose() builds the pose's one
 //   SceneUpdate (frame = pose sequence). Removals first, then downgrades,
@@ -38,6 +46,7 @@
 #include <vector>
 
 #include "frontend_mirror.h"
+#include "request_ledger.h"
 #include "scene_conversion.h"
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/protocol/link_shaper.h"
@@ -74,11 +83,14 @@ struct CoreOptions {
   bool hardPolygonCap = true;         // never let the frontend hold more than budget.maxTriangles
   double linkBurstBytes = 0.0;        // 0: max(budget-link * plannedLifetime, 64 KiB)
   double defaultAspect = 16.0 / 9.0;  // width/height when the pose has no viewport
+  // The first request id (> 0, < 2^62). The shell draws a random one per
+  // process, so a reply computed for an earlier backbone never matches.
+  std::uint64_t firstRequestId = 1;
 };
 Status validateCoreOptions(const CoreOptions& options);
 
 struct OutgoingRequest {
-  std::uint64_t ticket = 0;
+  std::uint64_t requestId = 0;  // == the message's requestId
   std::variant<protocol::SimplifyRequest, protocol::ImpostorRequest> message;
 };
 
@@ -109,9 +121,9 @@ class BackboneCore {
 
   // ---- requests to the simplifier ----
   std::vector<OutgoingRequest> takeRequests();
-  std::vector<std::uint64_t> takeCancellations();  // wire ids
-  void requestSubmitted(std::uint64_t ticket, std::uint64_t wireId);
-  void requestNotSubmitted(std::uint64_t ticket);
+  std::vector<std::uint64_t> takeCancellations();  // request ids
+  void requestSubmitted(std::uint64_t requestId);
+  void requestNotSubmitted(std::uint64_t requestId);
   Status onSimplifyResult(const protocol::SimplifyResult& result);
   Status onImpostorResult(const protocol::ImpostorResult& result);
 
@@ -142,7 +154,15 @@ class BackboneCore {
   const FrontendMirror& frontendMirror() const { return mirror_; }
   // The latest plan of the current (or last) pose; null before the first.
   const backbone::Plan* latestPlan() const { return plan_ ? &*plan_ : nullptr; }
-  std::size_t outstandingRequests() const { return byTicket_.size(); }
+  std::size_t outstandingRequests() const { return ledger_.openCount(); }
+  const RequestLedger& requestLedger() const { return ledger_; }
+  // The scheduler's link log within its window (settled = shipped bytes).
+  backbone::PlannerState::LinkLogTotals linkLogAfter(double afterSeconds) const {
+    return planner_.linkLogAfter(afterSeconds);
+  }
+  // Bytes the link shaper let through since the frontend session began
+  // (kept here: a grown burst replaces the shaper).
+  std::uint64_t shapedLinkBytes() const { return shapedBytes_; }
   const CoreOptions& options() const { return options_; }
   const char* schedulerName() const;
   std::uint64_t sceneFingerprint() const { return sceneGraph_.fingerprint; }
@@ -166,21 +186,6 @@ class BackboneCore {
     double estimatedBytes = 0.0;
     bool learned = false;
   };
-  struct Outstanding {
-    std::uint64_t ticket = 0;
-    std::uint64_t wireId = 0;
-    std::uint32_t object = 0;
-    std::uint32_t option = 0;
-    bool curve = false;   // startup request (curve samples, or warm-up)
-    bool warmup = false;  // only makes the simplifier load the scene
-    bool impostor = false;
-    protocol::RepresentationKind kind = protocol::RepresentationKind::kMesh;
-    std::uint64_t schedulerId = 0;   // the copy id the scheduler knows it by
-    double requestedAccuracy = 0.0;  // scheduler-relative
-    std::uint32_t targetTriangles = 0;
-    backbone::Sphere viewRegion;
-    std::uint64_t pose = 0;  // poseCounter_ when (re)issued
-  };
 
   BackboneCore(scene::Scene scene, std::string scenePath, CoreOptions options);
   Status initialize();
@@ -188,9 +193,16 @@ class BackboneCore {
   void rebuildCurves(std::uint32_t option);
   void touchObject(std::uint32_t object);
   Status runPlan();
-  void issueRequest(const backbone::RepresentationRequest& request);
-  void forgetTicket(std::uint64_t ticket);
-  Result<Outstanding> claim(std::uint64_t wireId, const char* what);
+  Status issueRequest(const backbone::RepresentationRequest& request);
+  // Drops a request's queued message (if not taken yet) and its link
+  // reservation; cancels it on the wire when it was submitted.
+  void withdraw(const LedgerRequest& request);
+  Result<LedgerRequest> claim(std::uint64_t id, const char* what);
+  // A claimed reply the core refused (or an error reply): closes it as
+  // failed or timed out and releases its link reservation.
+  void refuse(const LedgerRequest& request, const Status& replyStatus);
+  Status useSimplifyResult(const LedgerRequest& request, const protocol::SimplifyResult& result);
+  Status useImpostorResult(const LedgerRequest& request, const protocol::ImpostorResult& result);
   void learnMeshBytes(std::uint32_t object, double meshBytes, double triangles);
   void storeBackboneCopy(std::uint32_t option, backbone::RepresentationCopy copy,
                          protocol::Representation payload);
@@ -207,14 +219,11 @@ class BackboneCore {
   std::vector<double> meshBytesPerTriangle_;  // per object
   std::vector<bool> meshBytesLearned_;
   std::unique_ptr<backbone::Scheduler> scheduler_;
-  backbone::PlannerState planner_;
+  backbone::PlannerState planner_{options_.firstRequestId};
   bool dirty_ = true;
 
   // Requests.
-  std::uint64_t nextTicket_ = 1;
-  std::map<std::uint64_t, Outstanding> byTicket_;
-  std::map<std::uint64_t, std::uint64_t> ticketOfWire_;
-  std::map<std::uint32_t, std::uint64_t> ticketOfOption_;  // non-curve requests
+  RequestLedger ledger_;
   std::vector<OutgoingRequest> queued_;
   std::vector<std::uint64_t> cancellations_;
 
@@ -238,6 +247,7 @@ class BackboneCore {
   std::int64_t poseTimeNs_ = 0;
   std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   std::optional<protocol::LinkShaper> shaper_;
+  std::uint64_t shapedBytes_ = 0;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
 };
 

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 #include <string>
 #include <utility>
 
@@ -251,15 +252,18 @@ class Daemon {
   }
 
   void submitRequests() {
-    for (std::uint64_t wireId : core_.takeCancellations()) workers_.cancel(wireId);
+    for (std::uint64_t id : core_.takeCancellations()) workers_.cancel(id);
+    // The pool sends each request under the id the core (and the scheduler) gave it.
     for (auto& request : core_.takeRequests()) {
       thinlod::Result<std::uint64_t> id =
           std::visit([&](auto& message) { return workers_.submit(message); }, request.message);
-      if (id.ok()) {
-        core_.requestSubmitted(request.ticket, *id);
+      if (id.ok() && *id == request.requestId) {
+        core_.requestSubmitted(request.requestId);
       } else {
-        core_.requestNotSubmitted(request.ticket);
-        spdlog::warn("event=request_not_submitted error=\"{}\"", id.status().toString());
+        core_.requestNotSubmitted(request.requestId);
+        if (id.ok()) workers_.cancel(*id);
+        spdlog::warn("event=request_not_submitted request={} error=\"{}\"", request.requestId,
+                     id.ok() ? "the pool renamed the request" : id.status().toString());
       }
     }
   }
@@ -450,6 +454,10 @@ int main(int argc, char** argv) {
     }
   }
 
+  // Request ids start at a random point (as the WorkerPool's own did), so a
+  // reply computed for an earlier backbone process never matches a request.
+  std::random_device device;
+  settings.core.firstRequestId = ((std::uint64_t(device()) & 0x1fffffffu) << 32) | 1u;
   thinlod::Result<CoreOptions> options = coreOptions(settings);
   if (!options.ok()) {
     spdlog::error("event=bad_options error=\"{}\"", options.status().toString());

@@ -236,8 +236,11 @@ void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const Sche
     it = list.empty() ? state.pending.erase(it) : std::next(it);
   }
   const double window = config.plannedLifetime;
-  while (!state.linkLog.empty() && state.linkLog.front().time <= viewer.timeSeconds - window)
-    state.linkLog.pop_front();
+  // Settled entries carry their send time, so the log is not in time order.
+  state.linkLog.erase(
+      std::remove_if(state.linkLog.begin(), state.linkLog.end(),
+                     [&](const LinkSend& s) { return s.time <= viewer.timeSeconds - window; }),
+      state.linkLog.end());
   state.lastTime = viewer.timeSeconds;
 }
 
@@ -316,7 +319,7 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
         d.linkBytes = s.cost.linkBytes;
         linkBytes += d.linkBytes;
         const std::uint64_t id = isNew ? state.nextRequestId++ : s.candidate.copyId;
-        if (d.linkBytes > 0.0) state.linkLog.push_back({now, d.linkBytes});
+        if (d.linkBytes > 0.0) state.linkLog.push_back({now, d.linkBytes, id, false});
         PendingCopy p;
         p.option = s.candidate.option;
         p.requestId = id;

@@ -92,9 +92,13 @@ struct EvaluatedCandidates {
   std::vector<Span> byNode;
 };
 
+// One entry of the link log (PlannerState::settleLinkSend): a plan's
+// reservation until the caller settles it with what it shipped.
 struct LinkSend {
   double time = 0.0;
   double bytes = 0.0;
+  std::uint64_t id = 0;  // copy / request id
+  bool settled = false;
 };
 
 struct PlannerStateImpl {

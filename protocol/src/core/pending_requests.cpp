@@ -7,7 +7,9 @@ namespace thinlod::protocol {
 
 Status PendingRequests::add(std::uint64_t requestId) {
   if (requestId == 0) return Status(ErrorCode::kInvalidArgument, "request id 0 is reserved");
-  if (!entries_.emplace(requestId, Entry{}).second) {
+  Entry entry;
+  entry.order = nextOrder_++;
+  if (!entries_.emplace(requestId, entry).second) {
     return Status(ErrorCode::kInvalidArgument,
                   "request " + std::to_string(requestId) + " is already pending");
   }
@@ -26,9 +28,17 @@ std::vector<PendingRequests::Dispatch> PendingRequests::dispatch(
     slots.push_back({w.id, static_cast<std::int64_t>(std::max<std::uint32_t>(w.capacity, 1)) -
                                static_cast<std::int64_t>(inFlightOn(w.id))});
   }
+  // Waiting requests in the order they were added (ids are the caller's
+  // and need not grow with it).
+  std::vector<std::map<std::uint64_t, Entry>::iterator> waitingInOrder;
+  for (auto it = entries_.begin(); it != entries_.end(); ++it)
+    if (!it->second.inFlight) waitingInOrder.push_back(it);
+  std::sort(waitingInOrder.begin(), waitingInOrder.end(),
+            [](const auto& a, const auto& b) { return a->second.order < b->second.order; });
   std::vector<Dispatch> out;
-  for (auto& [requestId, entry] : entries_) {
-    if (entry.inFlight) continue;
+  for (auto& waiting : waitingInOrder) {
+    const std::uint64_t requestId = waiting->first;
+    Entry& entry = waiting->second;
     // Best slot: most free capacity, not the worker that just failed this
     // request if any other has room, then the smaller worker id.
     Slot* best = nullptr;

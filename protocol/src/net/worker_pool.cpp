@@ -75,12 +75,12 @@ std::size_t WorkerPool::pendingRequests() const { return impl_->pending.size(); 
 std::size_t WorkerPool::liveWorkers() const { return impl_->workers.size(); }
 
 Result<std::uint64_t> WorkerPool::submit(SimplifyRequest request) {
-  request.requestId = impl_->nextRequestId;
+  if (request.requestId == 0) request.requestId = impl_->nextRequestId;
   return impl_->submit(std::move(request));
 }
 
 Result<std::uint64_t> WorkerPool::submit(ImpostorRequest request) {
-  request.requestId = impl_->nextRequestId;
+  if (request.requestId == 0) request.requestId = impl_->nextRequestId;
   return impl_->submit(std::move(request));
 }
 
@@ -88,7 +88,7 @@ Result<std::uint64_t> WorkerPool::Impl::submit(Message request) {
   THINLOD_RETURN_IF_ERROR(validate(request));
   const std::uint64_t id = requestIdOf(request);
   THINLOD_RETURN_IF_ERROR(pending.add(id));
-  ++nextRequestId;
+  if (id >= nextRequestId) nextRequestId = id + 1;
   spdlog::debug("event=request_queued request={} kind={}", id,
                 std::holds_alternative<SimplifyRequest>(request) ? "simplify" : "impostor");
   requests.emplace(id, std::move(request));

@@ -22,11 +22,8 @@ namespace {
 
 struct CurveArgs {
   std::string input;
-  std::string output;  // optional: the curves as JSON (the curve cache format)
-  int levels = MeshCurveOptions{}.levels;
-  int segments = MeshCurveOptions{}.maxSegments;
-  std::size_t samples = SurfaceErrorOptions{}.samplesPerMesh;
-  bool measureBytes = true;
+  std::string output;      // optional: the curves as JSON (the curve cache format)
+  MeshCurveOptions curve;  // the options below are bound to it: its defaults are theirs
   bool json = false;
 };
 
@@ -60,13 +57,9 @@ void runCurve(const CurveArgs& args) {
   }
   timings["build"] = millisecondsSince(start);
 
-  MeshCurveOptions options;
-  options.levels = args.levels;
-  options.maxSegments = args.segments;
-  options.error.samplesPerMesh = args.samples;
-  options.measureEncodedBytes = args.measureBytes;
-  progressLine(command, "measuring " + std::to_string(args.levels) + " levels (" +
-                            std::to_string(args.samples) + " samples per side)");
+  const MeshCurveOptions& options = args.curve;
+  progressLine(command, "measuring " + std::to_string(options.levels) + " levels (" +
+                            std::to_string(options.error.samplesPerMesh) + " samples per side)");
   start = Clock::now();
   Result<MeshCurves> curves = measureMeshCurves(mesh, built.value(), options);
   if (!curves.ok()) fail(command, curves.status(), args.json, result);
@@ -101,7 +94,7 @@ void runCurve(const CurveArgs& args) {
   result["ok"] = true;
   result["levels"] = levels;
   result["triangles_curve"] = triplesOf(curves->triangles);
-  if (args.measureBytes) result["bytes_curve"] = triplesOf(curves->bytes);
+  if (options.measureEncodedBytes) result["bytes_curve"] = triplesOf(curves->bytes);
   result["timings_ms"] = timings;
   if (args.json) std::cout << result.dump(2) << std::endl;
 }
@@ -114,13 +107,14 @@ void addCurveCommand(CLI::App& app) {
       "curve", "Measure the accuracy curves (triangles and encoded bytes) of a mesh file");
   sub->add_option("input", args->input, "Input mesh file")->required()->check(CLI::ExistingFile);
   sub->add_option("-o,--output", args->output, "Write the curves as JSON to this file");
-  sub->add_option("--levels", args->levels, "Resolutions measured (geometric ladder)")
+  sub->add_option("--levels", args->curve.levels, "Resolutions measured (geometric ladder)")
       ->check(CLI::Range(2, 64));
-  sub->add_option("--segments", args->segments, "Segments of each fitted curve")
+  sub->add_option("--segments", args->curve.maxSegments, "Segments of each fitted curve")
       ->check(CLI::Range(1, 64));
-  sub->add_option("--samples", args->samples, "Surface samples per side for the error")
+  sub->add_option("--samples", args->curve.error.samplesPerMesh,
+                  "Surface samples per side for the error")
       ->check(CLI::Range(std::size_t{100}, std::size_t{10'000'000}));
-  sub->add_flag("!--no-bytes", args->measureBytes, "Skip the encoded-bytes curve");
+  sub->add_flag("!--no-bytes", args->curve.measureEncodedBytes, "Skip the encoded-bytes curve");
   sub->add_flag("--json", args->json, "Print levels, curves and timings as JSON on stdout");
   sub->callback([args] { runCurve(*args); });
 }

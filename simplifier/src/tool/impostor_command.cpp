@@ -28,11 +28,10 @@ struct ImpostorArgs {
   std::string output;      // texture: raw RGBA frame in the link format (.tltx)
   std::string meshOutput;  // meshed: depth mesh (any mesh format mesh_io writes)
   bool meshed = false;
-  int size = 256;
+  MeshedImpostorOptions impostor;  // --size, --max-angular-error: its defaults are theirs
   double radii = 4.0;
   std::vector<float> direction{0.0f, 0.0f, 1.0f};
-  double maxAngularError = 1e-3;
-  std::string backend = "auto";
+  std::string backend = render::backendName(render::Backend::kAuto);
   bool json = false;
 };
 
@@ -91,14 +90,12 @@ void runImpostor(const ImpostorArgs& args) {
   ImpostorScene scene;
   scene.parts.push_back({mesh, glm::mat4(1.0f), render::Material{}});
   scene.lighting.lights.push_back({});  // one directional light along -Z
-  MeshedImpostorOptions options;
-  options.textureSize = args.size;
-  options.maxAngularError = args.maxAngularError;
+  const MeshedImpostorOptions& options = args.impostor;
 
   RgbaImage texture;
   ConicRange validity;
   progressLine(command, std::string("rendering a ") + (args.meshed ? "meshed" : "simple") +
-                            " impostor, " + std::to_string(args.size) + " texels");
+                            " impostor, " + std::to_string(options.textureSize) + " texels");
   start = Clock::now();
   if (args.meshed) {
     Result<MeshedImpostor> impostor = (*renderer)->renderMeshed(scene, eye, options);
@@ -165,12 +162,13 @@ void addImpostorCommand(CLI::App& app) {
                   "Write the texture as a link-format zstd frame (decode with thinlod::codec)");
   sub->add_option("--mesh-output", args->meshOutput, "Meshed: write the depth mesh (OBJ/PLY/OFF)");
   sub->add_flag("--meshed", args->meshed, "Meshed impostor (texture + depth mesh)");
-  sub->add_option("--size", args->size, "Texture edge in texels")->check(CLI::Range(8, 4096));
+  sub->add_option("--size", args->impostor.textureSize, "Texture edge in texels")
+      ->check(CLI::Range(8, 4096));
   sub->add_option("--radii", args->radii, "Viewpoint distance in bounding radii")
       ->check(CLI::Range(1.1, 1e6));
   sub->add_option("--direction", args->direction, "Direction from the centre to the viewpoint")
       ->expected(3);
-  sub->add_option("--max-angular-error", args->maxAngularError,
+  sub->add_option("--max-angular-error", args->impostor.maxAngularError,
                   "Radians: the bound the validity range guarantees")
       ->check(CLI::Range(1e-9, 3.2));
   sub->add_option("--backend", args->backend, "Offscreen back-end: auto, egl or osmesa");

@@ -179,25 +179,34 @@ Answer handle(SimplifierService& service, const Request& request) {
   return result;
 }
 
+// The daemon's settings. What configures the service is bound straight to
+// `service` (one default each: ServiceOptions); the rest is the shell's own.
 struct ServeConfig {
+  ServiceOptions service = daemonServiceDefaults();
   std::string address = protocol::kDefaultSimplifierAddress;
   std::string name;
-  std::string modelsDir;
-  std::string sceneRoot = ".";
-  std::string scene;
-  std::string cacheDir;
-  std::string backend = "auto";
-  int capacity = 1;
-  int textureSize = 256;
-  int maxTextureSize = 2048;
-  int meshedTriangles = 64;
+  std::string modelsDir;  // -> service.modelSearchPaths
+  int capacity = 1;       // the Hello's capacity
+  // Range-checked and converted into `service` after parsing; defaults from it.
+  std::string backend = render::backendName(ServiceOptions{}.backend);
+  int textureSize = static_cast<int>(ServiceOptions{}.defaultTextureSize);
+  int maxTextureSize = static_cast<int>(ServiceOptions{}.maxTextureSize);
+  int meshedTriangles = static_cast<int>(ServiceOptions{}.meshedImpostorTriangles);
   protocol::TransportOptions transport;
+
+  // A library user's service accepts no scene path until it names a root;
+  // the daemon serves the directory it is started in.
+  static ServiceOptions daemonServiceDefaults() {
+    ServiceOptions options;
+    options.sceneRoot = ".";
+    return options;
+  }
 };
 
 std::optional<render::Backend> parseBackend(const std::string& name) {
-  if (name == "auto") return render::Backend::kAuto;
-  if (name == "egl") return render::Backend::kEgl;
-  if (name == "osmesa") return render::Backend::kOsMesa;
+  for (render::Backend backend :
+       {render::Backend::kAuto, render::Backend::kEgl, render::Backend::kOsMesa})
+    if (name == render::backendName(backend)) return backend;
   return std::nullopt;
 }
 
@@ -221,12 +230,12 @@ int runServe(const std::vector<std::string>& args) {
                     "peer name, unique per worker (default simplifier@<host>#<pid>)");
   runtime.addOption("models-dir", &config.modelsDir,
                     "directory searched for the scenes' mesh files (Inline urls)");
-  runtime.addOption("scene-root", &config.sceneRoot,
+  runtime.addOption("scene-root", &config.service.sceneRoot,
                     "requests may only load scene files inside this directory");
-  runtime.addOption("scene", &config.scene,
+  runtime.addOption("scene", &config.service.defaultScenePath,
                     "default scene for impostor requests (optional: else the last scene a "
                     "SimplifyRequest named)");
-  runtime.addOption("cache-dir", &config.cacheDir,
+  runtime.addOption("cache-dir", &config.service.curveCacheDir,
                     "measured-curve cache directory (default $THINLOD_CACHE_DIR or "
                     "build/cache/curves)");
   runtime.addOption("backend", &config.backend, "offscreen rendering: auto|egl|osmesa");
@@ -271,19 +280,18 @@ int runServe(const std::vector<std::string>& args) {
     return 2;
   }
   std::error_code ec;
-  const std::filesystem::path root = std::filesystem::canonical(config.sceneRoot, ec);
+  const std::filesystem::path root = std::filesystem::canonical(config.service.sceneRoot, ec);
   if (ec || !std::filesystem::is_directory(root, ec)) {
     spdlog::error("event=bad_option option=scene-root value=\"{}\" error=\"not a directory\"",
-                  config.sceneRoot);
+                  config.service.sceneRoot);
     return 2;
   }
 
-  ServiceOptions options;
+  ServiceOptions options = config.service;
   if (!config.modelsDir.empty()) options.modelSearchPaths = {config.modelsDir};
   options.sceneRoot = root.string();
-  options.defaultScenePath = config.scene;
-  options.curveCacheDir =
-      config.cacheDir.empty() ? MeshCurveCache::defaultDirectory().string() : config.cacheDir;
+  if (options.curveCacheDir.empty())
+    options.curveCacheDir = MeshCurveCache::defaultDirectory().string();
   options.backend = *backend;
   options.defaultTextureSize = static_cast<std::uint32_t>(config.textureSize);
   options.maxTextureSize = static_cast<std::uint32_t>(config.maxTextureSize);
@@ -328,7 +336,8 @@ int runServe(const std::vector<std::string>& args) {
   };
   const Status init = initDone.get();
   if (!init.ok()) {
-    spdlog::error("event=start_failed scene=\"{}\" error=\"{}\"", config.scene, init.toString());
+    spdlog::error("event=start_failed scene=\"{}\" error=\"{}\"", options.defaultScenePath,
+                  init.toString());
     stopCompute();
     return 1;
   }

@@ -23,11 +23,7 @@ struct SimplifyArgs {
   long long triangles = -1;
   bool json = false;
   bool binary = false;
-  bool keepBoundaries = true;
-  bool preventFlips = true;
-  float boundaryWeight = BuildOptions{}.boundaryWeight;
-  float attributeWeight = 0.0f;
-  float weldEpsilon = BuildOptions{}.weldEpsilon;
+  BuildOptions build;  // the options below are bound to it: its defaults are theirs
 };
 
 void runSimplify(const SimplifyArgs& args) {
@@ -52,12 +48,7 @@ void runSimplify(const SimplifyArgs& args) {
   result["input_triangles"] = mesh.triangleCount();
   result["input_vertices"] = mesh.vertexCount();
 
-  BuildOptions options;
-  options.preserveBoundaries = args.keepBoundaries;
-  options.boundaryWeight = args.boundaryWeight;
-  options.preventFlips = args.preventFlips;
-  options.attributeWeight = args.attributeWeight;
-  options.weldEpsilon = args.weldEpsilon;
+  BuildOptions options = args.build;
   int lastDecile = -1;
   options.progress = [&](double fraction) {
     const int decile = static_cast<int>(fraction * 10.0);
@@ -130,17 +121,18 @@ void addSimplifyCommand(CLI::App& app) {
   size->require_option(1);
   sub->add_flag("--json", args->json, "Print timings, sizes and errors as JSON on stdout");
   sub->add_flag("--binary", args->binary, "Write PLY/STL in binary");
-  sub->add_flag("!--no-boundaries", args->keepBoundaries,
+  sub->add_flag("!--no-boundaries", args->build.preserveBoundaries,
                 "Do not add the boundary-preserving planes");
-  sub->add_flag("!--allow-flips", args->preventFlips, "Do not reject collapses that flip faces");
-  sub->add_option("--boundary-weight", args->boundaryWeight,
+  sub->add_flag("!--allow-flips", args->build.preventFlips,
+                "Do not reject collapses that flip faces");
+  sub->add_option("--boundary-weight", args->build.boundaryWeight,
                   "Weight of the boundary planes relative to face planes")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--attribute-weight", args->attributeWeight,
+  sub->add_option("--attribute-weight", args->build.attributeWeight,
                   "Attribute-aware cost for uvs/colors (0: off; 0.01: a full-range change costs "
                   "like 10% of the diagonal)")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--weld-epsilon", args->weldEpsilon,
+  sub->add_option("--weld-epsilon", args->build.weldEpsilon,
                   "Weld vertices closer than this fraction of the bbox diagonal")
       ->check(CLI::NonNegativeNumber);
   sub->callback([args] { runSimplify(*args); });

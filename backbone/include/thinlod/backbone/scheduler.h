@@ -135,16 +135,41 @@ struct Plan {
 struct PlannerStateImpl;
 class PlannerState {
  public:
-  PlannerState();
+  // Request ids (RepresentationRequest::requestId, then the copy's id) count
+  // up from `firstRequestId` (> 0) and never repeat within one state, not
+  // even across reset(): a caller may put them on the wire as they are.
+  explicit PlannerState(std::uint64_t firstRequestId = 1);
   ~PlannerState();
   PlannerState(PlannerState&&) noexcept;
   PlannerState& operator=(PlannerState&&) noexcept;
   PlannerState(const PlannerState&) = delete;
   PlannerState& operator=(const PlannerState&) = delete;
 
-  void reset();  // forget caches, history and in-flight requests
+  void reset();  // forget caches, history, the link log and in-flight requests (not the id counter)
   std::uint64_t stepsPlanned() const;
   std::size_t pendingRequests() const;
+  // An id from the same counter for a request the caller makes outside a
+  // plan (the daemon's startup curve requests), so ids never collide.
+  std::uint64_t allocateRequestId();
+
+  // The link log: Budget::maxLinkBytesPerSecond plans against the bytes
+  // logged within the last plannedLifetime. A plan logs each send and
+  // request at plan time with its estimated bytes under the copy/request id
+  // (a reservation). A caller that ships the bytes settles them:
+  // settleLinkSend replaces the reservations of `id` by the bytes that went
+  // out at `timeSeconds` (or logs them when nothing was reserved);
+  // releaseLinkReservation drops the reservations of `id` (nothing will be
+  // shipped: a failed or replaced request). Settled entries are what the
+  // caller's link let through, so planner and link cannot disagree about it.
+  void settleLinkSend(std::uint64_t id, double timeSeconds, double bytes);
+  void releaseLinkReservation(std::uint64_t id);
+  struct LinkLogTotals {
+    double settledBytes = 0.0;   // shipped, as the caller reported them
+    double reservedBytes = 0.0;  // planned, not settled yet
+  };
+  // Entries logged after `afterSeconds` (plans prune those older than
+  // plannedLifetime).
+  LinkLogTotals linkLogAfter(double afterSeconds) const;
   PlannerStateImpl& impl() { return *impl_; }
 
  private:

@@ -8,7 +8,8 @@
 // - Request ids are the idempotency keys: a request keeps its id across
 //   attempts, so a worker may see it twice and a late duplicate result is
 //   recognised (complete() returns false) and dropped.
-// - dispatch() assigns waiting requests oldest first (smallest id first) to
+// - dispatch() assigns waiting requests oldest first (in the order add()
+//   saw them; a retried request keeps its place) to
 //   the live worker with the most free capacity, avoiding the worker whose
 //   attempt last failed when another one is free; ties go to the smaller
 //   worker id. A worker never holds more than its capacity.
@@ -88,12 +89,14 @@ class PendingRequests {
     std::uint64_t lastWorkerId = 0;  // the worker of the last failed attempt (0: none)
     int attempts = 0;
     Clock::time_point sentAt{};
+    std::uint64_t order = 0;  // add() sequence: dispatch order
   };
   // Ends the running attempt of `it`; moves the id to `released`.
   void release(std::map<std::uint64_t, Entry>::iterator it, Released& released);
 
   Options options_;
   std::map<std::uint64_t, Entry> entries_;
+  std::uint64_t nextOrder_ = 0;
 };
 
 }  // namespace thinlod::protocol

@@ -225,8 +225,11 @@ class WorkerPool {
   static Result<std::unique_ptr<WorkerPool>> bind(Options options);
   ~WorkerPool();
 
-  // Queues the request with a fresh request id (set in the request and
-  // returned); it is sent as soon as a worker has room.
+  // Queues the request under its requestId (the caller's one id end to
+  // end, e.g. the backbone's RequestLedger), or under a fresh id above every
+  // id submitted so far when it is 0; returns the id. It is sent as soon as
+  // a worker has room, requests in the order they were submitted.
+  // kInvalidArgument when the id is already pending.
   Result<std::uint64_t> submit(SimplifyRequest request);
   Result<std::uint64_t> submit(ImpostorRequest request);
   bool cancel(std::uint64_t requestId);
