@@ -393,7 +393,8 @@ class Collapser {
     // the boundary planes alone miss it where the border edges are short
     // (their weight scales with edge length squared): a tiny ear on a hole
     // of the bunny went first at almost no cost and stayed its 50% max.
-    if (kind_[u] == VertexKind::kBoundary) {
+    // Fans above kLargeFan skip it: the neighbour search is quadratic.
+    if (kind_[u] == VertexKind::kBoundary && listSize_[u] <= kLargeFan) {
       const std::uint32_t y = otherBorderNeighbor(u, w);
       if (y != kNone) farthest = std::max(farthest, squaredDistanceToSegment(pu, pw, point_[y].p));
     }
