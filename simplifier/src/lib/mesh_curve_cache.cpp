@@ -11,6 +11,7 @@
 #include <string>
 #include <system_error>
 
+#include "qem_collapse.h"
 #include "thinlod/simplifier/mesh_curve.h"
 
 namespace thinlod::simplifier {
@@ -164,6 +165,7 @@ std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& pr
   h.number(kMeshCurveFormatVersion);
   h.number(codec::kFrameVersion);  // encoded sizes depend on the frame layout
   h.text(producer);
+  h.number(qem::kCollapseOrderVersion);  // the producer string names settings, not the order
   h.number(static_cast<std::uint64_t>(minTriangles));
   h.number(static_cast<std::uint64_t>(maxTriangles));
   h.number(options.levels);

@@ -18,6 +18,12 @@ namespace thinlod::simplifier::qem {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
 
+// Version of the collapse order: bump it whenever a change can reorder the
+// collapses of some input. Cached measured curves (mesh_curve_cache.cpp) are
+// keyed by it, so a curve measured on another order is never reused.
+// 2: border term in the cost (distance of a border vertex to its new border).
+inline constexpr std::uint32_t kCollapseOrderVersion = 2;
+
 // The collapse order, in CleanMesh numbering. Steps are 1-based: step s is
 // the s-th collapse; "step 0" is the input.
 struct CollapseRecord {
