@@ -10,7 +10,8 @@
 //   topology rules allow) and stores the collapse order.
 // - Greedy by cost: QEM (Garland-Heckbert, area-weighted planes) plus a fan
 //   term (distance of the removed vertex to its new fan) that keeps thin
-//   tips. Collapses keep input vertex positions (vertex substitution, see
+//   tips, and for a border vertex a border term (its distance to the border
+//   segment that replaces it) that keeps small ears on holes. Collapses keep input vertex positions (vertex substitution, see
 //   progressive_mesh.cpp for why), keep manifold boundary vertices on the
 //   boundary, never create a non-manifold edge or close a hole, never move a
 //   vertex on a non-manifold edge of the input, and (preventFlips) reject
