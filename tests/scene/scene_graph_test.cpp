@@ -95,7 +95,9 @@ TEST(SceneGraph, PrimitiveShapeCurveIsTheAnalyticCurve) {
   Result<AccuracyCurve> direct = primitiveAccuracyCurve(PrimitiveShape::sphere(2.0f));
   ASSERT_TRUE(direct.ok());
   EXPECT_DOUBLE_EQ(c->curve.resourcesFor(50.0), direct->resourcesFor(50.0));
-  EXPECT_NEAR(c->diameter, 4.0 * std::sqrt(3.0), 1e-5);
+  // The reference length: the sphere's diameter (relative_accuracy.h).
+  EXPECT_DOUBLE_EQ(c->diameter, primitiveDiameter(PrimitiveShape::sphere(2.0f)));
+  EXPECT_NEAR(c->diameter, 4.0, 1e-5);
 }
 
 TEST(SceneGraph, GroupSumsChildrenRescaledToItsDiameter) {
@@ -107,8 +109,10 @@ TEST(SceneGraph, GroupSumsChildrenRescaledToItsDiameter) {
   ASSERT_TRUE(group.ok()) << group.status().toString();
   Result<AccuracyCurve> sphere = primitiveAccuracyCurve(PrimitiveShape::sphere(1.0f));
   ASSERT_TRUE(sphere.ok());
-  const double d = 2.0 * std::sqrt(3.0);
-  const double D = std::sqrt(12.0 * 12.0 + 2.0 * 2.0 + 2.0 * 2.0);
+  // Reference lengths: each sphere's diameter d, the group's the sphere
+  // enclosing both (centre 0, radius 5 + d / 2).
+  const double d = primitiveDiameter(PrimitiveShape::sphere(1.0f));
+  const double D = 10.0 + d;
   EXPECT_NEAR(group->diameter, D, 1e-5);
   // Section 3.4: the group reaches a when each child reaches a * d / D.
   for (double a : {20.0, 60.0, 200.0}) {
