@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <random>
 
 #include "relative_accuracy_scene.h"
@@ -150,6 +152,82 @@ TEST(RelativeAccuracyProperty, LeafSphereEnclosesTheWorldMesh) {
             << "trial " << trial << " object " << k + 1 << " scale " << s.scale;
       }
       EXPECT_DOUBLE_EQ((*view)->converted.records[k].diameter, referenceLength(object.worldSphere));
+    }
+  }
+}
+
+// Every tessellation of a primitive lies inside its analytic reference
+// sphere, at sizes 1e-3 .. 1e4, so L bounds the primitive's extent as it
+// bounds a mesh's.
+TEST(RelativeAccuracyProperty, PrimitiveReferenceSphereEnclosesEveryTessellation) {
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    const float size = static_cast<float>(std::pow(10.0, -3.0 + 7.0 * unit(rng)));
+    const float other = size * static_cast<float>(0.1 + 3.0 * unit(rng));
+    PrimitiveShape shape;
+    switch (trial % 4) {
+      case 0:
+        shape = PrimitiveShape::sphere(size);
+        break;
+      case 1:
+        shape = PrimitiveShape::box({size, other, 0.5f * (size + other)});
+        break;
+      case 2:
+        shape = PrimitiveShape::cylinder(size, other);
+        break;
+      default:
+        shape = PrimitiveShape::cone(size, other);
+        break;
+    }
+    const BoundingSphere sphere = primitiveReferenceSphere(shape);
+    EXPECT_EQ(primitiveDiameter(shape), referenceLength(sphere));
+    for (int triangles : {12, 200, 5000}) {
+      const IndexedMesh mesh = tessellate(shape, chooseTessellation(shape, triangles));
+      for (const glm::vec3& p : mesh.positions)
+        ASSERT_LE(glm::length(glm::dvec3(p) - glm::dvec3(sphere.center)), double(sphere.radius))
+            << primitiveKindName(shape.kind) << " size " << size << " triangles " << triangles;
+    }
+  }
+}
+
+// enclosingSphere holds every input sphere; mapReferenceSphere holds the
+// mapped content sphere's surface points for random transforms far from the
+// origin (the float centre's rounding goes into the radius).
+TEST(RelativeAccuracyProperty, EnclosingAndMappedSpheresHoldTheirInputs) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double scale = std::pow(10.0, -3.0 + 7.0 * unit(rng));
+    std::vector<BoundingSphere> spheres(1 + trial % 5);
+    for (BoundingSphere& s : spheres) {
+      s.center = glm::vec3(glm::dvec3(normal(rng), normal(rng), normal(rng)) * (100.0 * scale));
+      s.radius = static_cast<float>(scale * (0.01 + unit(rng)));
+    }
+    const BoundingSphere all = enclosingSphere(spheres);
+    for (const BoundingSphere& s : spheres)
+      EXPECT_LE(glm::length(glm::dvec3(s.center) - glm::dvec3(all.center)) + double(s.radius),
+                double(all.radius))
+          << trial;
+
+    const glm::dvec3 axis = glm::normalize(glm::dvec3(normal(rng), normal(rng), normal(rng)));
+    const glm::mat4 transform =
+        glm::translate(
+            glm::mat4(1.0f),
+            glm::vec3(glm::dvec3(normal(rng), normal(rng), normal(rng)) * (1e3 * scale))) *
+        glm::mat4_cast(glm::angleAxis(static_cast<float>(6.0 * unit(rng)), glm::vec3(axis))) *
+        glm::scale(glm::mat4(1.0f), glm::vec3(static_cast<float>(scale)));
+    const double stretch = scene::maxScale(transform);
+    const BoundingSphere content = spheres.front();
+    const BoundingSphere world = mapReferenceSphere(content, transform, stretch);
+    EXPECT_GE(referenceLength(world), stretch * referenceLength(content));
+    for (int k = 0; k < 20; ++k) {
+      const glm::dvec3 dir = glm::normalize(glm::dvec3(normal(rng), normal(rng), normal(rng)));
+      const glm::dvec3 onSurface = glm::dvec3(content.center) + dir * double(content.radius);
+      const glm::dvec3 mapped = glm::dmat4(transform) * glm::dvec4(onSurface, 1.0);
+      EXPECT_LE(glm::length(mapped - glm::dvec3(world.center)), double(world.radius) * (1.0 + 1e-6))
+          << trial;
     }
   }
 }

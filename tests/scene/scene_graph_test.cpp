@@ -34,12 +34,22 @@ TEST(SceneGraph, TransformFollowsVrmlOrder) {
 
 // Fuzz finding (fuzz/corpus/scene/crash-scale-overflow.wrl): a scale of 1e32
 // overflowed the float bounds, and the curve rescaling factor (inf or NaN)
-// reached AccuracyCurve::scaledAccuracy's assert. It is an error now.
+// reached AccuracyCurve::scaledAccuracy's assert. Node sizes are reference
+// spheres now (radius times the stretch: 1e29 here, finite), so the curve
+// is computed; a scale that overflows the sphere is still an error.
 TEST(SceneGraph, CurveOfAScaleBeyondFloatBoundsIsAnError) {
-  const Scene scene = parseOk(
+  const Scene finite = parseOk(
       "DEF A Group { children [ Shape { geometry Sphere { radius 1e-3 } } ] }\n"
       "DEF B Transform { scale 1e32 1e3 1e3 children [ USE A USE A ] }\n"
       "Transform { children [ USE B USE B ] }\n");
+  const Result<NodeCurve> computed = relativeCurve(*finite.roots.back());
+  ASSERT_TRUE(computed.ok()) << computed.status().toString();
+  EXPECT_TRUE(std::isfinite(computed->diameter));
+
+  const Scene scene = parseOk(
+      "DEF A Group { children [ Shape { geometry Sphere { radius 1e-3 } } ] }\n"
+      "DEF B Transform { scale 1e38 1e3 1e3 children [ USE A USE A ] }\n"
+      "Group { children [ Transform { scale 1e10 1 1 children [ USE B USE B ] } ] }\n");
   const Result<NodeCurve> curve = relativeCurve(*scene.roots.back());
   ASSERT_FALSE(curve.ok());
   EXPECT_EQ(curve.status().code(), ErrorCode::kInvalidArgument);

@@ -120,7 +120,7 @@ BoundingSphere sphereOf(const Node& node, CurveContext& ctx) {
     std::vector<BoundingSphere> children;
     for (const auto& child : node.children) {
       const BoundingSphere s = sphereOf(*child, ctx);
-      if (!(s.radius > 0.0f)) continue;
+      if (s.radius == 0.0f) continue;  // draws nothing (non-finite radii propagate)
       const glm::mat4 transform = child->localTransform();
       children.push_back(mapReferenceSphere(s, transform, maxScale(transform)));
     }
@@ -166,6 +166,12 @@ Status rescaledChildren(const Node& node, double diameter, CurveContext& ctx,
 Result<NodeCurve> computeCurve(const Node& node, CurveContext& ctx) {
   NodeCurve out;
   out.diameter = referenceLength(sphereOf(node, ctx));
+  // Float overflow of a mapped sphere (scale 1e38 x 1e10, fuzz/scene_file.cpp).
+  if (!std::isfinite(out.diameter))
+    return Status(ErrorCode::kInvalidArgument,
+                  std::string("relativeCurve: ") + nodeKindName(node.kind) + " node " +
+                      std::to_string(node.id) +
+                      ": scaled beyond what its bounds can represent (reference sphere overflows)");
   if (node.suppliedCurve) {
     out.curve = *node.suppliedCurve;
     return out;
