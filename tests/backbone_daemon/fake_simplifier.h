@@ -95,7 +95,10 @@ class FakeSimplifier {
     rep.texture.width = request.textureWidth;
     rep.texture.height = request.textureHeight;
     rep.texture.data.assign(texturebytes, 0x22);
-    rep.accuracy = double(request.textureWidth) / 2.8;
+    // size / 2.8 of the world box diagonal, in the reference length L = 2r
+    // (relative_accuracy.h) as the real simplifier reports it.
+    rep.accuracy = double(request.textureWidth) / 2.8 *
+                   (2.0 * double(o.worldSphere.radius) / double(o.worldBounds.diagonal()));
     // Parallax: a viewer at distance D turned by phi sees an error of about
     // diameter * sin(phi) / D.
     const glm::vec3 center = o.worldSphere.center;

@@ -176,7 +176,9 @@ TEST(Primitives, BoxIsExactWithTwelveTriangles) {
   EXPECT_EQ(m.triangleCount(), 12u);
   EXPECT_EQ(tessellationError(s, {}), 0.0);
   EXPECT_EQ(tessellationAccuracy(s, {}), kExactRelativeAccuracy);
-  EXPECT_NEAR(primitiveDiameter(s), std::sqrt(14.0), 1e-6);
+  // The reference sphere's diameter: the box diagonal, padded by 1e-6.
+  EXPECT_NEAR(primitiveDiameter(s), std::sqrt(14.0), 1e-5);
+  EXPECT_GE(primitiveDiameter(s), std::sqrt(14.0));
   for (const glm::vec3& p : m.positions) {
     EXPECT_FLOAT_EQ(std::abs(p.x), 0.5f);
     EXPECT_FLOAT_EQ(std::abs(p.y), 1.0f);
@@ -369,7 +371,8 @@ TEST(PrimitiveCurves, OverestimateIsAtMostTenPercent) {
     const double hi = curve->maxAccuracy();
     double worst = 0.0;
     for (int k = 0; k <= 400; ++k) {
-      const double a = lo * std::pow(hi / lo, k / 400.0);
+      // Clamped: pow may round the last point one ulp past the domain.
+      const double a = std::min(hi, lo * std::pow(hi / lo, k / 400.0));
       Result<TessellationParams> cheapest = tessellationForAccuracy(s, a, options.maxTriangles);
       ASSERT_TRUE(cheapest.ok()) << a;
       worst = std::max(worst, curve->resourcesFor(a) / tessellationTriangles(s, *cheapest));

@@ -34,12 +34,22 @@ TEST(SceneGraph, TransformFollowsVrmlOrder) {
 
 // Fuzz finding (fuzz/corpus/scene/crash-scale-overflow.wrl): a scale of 1e32
 // overflowed the float bounds, and the curve rescaling factor (inf or NaN)
-// reached AccuracyCurve::scaledAccuracy's assert. It is an error now.
+// reached AccuracyCurve::scaledAccuracy's assert. Node sizes are reference
+// spheres now (radius times the stretch: 1e29 here, finite), so the curve
+// is computed; a scale that overflows the sphere is still an error.
 TEST(SceneGraph, CurveOfAScaleBeyondFloatBoundsIsAnError) {
-  const Scene scene = parseOk(
+  const Scene finite = parseOk(
       "DEF A Group { children [ Shape { geometry Sphere { radius 1e-3 } } ] }\n"
       "DEF B Transform { scale 1e32 1e3 1e3 children [ USE A USE A ] }\n"
       "Transform { children [ USE B USE B ] }\n");
+  const Result<NodeCurve> computed = relativeCurve(*finite.roots.back());
+  ASSERT_TRUE(computed.ok()) << computed.status().toString();
+  EXPECT_TRUE(std::isfinite(computed->diameter));
+
+  const Scene scene = parseOk(
+      "DEF A Group { children [ Shape { geometry Sphere { radius 1e-3 } } ] }\n"
+      "DEF B Transform { scale 1e38 1e3 1e3 children [ USE A USE A ] }\n"
+      "Group { children [ Transform { scale 1e10 1 1 children [ USE B USE B ] } ] }\n");
   const Result<NodeCurve> curve = relativeCurve(*scene.roots.back());
   ASSERT_FALSE(curve.ok());
   EXPECT_EQ(curve.status().code(), ErrorCode::kInvalidArgument);
@@ -95,7 +105,9 @@ TEST(SceneGraph, PrimitiveShapeCurveIsTheAnalyticCurve) {
   Result<AccuracyCurve> direct = primitiveAccuracyCurve(PrimitiveShape::sphere(2.0f));
   ASSERT_TRUE(direct.ok());
   EXPECT_DOUBLE_EQ(c->curve.resourcesFor(50.0), direct->resourcesFor(50.0));
-  EXPECT_NEAR(c->diameter, 4.0 * std::sqrt(3.0), 1e-5);
+  // The reference length: the sphere's diameter (relative_accuracy.h).
+  EXPECT_DOUBLE_EQ(c->diameter, primitiveDiameter(PrimitiveShape::sphere(2.0f)));
+  EXPECT_NEAR(c->diameter, 4.0, 1e-5);
 }
 
 TEST(SceneGraph, GroupSumsChildrenRescaledToItsDiameter) {
@@ -107,8 +119,10 @@ TEST(SceneGraph, GroupSumsChildrenRescaledToItsDiameter) {
   ASSERT_TRUE(group.ok()) << group.status().toString();
   Result<AccuracyCurve> sphere = primitiveAccuracyCurve(PrimitiveShape::sphere(1.0f));
   ASSERT_TRUE(sphere.ok());
-  const double d = 2.0 * std::sqrt(3.0);
-  const double D = std::sqrt(12.0 * 12.0 + 2.0 * 2.0 + 2.0 * 2.0);
+  // Reference lengths: each sphere's diameter d, the group's the sphere
+  // enclosing both (centre 0, radius 5 + d / 2).
+  const double d = primitiveDiameter(PrimitiveShape::sphere(1.0f));
+  const double D = 10.0 + d;
   EXPECT_NEAR(group->diameter, D, 1e-5);
   // Section 3.4: the group reaches a when each child reaches a * d / D.
   for (double a : {20.0, 60.0, 200.0}) {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "test_meshes.h"
+#include "thinlod/common/core/relative_accuracy.h"
 
 namespace thinlod::simplifier {
 namespace {
@@ -89,16 +90,16 @@ TEST(MeshCurve, IcosphereLevelsMatchTheirSagitta) {
                                                 IcosphereLadder{&calls}, quickOptions());
   ASSERT_TRUE(curves.ok()) << curves.status().toString();
   ASSERT_EQ(curves->levels.size(), 5u);  // sphere levels 0..4
-  const double diagonal = original.diameter();
+  const double reference = referenceLength(referenceSphere(original));
   for (std::size_t i = 0; i + 1 < curves->levels.size(); ++i) {
     const CurveLevel& l = curves->levels[i];
     const IndexedMesh sphere = makeIcosphere(static_cast<int>(i), kRadius);
     // Against the finest sphere: coarse sagitta minus the finest's own.
     const double expected =
-        (maxSagitta(sphere, kRadius) - maxSagitta(original, kRadius)) / diagonal;
+        (maxSagitta(sphere, kRadius) - maxSagitta(original, kRadius)) / reference;
     EXPECT_EQ(l.triangles, sphere.triangleCount());
     EXPECT_NEAR(l.relativeMaxError, expected,
-                0.03 * expected + maxSagitta(original, kRadius) / diagonal);
+                0.03 * expected + maxSagitta(original, kRadius) / reference);
     EXPECT_NEAR(l.accuracy, 1.0 / l.relativeMaxError, 1e-9 * l.accuracy);
   }
   // The full mesh measures 0 (up to rounding) and is floored.

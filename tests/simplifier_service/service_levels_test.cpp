@@ -66,13 +66,14 @@ TEST(ServiceLevels, DeliveredAccuracyIncludesQuantizationWithinTheBudget) {
 }
 
 TEST(ServiceLevels, QuantizationBoundMatchesTheEncoder) {
-  // Our relative bound (step <= diagonal) is never below the encoder's own.
+  // Our relative bound (step <= L, the reference sphere's diameter) is never
+  // below the encoder's own.
   IndexedMesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   mesh.indices = {0, 1, 2, 0, 2, 3};
   for (int bits : {8, 12, 16, 20}) {
-    const double diagonal = mesh.diameter();
-    EXPECT_LE(codec::positionErrorBound(mesh, bits) / diagonal, quantizationError(bits) * 1.0001)
+    const double reference = referenceLength(referenceSphere(mesh));
+    EXPECT_LE(codec::positionErrorBound(mesh, bits) / reference, quantizationError(bits) * 1.0001)
         << bits;
   }
 }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <utility>
 
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::backbone_daemon {
@@ -145,10 +146,10 @@ Status BackboneCore::initialize() {
   meshBytesPerTriangle_.assign(count, kDefaultMeshBytesPerTriangle);
   meshBytesLearned_.assign(count, false);
   const double texels = double(options_.textureSize) * double(options_.textureSize);
-  // Relative accuracy of a texture (see docs/backbone.md): the object fills
-  // the texture up to perspective, detail below two texels is lost and the
-  // rendered level adds at most half a texel.
-  const double textureAccuracy = double(options_.textureSize) / 3.5;
+  // Prior texel count across the quad (see docs/backbone.md): the quad spans
+  // about the object's world box diagonal, detail below two texels is lost
+  // and the rendered level adds at most half a texel.
+  const double texelsPerDiagonal = double(options_.textureSize) / 3.5;
 
   for (std::uint32_t k = 0; k < count; ++k) {
     const ObjectRecord& record = converted_.records[k];
@@ -168,13 +169,11 @@ Status BackboneCore::initialize() {
         if (!curve.ok())
           return Status(curve.status().code(),
                         "object " + idText(record.id) + ": " + curve.status().message());
-        state.baseTriangles =
-            curve->scaledAccuracy(record.meshToScheduler / (1.0 + kQuantizationShare));
+        state.baseTriangles = curve->scaledAccuracy(1.0 / (1.0 + kQuantizationShare));
         state.measuredCurve = true;
       } else {
         // Until the simplifier's curve arrives: only the full mesh, exact.
-        state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy * record.meshToScheduler,
-                                                   record.fullTriangles);
+        state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy, record.fullTriangles);
         queueStartupRequest(k, static_cast<std::uint32_t>(scene_.options.size()), false);
       }
       scene_.options.push_back(std::move(option));
@@ -192,7 +191,10 @@ Status BackboneCore::initialize() {
       OptionState state;
       state.object = k;
       state.wireKind = wireKind;
-      state.textureAccuracy = textureAccuracy * record.impostorToScheduler;
+      // a = L / (3.5 texels), a texel = worldBoxDiagonal / texelsPerDiagonal.
+      state.textureAccuracy = record.worldBoxDiagonal > 0.0
+                                  ? texelsPerDiagonal * (record.diameter / record.worldBoxDiagonal)
+                                  : texelsPerDiagonal;
       state.estimatedTriangles = triangles;
       state.estimatedBytes = kDefaultTextureBytesPerTexel * texels + kMeshFrameOverheadBytes +
                              3.0 * triangles + kOperationOverheadBytes;
@@ -357,7 +359,7 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     // budget the target may rise later: deliver what the option promises.
     const double distance = backbone::conversionDistance(
         r.viewRegion.center, r.viewRegion.radius, record.bounds, options_.config.minimalDistance);
-    double absolute = r.relativeAccuracy * distance / record.diameter;
+    double absolute = absoluteAccuracy(r.relativeAccuracy, distance, record.diameter);
     if (options_.budget.fixedAccuracy)
       absolute = std::min(absolute, *options_.budget.fixedAccuracy);
     if (!std::isfinite(absolute) || absolute <= 0.0) absolute = 1.0;
@@ -455,7 +457,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
       if (!std::isfinite(s.accuracy) || s.accuracy <= 0.0 || !std::isfinite(s.resources) ||
           s.resources < 0.0 || s.resources > double(protocol::kMaxTriangleCount))
         return invalid(where + ": curve[" + std::to_string(i) + "] is not a finite sample");
-      samples.push_back({s.accuracy * record.meshToScheduler, s.resources});
+      samples.push_back({s.accuracy, s.resources});
     }
     Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
     if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
@@ -468,7 +470,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   }
 
   learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
-  const double relative = result.accuracy * record.meshToScheduler;
+  const double relative = result.accuracy;
   if (request.requestedAccuracy > 0.0 && relative < request.requestedAccuracy * 0.99) {
     // Delivered less than the curve promised: shift the curve so the same
     // triangles are credited with what they reached.
@@ -528,7 +530,7 @@ Status BackboneCore::useImpostorResult(const LedgerRequest& request,
   if (validity->isEmpty()) return invalid(where + ": empty validity range");
 
   OptionState& state = optionStates_[request.option];
-  const double textureRelative = rep.accuracy * record.impostorToScheduler;
+  const double textureRelative = rep.accuracy;
   const double bytes = payloadBytes(rep);
   const double oldAccuracy = state.textureAccuracy * state.parallaxFactor;
   const double oldTriangles = state.estimatedTriangles;

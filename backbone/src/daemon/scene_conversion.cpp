@@ -7,8 +7,6 @@
 #include <limits>
 #include <map>
 
-#include "thinlod/common/mesh/primitives.h"
-
 namespace thinlod::backbone_daemon {
 namespace {
 
@@ -176,17 +174,7 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
     record.primitive =
         object.shape != nullptr && object.shape->geometry.kind == scene::GeometryKind::kPrimitive;
     record.fullTriangles = static_cast<double>(object.fullMesh->triangleCount());
-    record.contentDiameter = object.diameter;
-    if (record.primitive) {
-      record.contentDiameter =
-          std::max(record.contentDiameter, primitiveDiameter(object.shape->geometry.primitive));
-    }
     record.worldBoxDiagonal = object.worldBounds.diagonal();
-    const double scale = scene::maxScale(object.objectToWorld);
-    const double contentWorld = scale * record.contentDiameter;
-    record.meshToScheduler = contentWorld > 0.0 ? record.diameter / contentWorld : 1.0;
-    record.impostorToScheduler =
-        record.worldBoxDiagonal > 0.0 ? record.diameter / record.worldBoxDiagonal : 1.0;
   }
   return out;
 }

@@ -13,12 +13,11 @@
 // - Leaf bounds are the objects' world bounding spheres; a parent's sphere
 //   encloses its children's (validateScene holds). Level groups without any
 //   object get a tiny sphere at their parent's centre (they render nothing).
-// - Relative accuracies: the scheduler's are relative to the leaf sphere's
-//   diameter 2r. The simplifier's mesh accuracies are relative to the
-//   content-frame bbox diagonal (primitives: primitiveDiameter), impostor
-//   accuracies to the world bbox diagonal. meshToScheduler / impostorToScheduler
-//   convert them so that the scheduler never overstates: a world distortion
-//   is at most maxScale * (content distortion).
+// - Relative accuracies have one reference length everywhere
+//   (thinlod/common/core/relative_accuracy.h, docs/protocol.md): the leaf
+//   sphere is the object's world reference sphere (SceneObject::worldSphere)
+//   and its diameter the L that the simplifier's mesh, primitive and
+//   impostor accuracies refer to, so they are used as they arrive.
 // - Options are not filled here (the core adds them). Pure: no I/O.
 #pragma once
 
@@ -37,13 +36,10 @@ struct ObjectRecord {
   const scene::SceneObject* object = nullptr;
   std::uint32_t leafNode = 0;  // index into SchedulingScene::nodes
   bool primitive = false;
-  double fullTriangles = 0.0;        // the object's original geometry
-  backbone::Sphere bounds;           // world
-  double diameter = 0.0;             // 2 * bounds.radius (scheduler's relative size)
-  double contentDiameter = 0.0;      // what the simplifier's mesh accuracies refer to
-  double worldBoxDiagonal = 0.0;     // what the simplifier's impostor accuracies refer to
-  double meshToScheduler = 1.0;      // a_scheduler = a_simplifier_mesh * this
-  double impostorToScheduler = 1.0;  // a_scheduler = a_simplifier_impostor * this
+  double fullTriangles = 0.0;     // the object's original geometry
+  backbone::Sphere bounds;        // world
+  double diameter = 0.0;          // 2 * bounds.radius: the world reference length L
+  double worldBoxDiagonal = 0.0;  // world bbox diagonal: the impostor quad's expected width
 };
 
 struct ConvertedScene {

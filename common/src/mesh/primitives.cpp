@@ -338,9 +338,30 @@ Bounds primitiveBounds(const PrimitiveShape& s) {
   return b;
 }
 
+BoundingSphere primitiveReferenceSphere(const PrimitiveShape& s) {
+  double radius = 0.0;
+  switch (s.kind) {
+    case PrimitiveKind::kSphere:
+      radius = s.radius;
+      break;
+    case PrimitiveKind::kBox:
+      radius = 0.5 * glm::length(glm::dvec3(s.boxSize));
+      break;
+    default:  // cylinder, cone: the sphere through both rims (the cone's apex is inside)
+      radius = std::sqrt(double(s.radius) * s.radius + 0.25 * double(s.height) * s.height);
+      break;
+  }
+  // Room for the float rounding of tessellated vertices (as boundingSphere).
+  radius *= 1.0 + 1e-6;
+  BoundingSphere sphere;
+  sphere.radius = static_cast<float>(radius);
+  if (double(sphere.radius) < radius)
+    sphere.radius = std::nextafter(sphere.radius, std::numeric_limits<float>::infinity());
+  return sphere;
+}
+
 double primitiveDiameter(const PrimitiveShape& s) {
-  const Bounds b = primitiveBounds(s);
-  return glm::length(glm::dvec3(b.max) - glm::dvec3(b.min));
+  return referenceLength(primitiveReferenceSphere(s));
 }
 
 int tessellationTriangles(const PrimitiveShape& s, const TessellationParams& p) {

@@ -7,6 +7,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "thinlod/common/core/relative_accuracy.h"
+#include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/scene/scene.h"
 
 namespace thinlod::scene {
@@ -95,9 +97,38 @@ double largestEigenvalue(std::array<std::array<double, 3>, 3> a) {
 
 struct CurveContext {
   const PrimitiveCurveOptions& options;
-  BoundsMemo bounds;
+  std::unordered_map<const Node*, BoundingSphere> spheres;
   std::unordered_map<const Node*, NodeCurve> curves;
 };
+
+// A node's reference sphere in its content frame (relative_accuracy.h):
+// Shapes the object's, nodes with children the enclosingSphere of their
+// children's mapped by the child transforms; radius 0 when nothing draws.
+BoundingSphere sphereOf(const Node& node, CurveContext& ctx) {
+  auto found = ctx.spheres.find(&node);
+  if (found != ctx.spheres.end()) return found->second;
+  BoundingSphere out;
+  if (const ShapeNode* shape = node.as<ShapeNode>()) {
+    const Geometry& g = shape->geometry;
+    if (g.kind == GeometryKind::kPrimitive && validatePrimitive(g.primitive).ok()) {
+      out = primitiveReferenceSphere(g.primitive);
+    } else if ((g.kind == GeometryKind::kMeshFile || g.kind == GeometryKind::kIndexedFaceSet) &&
+               g.mesh && g.mesh->triangleCount() > 0) {
+      out = referenceSphere(*g.mesh);
+    }
+  } else if (hasChildren(node.kind)) {
+    std::vector<BoundingSphere> children;
+    for (const auto& child : node.children) {
+      const BoundingSphere s = sphereOf(*child, ctx);
+      if (s.radius == 0.0f) continue;  // draws nothing (non-finite radii propagate)
+      const glm::mat4 transform = child->localTransform();
+      children.push_back(mapReferenceSphere(s, transform, maxScale(transform)));
+    }
+    out = enclosingSphere(children);
+  }
+  ctx.spheres.emplace(&node, out);
+  return out;
+}
 
 Result<NodeCurve> curveOf(const Node& node, CurveContext& ctx);
 
@@ -134,7 +165,13 @@ Status rescaledChildren(const Node& node, double diameter, CurveContext& ctx,
 
 Result<NodeCurve> computeCurve(const Node& node, CurveContext& ctx) {
   NodeCurve out;
-  out.diameter = boundsOf(node, ctx.bounds).diagonal();
+  out.diameter = referenceLength(sphereOf(node, ctx));
+  // Float overflow of a mapped sphere (scale 1e38 x 1e10, fuzz/scene_file.cpp).
+  if (!std::isfinite(out.diameter))
+    return Status(ErrorCode::kInvalidArgument,
+                  std::string("relativeCurve: ") + nodeKindName(node.kind) + " node " +
+                      std::to_string(node.id) +
+                      ": scaled beyond what its bounds can represent (reference sphere overflows)");
   if (node.suppliedCurve) {
     out.curve = *node.suppliedCurve;
     return out;

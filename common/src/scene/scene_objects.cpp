@@ -2,6 +2,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::scene {
@@ -50,14 +51,17 @@ Result<std::vector<SceneObject>> collectSceneObjects(const Scene& scene,
     object.instance = static_cast<int>(i);
     object.objectToWorld = instances[i].contentToWorld;
     object.fullMesh = *mesh;
-    object.diameter = (*mesh)->diameter();
     IndexedMesh world;
     world.positions.reserve((*mesh)->positions.size());
     for (const glm::vec3& p : (*mesh)->positions) {
       world.positions.push_back(glm::vec3(object.objectToWorld * glm::vec4(p, 1.0f)));
     }
     object.worldBounds = world.bounds();
-    object.worldSphere = world.boundingSphere();
+    object.contentSphere = shape->geometry.kind == GeometryKind::kPrimitive
+                               ? primitiveReferenceSphere(shape->geometry.primitive)
+                               : referenceSphere(**mesh);
+    object.worldSphere = mapReferenceSphere(object.contentSphere, object.objectToWorld,
+                                            maxScale(object.objectToWorld));
     objects.push_back(std::move(object));
   }
   return objects;

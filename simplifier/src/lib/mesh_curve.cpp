@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "thinlod/common/core/relative_accuracy.h"
+
 namespace thinlod::simplifier {
 namespace {
 
@@ -26,7 +28,7 @@ Status checkOptions(const MeshCurveOptions& options) {
   return Status();
 }
 
-Result<CurveLevel> measureLevel(const IndexedMesh& original, double diagonal, std::size_t target,
+Result<CurveLevel> measureLevel(const IndexedMesh& original, double reference, std::size_t target,
                                 const IndexedMesh& level, const MeshCurveOptions& options) {
   const std::string what = "extraction of " + std::to_string(target) + " triangles";
   const Status valid = level.validate(what);
@@ -41,18 +43,20 @@ Result<CurveLevel> measureLevel(const IndexedMesh& original, double diagonal, st
   CurveLevel out;
   out.requestedTriangles = target;
   out.triangles = level.triangleCount();
-  out.relativeMaxError = error->relativeMax();
-  out.relativeMeanError = error->relativeMean();
+  out.relativeMaxError = relativeError(error->max(), reference);
+  out.relativeMeanError = relativeError(error->mean(), reference);
   const double d = std::max(out.relativeMaxError, options.minRelativeError);
   out.accuracy = 1.0 / d;
   if (options.measureEncodedBytes) {
     codec::MeshEncodeOptions encode = options.encode;
-    encode.positionBits = codec::positionBitsForAccuracy(out.accuracy, options.quantizationBudgetFraction);
+    encode.positionBits =
+        codec::positionBitsForAccuracy(out.accuracy, options.quantizationBudgetFraction);
     Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(level, encode);
     if (!frame.ok()) return frame.status();
     out.encodedBytes = frame->size();
     out.positionBits = encode.positionBits;
-    out.encodedAccuracy = 1.0 / (d + codec::positionErrorBound(level, encode.positionBits) / diagonal);
+    out.encodedAccuracy =
+        1.0 / (d + relativeError(codec::positionErrorBound(level, encode.positionBits), reference));
   }
   return out;
 }
@@ -87,8 +91,9 @@ Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, std::size_t mi
     return invalid("triangle range [" + std::to_string(minTriangles) + ", " +
                    std::to_string(maxTriangles) + "] is empty");
   }
-  const double diagonal = original.diameter();
-  if (!(diagonal > 0.0)) return invalid("original mesh has a zero-size bounding box");
+  // The one reference length of relative accuracy (relative_accuracy.h).
+  const double reference = referenceLength(referenceSphere(original));
+  if (!(reference > 0.0)) return invalid("original mesh has a zero-size reference sphere");
 
   MeshCurves curves;
   for (std::size_t target : geometricLadder(minTriangles, maxTriangles, options.levels)) {
@@ -97,7 +102,7 @@ Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, std::size_t mi
     if (!curves.levels.empty() && level.triangleCount() == curves.levels.back().triangles) {
       continue;
     }
-    Result<CurveLevel> measured = measureLevel(original, diagonal, target, level, options);
+    Result<CurveLevel> measured = measureLevel(original, reference, target, level, options);
     if (!measured.ok()) return measured.status();
     curves.levels.push_back(*measured);
   }

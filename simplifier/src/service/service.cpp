@@ -159,7 +159,7 @@ Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const Ind
   if (!pm.ok()) return Status(pm.status().code(), what + ": " + pm.status().message());
   ++stats.progressiveMeshBuilds;
   model->pm = std::move(pm).value();
-  model->diameter = mesh->diameter();
+  model->diameter = referenceLength(referenceSphere(*mesh));
   model->original = std::move(mesh);
   if (model->pm.maxTriangles() == 0 || !(model->diameter > 0.0)) {
     return invalid(what + ": no triangles or zero size after cleanup");
@@ -264,7 +264,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyPrimitive(
   THINLOD_RETURN_IF_ERROR(validatePrimitive(shape));
   const int maxTriangles = std::clamp(options.maxPrimitiveTriangles, 12, kMaxPrimitiveTriangles);
   auto delivered = [&](const TessellationParams& p) {
-    return deliveredLevel(tessellationError(shape, p) / primitiveDiameter(shape));
+    return deliveredLevel(relativeError(tessellationError(shape, p), primitiveDiameter(shape)));
   };
   TessellationParams params = chooseTessellation(shape, maxTriangles);
   if (request.target == protocol::SimplifyRequest::Target::kTriangles) {

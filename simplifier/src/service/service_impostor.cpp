@@ -164,8 +164,9 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   base.maxAngularError = request.accuracyBound;
   base.up = request.orientation * glm::vec3(0.0f, 1.0f, 0.0f);
   std::vector<glm::vec3> points;
-  Bounds worldBounds;
+  std::vector<BoundingSphere> spheres;
   for (const scene::SceneObject* object : objects) {
+    spheres.push_back(object->worldSphere);
     std::vector<unsigned char> referenced(object->fullMesh->vertexCount(), 0);
     for (std::uint32_t index : object->fullMesh->indices) referenced[index] = 1;
     for (std::size_t v = 0; v < referenced.size(); ++v) {
@@ -173,7 +174,6 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
       const glm::vec3 p =
           glm::vec3(object->objectToWorld * glm::vec4(object->fullMesh->positions[v], 1.0f));
       points.push_back(p);
-      worldBounds.extend(p);
     }
   }
   Result<ImpostorFraming> framing = frameImpostor(points, request.eye, base);
@@ -290,9 +290,9 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   representation.texture = std::move(texture).value();
   representation.transform = glm::mat4(1.0f);
   // Relative accuracy the texture supports: detail finer than two texels is
-  // lost, plus the error of the level it was rendered from (docs/simplifier.md).
-  const double diameter = worldBounds.diagonal();
-  representation.accuracy = diameter / (2.0 * texel + levelError);
+  // lost, plus the error of the level it was rendered from (docs/simplifier.md),
+  // relative to the objects' world reference length (relative_accuracy.h).
+  representation.accuracy = referenceLength(enclosingSphere(spheres)) / (2.0 * texel + levelError);
   return representation;
 }
 

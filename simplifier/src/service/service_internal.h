@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
@@ -36,9 +37,10 @@ struct LevelCredit {
   double relativeError = 0.0;          // max over this and every finer rung of max(d, floor)
 };
 
-// Worst relative displacement (fraction of the bbox diagonal) of Draco
-// quantization with `bits` position bits: half a step per axis, step <=
-// diagonal / (2^bits - 1).
+// Worst relative displacement (fraction of the reference length L) of Draco
+// quantization with `bits` position bits: half a step per axis, step =
+// largest axis extent / (2^bits - 1) <= L / (2^bits - 1) (an enclosing
+// sphere's diameter bounds every extent).
 double quantizationError(int bits);
 // Relative accuracy the client decodes: 1 / (geometric d + quantization),
 // with the position bits positionBitsForAccuracy chooses for 1/d.
@@ -65,7 +67,7 @@ std::vector<AccuracySample> curveSamples(std::vector<AccuracySample> points, std
 // the same full mesh.
 struct MeshModel {
   std::shared_ptr<const IndexedMesh> original;
-  double diameter = 0.0;  // original's bbox diagonal (relative accuracy's size)
+  double diameter = 0.0;  // L of `original` (referenceLength(referenceSphere(original)))
   ProgressiveMesh pm;
   bool curveReady = false;
   std::vector<LevelCredit> ladder;

@@ -3,13 +3,15 @@
 //
 // Contract:
 // - A geometric ladder of triangle counts from minTriangles to maxTriangles
-//   is extracted; at each level d = symmetric Hausdorff max / original bbox
-//   diagonal (measureSurfaceError), floored at minRelativeError because the
-//   full mesh has d = 0 and a curve needs a finite domain; a = 1/d.
+//   is extracted; at each level d = symmetric Hausdorff max
+//   (measureSurfaceError) / L, L = referenceLength(referenceSphere(original))
+//   (core/relative_accuracy.h: the one reference length), floored at
+//   minRelativeError because the full mesh has d = 0 and a curve needs a
+//   finite domain; a = 1/d.
 // - triangles curve: resources = extracted triangle count against a.
 //   bytes curve: resources = Draco-encoded frame size (encodeMesh, position
 //   bits from positionBitsForAccuracy(a)) against the accuracy of what the
-//   client decodes, bounded by 1 / (d + quantization bound / diagonal)
+//   client decodes, bounded by 1 / (d + quantization bound / L)
 //   (Hausdorff triangle inequality: moving vertices by <= q moves the
 //   surface by <= q).
 // - Both curves come from AccuracyCurve::fitConservative: for every a the
@@ -42,7 +44,9 @@
 
 namespace thinlod::simplifier {
 
-inline constexpr int kMeshCurveFormatVersion = 1;
+// 2: relative errors refer to the reference sphere's diameter (version 1
+// files used the bbox diagonal; they are rejected and measured again).
+inline constexpr int kMeshCurveFormatVersion = 2;
 
 struct MeshCurveOptions {
   int levels = 12;                 // ladder rungs (duplicates after rounding merge)
@@ -57,12 +61,12 @@ struct MeshCurveOptions {
 struct CurveLevel {
   std::size_t requestedTriangles = 0;
   std::size_t triangles = 0;      // what the extraction returned
-  double relativeMaxError = 0.0;  // measured d, before the floor
+  double relativeMaxError = 0.0;  // measured d = Hausdorff max / L, before the floor
   double relativeMeanError = 0.0;
   double accuracy = 0.0;         // 1 / max(d, floor)
   std::size_t encodedBytes = 0;  // 0 when not measured
   int positionBits = 0;
-  double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / diagonal)
+  double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / L)
 };
 
 struct MeshCurves {

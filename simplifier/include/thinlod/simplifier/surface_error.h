@@ -4,7 +4,9 @@
 //
 // Contract:
 // - Distances in the meshes' units; `relative*` divide by the original's
-//   bounding-box diagonal (the "object size" of relative accuracy, a = 1/d).
+//   bounding-box diagonal (Metro's convention, for reports and benchmarks).
+//   Relative accuracy divides max() by the reference length instead
+//   (core/relative_accuracy.h; mesh_curve.h does).
 // - "Forward" samples the original and measures each sample's distance to the
 //   simplified surface; "backward" the other way round. Each side is sampled
 //   with `samplesPerMesh` stratified area-weighted random points; when

@@ -51,7 +51,8 @@ struct IndexedMesh {
   Bounds bounds() const;
   // Smallest-ish enclosing sphere (Ritter); radius >= true minimum.
   BoundingSphere boundingSphere() const;
-  // Diameter used as "object size" for relative accuracy: bbox diagonal.
+  // Bbox diagonal (a size for tolerances and codec bounds). Relative accuracy
+  // refers to the reference sphere instead (relative_accuracy.h).
   float diameter() const { return bounds().diagonal(); }
   // Area-weighted per-vertex normals (replaces `normals`).
   void computeNormals();

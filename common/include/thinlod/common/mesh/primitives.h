@@ -10,8 +10,11 @@
 // - tessellationError() is the exact symmetric Hausdorff distance between
 //   the tessellation and the true closed surface (metres): sphere
 //   R - min over faces of dist(centre, face); cylinder and cone the rim
-//   sagitta R (1 - cos(pi/n)); box 0. Diameter = bbox diagonal of the true
-//   shape; relative accuracy a = diameter / error, capped at
+//   sagitta R (1 - cos(pi/n)); box 0. The reference sphere
+//   (relative_accuracy.h) is analytic, centred at the origin: sphere R, box
+//   half its diagonal, cylinder and cone sqrt(R^2 + (height/2)^2) (through
+//   both rims; the cone's apex lies inside). primitiveDiameter is its
+//   diameter L; relative accuracy a = L / error, capped at
 //   kExactRelativeAccuracy (the box, and errors below float precision).
 // - The accuracy curve is a conservative piecewise-linear fit over the exact
 //   (a, triangles) points of every tessellation up to maxTriangles: it never
@@ -32,6 +35,7 @@
 
 #include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/core/status.h"
 
 namespace thinlod {
@@ -70,6 +74,10 @@ struct TessellationParams {
 
 Status validatePrimitive(const PrimitiveShape& shape);
 Bounds primitiveBounds(const PrimitiveShape& shape);
+// The reference sphere of relative accuracy (contract above); every
+// tessellation lies inside it.
+BoundingSphere primitiveReferenceSphere(const PrimitiveShape& shape);
+// referenceLength(primitiveReferenceSphere(shape)): what a = L / error uses.
 double primitiveDiameter(const PrimitiveShape& shape);
 
 int tessellationTriangles(const PrimitiveShape& shape, const TessellationParams& params);

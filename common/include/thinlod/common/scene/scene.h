@@ -244,10 +244,14 @@ std::vector<NodeInstance> flattenInstances(const Scene& scene);
 // children, each child's accuracy first multiplied by
 // diameter / (maxScale(child localTransform) * childDiameter); LOD -> lower
 // envelope of the levels after the same rescaling, `levelOfSegment` filled;
-// lights, viewpoints, empty groups -> empty curve, diameter 0.
+// lights, viewpoints, empty groups -> empty curve, diameter 0. `diameter` is
+// the node's reference length (core/relative_accuracy.h): a Shape's object
+// reference sphere, a parent's enclosingSphere of its children's spheres
+// mapped by their transforms (so one child under a uniform scale keeps its
+// relative accuracy exactly).
 struct NodeCurve {
   AccuracyCurve curve;
-  double diameter = 0.0;            // contentBounds(node).diagonal()
+  double diameter = 0.0;            // reference length L, content frame
   std::vector<int> levelOfSegment;  // LOD only: level index per curve segment
 };
 Result<NodeCurve> relativeCurve(const Node& node, const PrimitiveCurveOptions& options = {});

@@ -10,7 +10,12 @@
 // - fullMesh is the Shape's best geometry in its own (content) frame: the
 //   loaded mesh file or IndexedFaceSet as is, a primitive tessellated at
 //   `primitiveTriangles` (its "original"). objectToWorld maps that frame to
-//   world; worldBounds / worldSphere are the transformed bounds.
+//   world; worldBounds are the transformed mesh's bounds.
+// - contentSphere is the object's reference sphere of relative accuracy
+//   (core/relative_accuracy.h): primitiveReferenceSphere for a primitive,
+//   referenceSphere(fullMesh) otherwise. worldSphere is it mapped by
+//   objectToWorld (mapReferenceSphere with maxScale); it encloses the object
+//   and is the scheduler's leaf sphere, its diameter the world L.
 // - Pointers refer into the Scene, which must outlive the objects.
 // - Errors: a mesh-file Shape whose mesh was not resolved -> kNotFound naming
 //   the url; an invalid primitive -> kInvalidArgument.
@@ -35,8 +40,8 @@ struct SceneObject {
   glm::mat4 objectToWorld{1.0f};
   std::shared_ptr<const IndexedMesh> fullMesh;  // content frame
   Bounds worldBounds;
-  BoundingSphere worldSphere;  // of the transformed full mesh
-  double diameter = 0.0;       // content-frame bbox diagonal (relative accuracy's size)
+  BoundingSphere contentSphere;  // reference sphere, content frame
+  BoundingSphere worldSphere;    // contentSphere mapped to world
 };
 
 struct SceneObjectOptions {
