@@ -82,7 +82,7 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
                                 const PlannerStateImpl& state, const JointBudget& hard,
                                 std::vector<LeafSelection>& selections);
 
-inline constexpr double kOffScreenWeight = 0.25;
+inline constexpr double kOffScreenWeight = 0.02;
 inline constexpr double kNewGenerationGainScale = 0.8;
 
 }  // namespace thinlod::backbone
