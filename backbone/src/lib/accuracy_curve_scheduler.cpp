@@ -105,15 +105,14 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
       s.dropped = true;
     }
   }
+  preferCurrentCopies(scene, config, region, state, hard, trianglesFirst, selections, stats);
   // Budget fill (budget_fill.h): what the uniform target leaves of the hard
   // budget goes where the image gains most; no leaf drops below its need. A
-  // fixed accuracy spends only what it needs. Before the hysteresis pass, so
-  // the room is divided from the target's picks (displayed copies are fill
-  // options of their own) rather than left to whatever copies were kept.
+  // fixed accuracy spends only what it needs. After the hysteresis pass, which
+  // would otherwise swap the fill's upgrades back to cheaper displayed copies.
   if (config.fillBudget && !budget.fixedAccuracy)
     stats.budgetFillUpgrades +=
         fillRemainingBudget(scene, config, step.viewer, region, state, hard, selections).upgraded;
-  preferCurrentCopies(scene, config, region, state, hard, trianglesFirst, selections, stats);
   state.previousTarget = target;
   state.lastSelectionCount = selections.size();
 

@@ -191,6 +191,14 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   for (std::size_t i = 0; i < selections.size(); ++i) {
     const LeafSelection& s = selections[i];
     if (!s.rendered || !(s.diameter > 0.0)) continue;
+    // Nothing on display yet: its first representation is the cheapest that
+    // meets the target, so it arrives soonest (a larger first request left
+    // the city walk's first second blank); the fill raises it later.
+    const SceneObject& object = scene.objects[s.object];
+    bool displayed = false;
+    for (std::uint32_t k = 0; k < object.optionCount && !displayed; ++k)
+      displayed = scene.options[object.firstOption + k].atFrontend.present;
+    if (!displayed) continue;
     const SceneNode& node = scene.nodes[s.node];
     collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
                           pendingFor(state, s.object), node.bounds, candidates);
@@ -226,12 +234,18 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
       // the room allows, and the option's top when it fits.
       const double limit = s.cost.triangles + roomTriangles;
       std::vector<double> accuracies;
+      int rungs = 0;
       for (double rung : fillTriangleLadder(std::min(limit, 1e7))) {
+        if (rung < s.cost.triangles) continue;
+        // Bounded work per leaf (the fill stays linear in the visible
+        // leaves): at most kMaxFillRungs rungs above the pick, then the top.
+        if (++rungs > kMaxFillRungs) break;
         const std::optional<double> a = option.relativeTriangles.maxAccuracyWithin(rung);
         if (!a) continue;
         const double at = std::min(*a, k.maxRelativeAccuracy);
         if (at < low) continue;
         if (accuracies.empty() || at > accuracies.back()) accuracies.push_back(at);
+        if (at >= k.maxRelativeAccuracy) break;  // the top: later rungs add nothing
       }
       if (accuracies.empty() || accuracies.back() < k.maxRelativeAccuracy)
         accuracies.push_back(k.maxRelativeAccuracy);

@@ -15,7 +15,9 @@
 // - fillRemainingBudget (adapter): builds the items from the selections and
 //   each leaf's candidates (copies at their accuracy, new representations
 //   on a fixed ladder of triangle counts), runs the core, and rewrites the
-//   selections it upgraded. No selection ends below its `need` (the target
+//   selections it upgraded. Only objects that already show something at the
+//   frontend are raised (a first representation stays the cheapest, so it
+//   arrives soonest). No selection ends below its `need` (the target
 //   in its frame); the selections stay within `hard` (checked on the
 //   selections themselves; on any rounding overshoot the fill is undone).
 #pragma once
@@ -82,6 +84,10 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
                                 const PlannerStateImpl& state, const JointBudget& hard,
                                 std::vector<LeafSelection>& selections);
 
+// Rungs offered per new representation, from the pick's triangle count up
+// (24 rungs: 24 more triangles, or about 3.2x, whichever is more), plus the
+// representation's top when it fits: a step raises a leaf at most that far.
+inline constexpr int kMaxFillRungs = 24;
 inline constexpr double kOffScreenWeight = 0.02;
 inline constexpr double kNewGenerationGainScale = 0.8;
 
