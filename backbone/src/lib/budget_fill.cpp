@@ -78,7 +78,24 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
   if (caps.useTriangles && !(usedTriangles <= caps.triangles)) return chosen;
   if (caps.useLink && !(usedLink <= caps.linkBytes)) return chosen;
 
+  // Free upgrades first: a lower error for no more of either resource (a
+  // displayed copy better than the pick) never risks a cap.
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const FillItem& item = items[i];
+    const FillOption& now = item.options[chosen[i]];
+    std::size_t best = chosen[i];
+    for (std::size_t j = 0; j < item.options.size(); ++j) {
+      const FillOption& o = item.options[j];
+      if (!finiteCost(o) || o.triangles > now.triangles || o.linkBytes > now.linkBytes) continue;
+      if (o.error < item.options[best].error) best = j;
+    }
+    usedTriangles += item.options[best].triangles - now.triangles;
+    usedLink += item.options[best].linkBytes - now.linkBytes;
+    chosen[i] = best;
+  }
+
   std::vector<std::uint32_t> version(items.size(), 0);
+  std::vector<std::size_t> stalled;  // items with no upgrade that fits
   std::priority_queue<Upgrade> heap;
   auto fits = [&](double extraTriangles, double extraLink) {
     return (!caps.useTriangles || usedTriangles + extraTriangles <= caps.triangles) &&
@@ -104,7 +121,11 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
         found = true;
       }
     }
-    if (found) heap.push(best);
+    if (found) {
+      heap.push(best);
+    } else {
+      stalled.push_back(i);
+    }
   };
   for (std::size_t i = 0; i < items.size(); ++i) pushBest(i);
   while (!heap.empty()) {
@@ -123,14 +144,16 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     usedTriangles += extraTriangles;
     usedLink += extraLink;
     chosen[u.item] = u.option;
+    pushBest(u.item);
     if (extraTriangles < 0.0 || extraLink < 0.0) {
-      // Room grew: upgrades that did not fit before may fit now.
-      for (std::size_t i = 0; i < items.size(); ++i) {
+      // Room grew in one resource: upgrades that did not fit may fit now
+      // (only the stalled items; the others are re-checked when popped).
+      std::vector<std::size_t> retry;
+      retry.swap(stalled);
+      for (std::size_t i : retry) {
         ++version[i];
         pushBest(i);
       }
-    } else {
-      pushBest(u.item);
     }
   }
   return chosen;
