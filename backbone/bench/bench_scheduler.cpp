@@ -287,9 +287,10 @@ void scaling(std::size_t minObjects, std::size_t maxObjects, std::size_t maxBoth
     Budget budget;
     budget.maxTriangles = 20.0 * double(n);
     const bool compare = n <= maxReference;
-    for (const char* name : {"paper", "no-merge"}) {
+    for (const char* name : {"paper", "paper-nofill", "no-merge"}) {
       if (!wanted(name)) continue;
-      SchedulerConfig config = std::string(name) == "paper" ? paperConfig() : exactConfig();
+      SchedulerConfig config = std::string(name) == "no-merge" ? exactConfig() : paperConfig();
+      if (std::string(name) == "paper-nofill") config.fillBudget = false;  // the budget fill's cost
       auto scheduler = makeAccuracyCurveScheduler(config).value();
       config.reuseLeafWork = false;
       auto reference = makeAccuracyCurveScheduler(config).value();
@@ -436,7 +437,8 @@ int main(int argc, char** argv) {
   app.add_option("--steps", steps, "planning steps per flight")->check(CLI::Range(2, 100000));
   app.add_option("--scenes", scenes, "small scenes in the comparison")
       ->check(CLI::Range(1, 100000));
-  app.add_option("--only", g_only, "scaling config to run (paper, no-merge, paper-both-budgets)");
+  app.add_option("--only", g_only,
+                 "scaling config to run (paper, paper-nofill, no-merge, paper-both-budgets)");
   app.add_flag("--verbose", g_verbose, "one line per planning step on stderr");
   CLI11_PARSE(app, argc, argv);
   comparison(scenes);

@@ -78,6 +78,8 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "planned lifetime of a representation (s)");
   runtime.addOption("link-delay", &config.linkDelay, "backbone -> frontend delay (s)");
   runtime.addOption("generation-delay", &config.generationDelay, "simplifier generation delay (s)");
+  runtime.addOption("fill-budget", &config.fillBudget,
+                    "curves: spend what the uniform target leaves of the budget (=false: off)");
   runtime.addOption("minimal-distance", &config.minimalDistance,
                     "lower clamp of the viewer-object distance (m)");
   runtime.addOption("sync-wait-ms", &s.syncWaitMs,

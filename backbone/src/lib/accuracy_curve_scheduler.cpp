@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "budget_fill.h"
 #include "curve_propagation.h"
 #include "joint_solver.h"
 #include "scheduler_common.h"
@@ -109,6 +110,13 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
     }
   }
   preferCurrentCopies(scene, config, region, state, hard, trianglesFirst, selections, stats);
+  // Budget fill (budget_fill.h): what the uniform target leaves of the hard
+  // budget goes where the image gains most; no leaf drops below its need. A
+  // fixed accuracy spends only what it needs. After the hysteresis pass, which
+  // would otherwise swap the fill's upgrades back to cheaper displayed copies.
+  if (config.fillBudget && !budget.fixedAccuracy)
+    stats.budgetFillUpgrades +=
+        fillRemainingBudget(scene, config, step.viewer, region, state, hard, selections).upgraded;
   state.previousTarget = target;
   state.lastSelectionCount = selections.size();
 

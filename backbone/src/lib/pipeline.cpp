@@ -39,6 +39,7 @@ SchedulerConfig withoutApproximations(SchedulerConfig c) {
   c.switchDelaySteps = 0;
   c.targetHysteresis = 0.0;
   c.rangeHysteresis = 0.0;
+  c.fillBudget = false;
   return c;
 }
 

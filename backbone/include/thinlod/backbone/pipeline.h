@@ -83,12 +83,15 @@ struct SchedulerConfig {
   // reference path kept so bench_scheduler can check, in the same run, that
   // both give identical plans (docs/scheduling.md).
   bool reuseLeafWork = true;
+  // Accuracy-curve method: after the uniform target, spend the rest of the
+  // hard budget where the image gains most (docs/scheduling.md "Budget fill").
+  bool fillBudget = true;
 };
 
 Status validateConfig(const SchedulerConfig& config);
 // `config` with every approximation and stability device off (no merging, no
 // cache growth, exact curves, unlimited Pareto passes, no reserve, no
-// preference for current copies, no delays or hysteresis): the plain model
+// preference for current copies, no delays or hysteresis, no budget fill): the plain model
 // of the paper, whose target the brute-force scheduler reproduces exactly.
 // Prediction settings (speeds, lifetime, delays, distances) are kept.
 SchedulerConfig withoutApproximations(SchedulerConfig config);

@@ -111,6 +111,7 @@ struct PlanStats {
   std::uint32_t paretoThinnings = 0;      // > 0: the two-resource result may be below optimal
   std::uint32_t undecidedAccuracies = 0;  // > 0: pass limit hit, result may be below optimal
   std::uint32_t hysteresisKeeps = 0;      // copies kept although a cheaper one was chosen
+  std::uint32_t budgetFillUpgrades = 0;   // leaves raised above the target by the budget fill
   bool usedExactSolver = false;
 };
 

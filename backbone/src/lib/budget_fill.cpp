@@ -1,0 +1,332 @@
+// Budget fill: spend what the uniform target leaves of the hard budget where
+// the image gains most (budget_fill.h, docs/scheduling.md "Budget fill").
+#include "budget_fill.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <queue>
+
+#include "scheduler_common.h"
+
+namespace thinlod::backbone {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Upgrade {
+  double ratio;  // gain per extra primary resource (infinity: free)
+  double gain;
+  std::size_t item;
+  std::size_t option;
+  std::uint32_t version;
+  // Max-heap: best ratio, then best gain, then lowest item / option index.
+  bool operator<(const Upgrade& o) const {
+    if (ratio != o.ratio) return ratio < o.ratio;
+    if (gain != o.gain) return gain < o.gain;
+    if (item != o.item) return item > o.item;
+    return option > o.option;
+  }
+};
+
+bool finiteCost(const FillOption& o) {
+  return std::isfinite(o.error) && std::isfinite(o.triangles) && std::isfinite(o.linkBytes) &&
+         std::isfinite(o.gainScale) && o.error >= 0.0 && o.gainScale > 0.0;
+}
+
+}  // namespace
+
+double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen) {
+  if (!(frameAccuracy > 0.0) || !(distance > 0.0)) return kInf;
+  const double size = diameter / distance;
+  return onScreen * size * size / frameAccuracy;
+}
+
+std::vector<double> fillTriangleLadder(double limit) {
+  std::vector<double> ladder;
+  if (!(limit >= 1.0)) return ladder;
+  limit = std::min(limit, 1e9);
+  // Each rung from the one before (never from the limit): every room gives a
+  // prefix of the same sequence, and consecutive rungs differ by at most
+  // max(1, 5 %).
+  for (double t = 1.0; t <= limit; t = std::max(t + 1.0, std::floor(t * kFillLadderStep)))
+    ladder.push_back(t);
+  return ladder;
+}
+
+std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps) {
+  std::vector<std::size_t> chosen(items.size(), 0);
+  double usedTriangles = 0.0;
+  double usedLink = 0.0;
+  bool sane = true;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const FillItem& item = items[i];
+    if (item.current >= item.options.size()) {
+      sane = false;
+      continue;
+    }
+    chosen[i] = item.current;
+    const FillOption& c = item.options[item.current];
+    sane &= finiteCost(c);
+    usedTriangles += c.triangles;
+    usedLink += c.linkBytes;
+  }
+  // No cap: nothing bounds the fill (a fixed accuracy alone), so nothing moves.
+  // Already over a cap, or malformed input: leave the picks as they are.
+  if (!sane || (!caps.useTriangles && !caps.useLink)) return chosen;
+  if (caps.useTriangles && !(usedTriangles <= caps.triangles)) return chosen;
+  if (caps.useLink && !(usedLink <= caps.linkBytes)) return chosen;
+
+  // Free upgrades first: a lower error for no more of either resource (a
+  // displayed copy better than the pick) never risks a cap.
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const FillItem& item = items[i];
+    const FillOption& now = item.options[chosen[i]];
+    std::size_t best = chosen[i];
+    for (std::size_t j = 0; j < item.options.size(); ++j) {
+      const FillOption& o = item.options[j];
+      if (!finiteCost(o) || o.triangles > now.triangles || o.linkBytes > now.linkBytes) continue;
+      if (o.error < item.options[best].error) best = j;
+    }
+    usedTriangles += item.options[best].triangles - now.triangles;
+    usedLink += item.options[best].linkBytes - now.linkBytes;
+    chosen[i] = best;
+  }
+
+  std::vector<std::uint32_t> version(items.size(), 0);
+  std::vector<std::size_t> stalled;  // items with no upgrade that fits
+  std::priority_queue<Upgrade> heap;
+  auto fits = [&](double extraTriangles, double extraLink) {
+    return (!caps.useTriangles || usedTriangles + extraTriangles <= caps.triangles) &&
+           (!caps.useLink || usedLink + extraLink <= caps.linkBytes);
+  };
+  auto pushBest = [&](std::size_t i) {
+    const FillItem& item = items[i];
+    const FillOption& now = item.options[chosen[i]];
+    bool found = false;
+    Upgrade best{0.0, 0.0, i, 0, version[i]};
+    for (std::size_t j = 0; j < item.options.size(); ++j) {
+      const FillOption& o = item.options[j];
+      if (j == chosen[i] || !finiteCost(o) || !(o.error < now.error)) continue;
+      const double extraTriangles = o.triangles - now.triangles;
+      const double extraLink = o.linkBytes - now.linkBytes;
+      if (!fits(extraTriangles, extraLink)) continue;
+      const double extra = caps.useTriangles ? extraTriangles : extraLink;
+      const double gain = (now.error - o.error) * o.gainScale;
+      const double ratio = extra > 0.0 ? gain / extra : kInf;
+      const Upgrade candidate{ratio, gain, i, j, version[i]};
+      if (!found || best < candidate) {
+        best = candidate;
+        found = true;
+      }
+    }
+    if (found) {
+      heap.push(best);
+    } else {
+      stalled.push_back(i);
+    }
+  };
+  for (std::size_t i = 0; i < items.size(); ++i) pushBest(i);
+  while (!heap.empty()) {
+    const Upgrade u = heap.top();
+    heap.pop();
+    if (u.version != version[u.item]) continue;
+    const FillOption& now = items[u.item].options[chosen[u.item]];
+    const FillOption& next = items[u.item].options[u.option];
+    const double extraTriangles = next.triangles - now.triangles;
+    const double extraLink = next.linkBytes - now.linkBytes;
+    ++version[u.item];
+    if (!fits(extraTriangles, extraLink)) {
+      pushBest(u.item);  // something smaller may still fit
+      continue;
+    }
+    usedTriangles += extraTriangles;
+    usedLink += extraLink;
+    chosen[u.item] = u.option;
+    pushBest(u.item);
+    if (extraTriangles < 0.0 || extraLink < 0.0) {
+      // Room grew in one resource: upgrades that did not fit may fit now
+      // (only the stalled items; the others are re-checked when popped).
+      std::vector<std::size_t> retry;
+      retry.swap(stalled);
+      for (std::size_t i : retry) {
+        ++version[i];
+        pushBest(i);
+      }
+    }
+  }
+  return chosen;
+}
+
+namespace {
+
+// What one option of the fill stands for in the selections.
+struct OptionSource {
+  std::uint32_t candidate = 0;  // index into the leaf's candidates
+  double generateAt = 0.0;      // relative accuracy a new representation is made for
+};
+
+// 1 when the leaf's sphere meets the current view cone (the diagonal half
+// field of view), else kOffScreenWeight: it only shows after a turn.
+double onScreenWeight(const ViewerState& viewer, const Sphere& bounds) {
+  const glm::dvec3 toObject = bounds.center - viewer.position;
+  const double distance = glm::length(toObject);
+  const double viewLength = glm::length(viewer.viewDirection);
+  if (!(distance > bounds.radius) || !(viewLength > 0.0)) return 1.0;  // viewer inside it
+  const double cosAngle =
+      std::clamp(glm::dot(toObject, viewer.viewDirection) / (distance * viewLength), -1.0, 1.0);
+  const double angle = std::acos(cosAngle);
+  const double halfDiagonal = std::atan(
+      std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)));
+  const double angularRadius = std::asin(std::min(1.0, bounds.radius / distance));
+  return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
+}
+
+}  // namespace
+
+FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerConfig& config,
+                                const ViewerState& viewer, const PredictedRegion& region,
+                                const PlannerStateImpl& state, const JointBudget& hard,
+                                std::vector<LeafSelection>& selections) {
+  FillOutcome outcome;
+  for (const LeafSelection& s : selections)
+    if (s.rendered) outcome.trianglesBefore += s.cost.triangles;
+  outcome.trianglesAfter = outcome.trianglesBefore;
+  if (!hard.useTriangles && !hard.useLink) return outcome;
+
+  double usedTriangles = 0.0;
+  double usedLink = 0.0;
+  for (const LeafSelection& s : selections) {
+    if (!s.rendered) continue;
+    usedTriangles += s.cost.triangles;
+    usedLink += s.cost.linkBytes;
+  }
+  const double roomTriangles = hard.useTriangles ? hard.triangles - usedTriangles : kInf;
+  const double roomLink = hard.useLink ? hard.linkBytes - usedLink : kInf;
+  if (!(roomTriangles > 0.0) || !(roomLink > 0.0)) return outcome;
+
+  std::vector<FillItem> items;
+  std::vector<std::size_t> itemSelection;
+  std::vector<std::vector<OptionSource>> sources;
+  std::vector<std::vector<LeafCandidate>> candidatesOf;
+  std::vector<LeafCandidate> candidates;
+  for (std::size_t i = 0; i < selections.size(); ++i) {
+    const LeafSelection& s = selections[i];
+    if (!s.rendered || !(s.diameter > 0.0)) continue;
+    // Nothing on display yet: its first representation is the cheapest that
+    // meets the target, so it arrives soonest (a larger first request left
+    // the city walk's first second blank); the fill raises it later.
+    const SceneObject& object = scene.objects[s.object];
+    bool displayed = false;
+    for (std::uint32_t k = 0; k < object.optionCount && !displayed; ++k)
+      displayed = scene.options[object.firstOption + k].atFrontend.present;
+    if (!displayed) continue;
+    const SceneNode& node = scene.nodes[s.node];
+    collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
+                          pendingFor(state, s.object), node.bounds, candidates);
+    const double nowDistance =
+        conversionDistance(viewer.position, 0.0, node.bounds, config.minimalDistance);
+    const double onScreen = onScreenWeight(viewer, node.bounds);
+    FillItem item;
+    std::vector<OptionSource> itemSources;
+    // The current pick first (its own cost, as the push-down charged it).
+    item.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, onScreen),
+                            s.cost.triangles, s.cost.linkBytes, 1.0});
+    itemSources.push_back({0, -1.0});
+    const double floor = s.need * (1.0 - kAccuracyTolerance);
+    for (std::uint32_t c = 0; c < candidates.size(); ++c) {
+      const LeafCandidate& k = candidates[c];
+      if (!(k.maxRelativeAccuracy >= floor)) continue;
+      if (k.source != CandidateSource::kNew) {
+        if (k.fixedTriangles - s.cost.triangles > roomTriangles ||
+            k.fixedLinkBytes - s.cost.linkBytes > roomLink)
+          continue;
+        item.options.push_back(
+            {fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy, onScreen),
+             k.fixedTriangles, k.fixedLinkBytes, 1.0});
+        itemSources.push_back({c, -1.0});
+        continue;
+      }
+      const RepresentationOption& option = *k.representation;
+      const double start =
+          std::max(option.relativeTriangles.minAccuracy(), option.relativeLinkBytes.minAccuracy());
+      const double low = std::max(s.need, start);
+      if (!(low <= k.maxRelativeAccuracy)) continue;
+      // Levels: the best accuracy within each rung of the ladder, up to what
+      // the room allows, and the option's top when it fits.
+      const double limit = s.cost.triangles + roomTriangles;
+      std::vector<double> accuracies;
+      int rungs = 0;
+      for (double rung : fillTriangleLadder(std::min(limit, 1e7))) {
+        if (rung < s.cost.triangles) continue;
+        // Bounded work per leaf (the fill stays linear in the visible
+        // leaves): at most kMaxFillRungs rungs above the pick, then the top.
+        if (++rungs > kMaxFillRungs) break;
+        const std::optional<double> a = option.relativeTriangles.maxAccuracyWithin(rung);
+        if (!a) continue;
+        const double at = std::min(*a, k.maxRelativeAccuracy);
+        if (at < low) continue;
+        if (accuracies.empty() || at > accuracies.back()) accuracies.push_back(at);
+        if (at >= k.maxRelativeAccuracy) break;  // the top: later rungs add nothing
+      }
+      if (accuracies.empty() || accuracies.back() < k.maxRelativeAccuracy)
+        accuracies.push_back(k.maxRelativeAccuracy);
+      for (double at : accuracies) {
+        const CandidateCost cost = candidateCost(k, at);
+        if (cost.triangles - s.cost.triangles > roomTriangles ||
+            cost.linkBytes - s.cost.linkBytes > roomLink)
+          continue;
+        item.options.push_back({fillImageError(s.diameter, nowDistance, at, onScreen),
+                                cost.triangles, cost.linkBytes, kNewGenerationGainScale});
+        itemSources.push_back({c, at});
+      }
+    }
+    if (item.options.size() < 2) continue;
+    items.push_back(std::move(item));
+    itemSelection.push_back(i);
+    sources.push_back(std::move(itemSources));
+    candidatesOf.push_back(candidates);
+  }
+  if (items.empty()) return outcome;
+
+  FillCaps caps;
+  caps.useTriangles = hard.useTriangles;
+  caps.useLink = hard.useLink;
+  caps.triangles = hard.triangles;
+  caps.linkBytes = hard.linkBytes;
+  // The core sees only the fillable leaves; the others' costs come off the caps.
+  double fixedTriangles = usedTriangles;
+  double fixedLink = usedLink;
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    fixedTriangles -= items[k].options[0].triangles;
+    fixedLink -= items[k].options[0].linkBytes;
+  }
+  caps.triangles -= fixedTriangles;
+  caps.linkBytes -= fixedLink;
+  const std::vector<std::size_t> chosen = fillByGain(items, caps);
+
+  const std::vector<LeafSelection> before = selections;
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    if (chosen[k] == 0) continue;
+    LeafSelection& s = selections[itemSelection[k]];
+    const OptionSource& source = sources[k][chosen[k]];
+    const LeafCandidate& candidate = candidatesOf[k][source.candidate];
+    const double need = s.need;
+    const double at = source.generateAt > 0.0 ? source.generateAt : need;
+    s = makeSelection(s.node, s.object, candidate, at, s.distance, s.diameter);
+    s.need = need;  // the target's need stays what the plan reports
+    ++outcome.upgraded;
+  }
+  if (!withinBudget(selections, hard)) {
+    selections = before;  // rounding: the cap is hard, the fill is optional
+    outcome.upgraded = 0;
+    return outcome;
+  }
+  outcome.trianglesAfter = 0.0;
+  for (const LeafSelection& s : selections)
+    if (s.rendered) outcome.trianglesAfter += s.cost.triangles;
+  return outcome;
+}
+
+}  // namespace thinlod::backbone
