@@ -195,15 +195,9 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   outcome.trianglesAfter = outcome.trianglesBefore;
   if (!hard.useTriangles && !hard.useLink) return outcome;
 
-  double usedTriangles = 0.0;
-  double usedLink = 0.0;
-  for (const LeafSelection& s : selections) {
-    if (!s.rendered) continue;
-    usedTriangles += s.cost.triangles;
-    usedLink += s.cost.linkBytes;
-  }
-  const double roomTriangles = hard.useTriangles ? hard.triangles - usedTriangles : kInf;
-  const double roomLink = hard.useLink ? hard.linkBytes - usedLink : kInf;
+  const CandidateCost used = renderedCost(selections);
+  const double roomTriangles = hard.useTriangles ? hard.triangles - used.triangles : kInf;
+  const double roomLink = hard.useLink ? hard.linkBytes - used.linkBytes : kInf;
   if (!(roomTriangles > 0.0) || !(roomLink > 0.0)) return outcome;
 
   std::vector<FillItem> items;
@@ -296,8 +290,8 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   caps.triangles = hard.triangles;
   caps.linkBytes = hard.linkBytes;
   // The core sees only the fillable leaves; the others' costs come off the caps.
-  double fixedTriangles = usedTriangles;
-  double fixedLink = usedLink;
+  double fixedTriangles = used.triangles;
+  double fixedLink = used.linkBytes;
   for (std::size_t k = 0; k < items.size(); ++k) {
     fixedTriangles -= items[k].options[0].triangles;
     fixedLink -= items[k].options[0].linkBytes;

@@ -77,29 +77,29 @@ JointBudget reserveShare(const JointBudget& budget, double share) {
   return soft;
 }
 
-bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudget& budget) {
-  double triangles = 0.0;
-  double link = 0.0;
+CandidateCost renderedCost(const std::vector<LeafSelection>& selections) {
+  CandidateCost total;
   for (const LeafSelection& s : selections) {
     if (!s.rendered) continue;
-    triangles += s.cost.triangles;
-    link += s.cost.linkBytes;
+    total.triangles += s.cost.triangles;
+    total.linkBytes += s.cost.linkBytes;
   }
-  return (!budget.useTriangles || triangles <= budget.triangles) &&
-         (!budget.useLink || link <= budget.linkBytes);
+  return total;
+}
+
+bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudget& budget) {
+  const CandidateCost used = renderedCost(selections);
+  return (!budget.useTriangles || used.triangles <= budget.triangles) &&
+         (!budget.useLink || used.linkBytes <= budget.linkBytes);
 }
 
 void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& config,
                          const PredictedRegion& region, PlannerStateImpl& state,
                          const JointBudget& hard, bool trianglesFirst,
                          std::vector<LeafSelection>& selections, PlanStats& stats) {
-  double triangles = 0.0;
-  double link = 0.0;
-  for (const LeafSelection& s : selections) {
-    if (!s.rendered) continue;
-    triangles += s.cost.triangles;
-    link += s.cost.linkBytes;
-  }
+  const CandidateCost used = renderedCost(selections);
+  double triangles = used.triangles;
+  double link = used.linkBytes;
   double roomTriangles = hard.useTriangles ? hard.triangles - triangles : kInf;
   double roomLink = hard.useLink ? hard.linkBytes - link : kInf;
 

@@ -14,6 +14,8 @@ const char* modeName(const Budget& budget);
 JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,
                        const ViewerState& viewer, const SchedulerConfig& config);
 JointBudget reserveShare(const JointBudget& budget, double share);
+// Triangles and link bytes of the rendered selections.
+CandidateCost renderedCost(const std::vector<LeafSelection>& selections);
 bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudget& budget);
 
 // Hysteresis: where a valid frontend (or in-flight) copy meets the need but
