@@ -183,15 +183,20 @@ bool jpegHeaderSafe(const std::uint8_t* data, std::size_t size) {
   return false;
 }
 
-Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
-                   RgbaImage& out) {
-  if (codec == TextureCodec::kPng && !pngChunksComplete(payload, size)) {
-    return textureError(ErrorCode::kParseError, "PNG payload is truncated or malformed");
+// PNG or JPEG bytes checked (whole chunks / segments, see above) and opened
+// by OpenImageIO through `proxy`, which must outlive the returned input.
+// `what` names the bytes in errors ("payload", "file").
+Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::uint8_t* data, std::size_t size,
+                                                    TextureCodec codec, const char* what,
+                                                    OIIO::Filesystem::IOMemReader& proxy) {
+  if (codec == TextureCodec::kPng && !pngChunksComplete(data, size)) {
+    return textureError(ErrorCode::kParseError,
+                        std::string("PNG ") + what + " is truncated or malformed");
   }
-  if (codec == TextureCodec::kJpeg && !jpegHeaderSafe(payload, size)) {
-    return textureError(ErrorCode::kParseError, "JPEG payload has a malformed header");
+  if (codec == TextureCodec::kJpeg && !jpegHeaderSafe(data, size)) {
+    return textureError(ErrorCode::kParseError,
+                        std::string("JPEG ") + what + " has a malformed header");
   }
-  OIIO::Filesystem::IOMemReader proxy(payload, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
   // OpenImageIO 2.4 only honours the proxy next to other configuration
@@ -202,33 +207,10 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
   if (!input) {
     return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + OIIO::geterror());
   }
-  const OIIO::ImageSpec& spec = input->spec();
-  const int wantChannels = codec == TextureCodec::kJpeg ? 3 : 4;
-  // Checked against the frame header before any pixel is decoded.
-  if (spec.width != out.width || spec.height != out.height || spec.depth != 1 ||
-      spec.nchannels != wantChannels) {
-    return textureError(ErrorCode::kParseError,
-                        "image is " + std::to_string(spec.width) + "x" +
-                            std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) +
-                            ", header says " + std::to_string(out.width) + "x" +
-                            std::to_string(out.height) + "x" + std::to_string(wantChannels));
-  }
-  bool ok = false;
-  if (wantChannels == 4) {
-    ok = input->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, out.pixels.data());
-  } else {
-    std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
-    ok = input->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
-    for (std::size_t p = 0, n = rgb.size() / 3; ok && p < n; ++p) {
-      for (int c = 0; c < 3; ++c) out.pixels[4 * p + c] = rgb[3 * p + c];
-      out.pixels[4 * p + 3] = 255;
-    }
-  }
-  if (!ok) return textureError(ErrorCode::kParseError, "OpenImageIO: " + input->geterror());
-  return Status();
+  return input;
 }
 
-// RGBA8 from an image file's pixels (1 grey, 2 grey + alpha, 3 RGB, 4+ RGBA).
+// RGBA8 from an image's pixels (1 grey, 2 grey + alpha, 3 RGB, 4+ RGBA).
 void expandToRgba(const std::vector<std::uint8_t>& in, int channels, RgbaImage& out) {
   const std::size_t pixels = out.pixels.size() / 4;
   for (std::size_t p = 0; p < pixels; ++p) {
@@ -244,6 +226,36 @@ void expandToRgba(const std::vector<std::uint8_t>& in, int channels, RgbaImage& 
       dst[3] = channels >= 4 ? src[3] : 255;
     }
   }
+}
+
+Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
+                   RgbaImage& out) {
+  OIIO::Filesystem::IOMemReader proxy(payload, size);
+  Result<std::unique_ptr<OIIO::ImageInput>> opened =
+      openImage(payload, size, codec, "payload", proxy);
+  if (!opened.ok()) return opened.status();
+  OIIO::ImageInput& input = **opened;
+  const OIIO::ImageSpec& spec = input.spec();
+  const int wantChannels = codec == TextureCodec::kJpeg ? 3 : 4;
+  // Checked against the frame header before any pixel is decoded.
+  if (spec.width != out.width || spec.height != out.height || spec.depth != 1 ||
+      spec.nchannels != wantChannels) {
+    return textureError(ErrorCode::kParseError,
+                        "image is " + std::to_string(spec.width) + "x" +
+                            std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) +
+                            ", header says " + std::to_string(out.width) + "x" +
+                            std::to_string(out.height) + "x" + std::to_string(wantChannels));
+  }
+  bool ok = false;
+  if (wantChannels == 4) {
+    ok = input.read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, out.pixels.data());
+  } else {
+    std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
+    ok = input.read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
+    if (ok) expandToRgba(rgb, 3, out);
+  }
+  if (!ok) return textureError(ErrorCode::kParseError, "OpenImageIO: " + input.geterror());
+  return Status();
 }
 
 double psnrRgb(const RgbaImage& a, const RgbaImage& b) {
@@ -359,28 +371,16 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
   TextureCodec codec;
   if (size >= 8 && std::equal(kPngMagic, kPngMagic + 8, data)) {
     codec = TextureCodec::kPng;
-    if (!pngChunksComplete(data, size)) {
-      return textureError(ErrorCode::kParseError, "PNG file is truncated or malformed");
-    }
   } else if (size >= 2 && data[0] == 0xFF && data[1] == 0xD8) {
     codec = TextureCodec::kJpeg;
-    if (!jpegHeaderSafe(data, size)) {
-      return textureError(ErrorCode::kParseError, "JPEG file has a malformed header");
-    }
   } else {
     return textureError(ErrorCode::kUnsupported, "not a PNG or JPEG file (only those are read)");
   }
   try {
     OIIO::Filesystem::IOMemReader proxy(data, size);
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    void* proxyPointer = &proxy;  // see decodeImage
-    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
-    std::unique_ptr<OIIO::ImageInput> input =
-        OIIO::ImageInput::open(formatFileName(codec), &config);
-    if (!input) {
-      return textureError(ErrorCode::kParseError, "OpenImageIO: " + OIIO::geterror());
-    }
+    Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(data, size, codec, "file", proxy);
+    if (!opened.ok()) return opened.status();
+    std::unique_ptr<OIIO::ImageInput> input = std::move(opened).value();
     const OIIO::ImageSpec& spec = input->spec();
     const std::string dims = std::to_string(spec.width) + "x" + std::to_string(spec.height);
     if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.nchannels <= 0 ||
