@@ -2,6 +2,7 @@
 // by name, and the frame holds the hard budget whatever a method returns.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -81,6 +82,49 @@ TEST(SchedulerCatalogue, EveryBudgetedMethodHoldsThePolygonCap) {
       }
     }
     EXPECT_GT(rendered, 24u) << e.name;
+  }
+}
+
+// When even the cheapest plan overshoots the cap, every budgeted method drops
+// what the viewer cannot see now before anything in view, however much larger
+// the unseen objects look (keepPriority; the city-walk case of the workbench,
+// where near buildings behind the viewer used to push out the ones ahead).
+TEST(SchedulerCatalogue, EveryBudgetedMethodDropsObjectsOutOfViewFirst) {
+  SceneBuilder b;
+  const int root = b.group(-1);
+  for (int i = 0; i < 4; ++i)  // ahead, in the view cone: 10-16 m away
+    b.leaf(root, {{0.5 * i, 0, -10.0 - 2.0 * i}, 0.5}, {meshOption(5, 100, 50, 1000)});
+  // 55 degrees to the side, nearer (3-6 m): outside the current view cone
+  // (about 33 degrees to its corners) but within a turn of the planned
+  // lifetime, so they are visible to the scheduler and look larger.
+  const glm::dvec3 side(std::sin(0.96), 0.0, -std::cos(0.96));
+  for (int i = 0; i < 4; ++i)
+    b.leaf(root, {side * (3.0 + i), 0.5}, {meshOption(5, 100, 50, 1000)});
+  const SchedulingScene scene = b.build();
+  for (const SchedulerEntry& e : schedulerCatalogue()) {
+    if (std::string(e.name) == "brute-force" || std::string(e.name) == "vrml-static") continue;
+    SchedulerOptions options;
+    options.config = exactConfig();
+    auto scheduler = makeScheduler(e.name, options).value();
+    PlannerState state;
+    Budget budget;
+    budget.maxTriangles = 450.0;  // four objects at their cheapest 100 triangles
+    ViewerState viewer = viewerAt({0, 0, 0}, {0, 0, -1});
+    viewer.horizontalFov = 1.0;
+    viewer.verticalFov = 0.8;
+    auto plan = scheduler->plan(scene, viewer, budget, state);
+    ASSERT_TRUE(plan.ok()) << e.name << ": " << plan.status().message();
+    EXPECT_LE(plan->predictedTriangles, 450.0) << e.name;
+    // All four unseen objects go; an in-view one only after them (active-set's
+    // floors are coarser and also drop the farthest one ahead).
+    std::vector<std::uint32_t> dropped = plan->dropped;
+    std::sort(dropped.begin(), dropped.end());
+    ASSERT_GE(dropped.size(), 4u) << e.name;
+    EXPECT_EQ(std::vector<std::uint32_t>(dropped.end() - 4, dropped.end()),
+              (std::vector<std::uint32_t>{4, 5, 6, 7}))
+        << e.name;
+    for (std::size_t k = 0; k + 4 < dropped.size(); ++k)  // ahead: the farthest first
+      EXPECT_EQ(dropped[k], 4 - (dropped.size() - 4) + k) << e.name;
   }
 }
 

@@ -84,7 +84,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
       JointSolver full(scene, config, region, state, hard, stats);
       best = full.maximise(budget.fixedAccuracy, std::nullopt);
       if (!best) {
-        full.dropUntilFeasible();
+        full.dropUntilFeasible(step.viewer);
         best = full.maximise(budget.fixedAccuracy, std::nullopt);
       }
       target = best ? stickyTarget(*best, state.previousTarget, config.targetHysteresis) : 0.0;

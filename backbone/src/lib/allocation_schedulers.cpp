@@ -55,10 +55,10 @@ std::vector<VisibleLeaf> collectLeaves(const VisibleTree& tree, const Scheduling
   return leaves;
 }
 
-// Marks the least visible leaves (smallest diameter / D) dropped until the
+// Marks the least visible leaves (lowest keepPriority) dropped until the
 // sum of `floor` over the others is at most cap; returns the kept flags.
 // Leaves whose floor is not finite are dropped first, whatever their size.
-std::vector<std::uint8_t> dropLeastVisible(const VisibleTree& tree,
+std::vector<std::uint8_t> dropLeastVisible(const SelectionStep& step, const VisibleTree& tree,
                                            const std::vector<VisibleLeaf>& leaves,
                                            const std::vector<double>& floor, double cap) {
   std::vector<std::uint8_t> kept(leaves.size(), 1);
@@ -73,11 +73,14 @@ std::vector<std::uint8_t> dropLeastVisible(const VisibleTree& tree,
   if (used <= cap) return kept;
   std::vector<std::size_t> order(leaves.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const VisibleNode& na = tree.nodes[leaves[a].treeNode];
-    const VisibleNode& nb = tree.nodes[leaves[b].treeNode];
-    return na.diameter * nb.distance < nb.diameter * na.distance;
-  });
+  std::vector<double> priority(leaves.size());
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const VisibleNode& n = tree.nodes[leaves[i].treeNode];
+    priority[i] =
+        keepPriority(step.viewer, step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });
   for (std::size_t i : order) {
     if (used <= cap) break;
     if (!kept[i]) continue;
@@ -179,7 +182,7 @@ Result<Selection> AslodMethod::select(const SelectionStep& step) const {
     if (previous != step.state.aslodAllocations.end()) objects[i].previous = previous->second;
   }
   const double cap = std::floor(step.hard.triangles);
-  const std::vector<std::uint8_t> kept = dropLeastVisible(tree, leaves, cheapest, cap);
+  const std::vector<std::uint8_t> kept = dropLeastVisible(step, tree, leaves, cheapest, cap);
   std::vector<AslodObject> allocated;
   for (std::size_t i = 0; i < leaves.size(); ++i)
     if (kept[i]) allocated.push_back(objects[i]);
@@ -325,7 +328,7 @@ Result<Selection> SpanOfLevelChangedMethod::select(const SelectionStep& step) co
     coarsest[i] = choices[i].back().triangles;
   }
   const double cap = step.hard.triangles;
-  const std::vector<std::uint8_t> kept = dropLeastVisible(tree, leaves, coarsest, cap);
+  const std::vector<std::uint8_t> kept = dropLeastVisible(step, tree, leaves, coarsest, cap);
   std::vector<SlcObject> objects;
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     if (!kept[i]) continue;

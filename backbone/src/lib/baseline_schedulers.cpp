@@ -185,12 +185,15 @@ Result<Selection> GreedyMethod::select(const SelectionStep& step) const {
   std::vector<std::uint8_t> dropped(items.size(), 0);
   if (used > cap) {
     std::vector<std::size_t> order(items.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const VisibleNode& na = tree.nodes[items[a].treeNode];
-      const VisibleNode& nb = tree.nodes[items[b].treeNode];
-      return na.diameter / na.distance < nb.diameter / nb.distance;
-    });
+    std::vector<double> priority(items.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      order[i] = i;
+      const VisibleNode& n = tree.nodes[items[i].treeNode];
+      priority[i] =
+          keepPriority(step.viewer, step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+    }
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });
     for (std::size_t i : order) {
       if (used <= cap) break;
       dropped[i] = 1;

@@ -167,22 +167,6 @@ struct OptionSource {
   double generateAt = 0.0;      // relative accuracy a new representation is made for
 };
 
-// 1 when the leaf's sphere meets the current view cone (the diagonal half
-// field of view), else kOffScreenWeight: it only shows after a turn.
-double onScreenWeight(const ViewerState& viewer, const Sphere& bounds) {
-  const glm::dvec3 toObject = bounds.center - viewer.position;
-  const double distance = glm::length(toObject);
-  const double viewLength = glm::length(viewer.viewDirection);
-  if (!(distance > bounds.radius) || !(viewLength > 0.0)) return 1.0;  // viewer inside it
-  const double cosAngle =
-      std::clamp(glm::dot(toObject, viewer.viewDirection) / (distance * viewLength), -1.0, 1.0);
-  const double angle = std::acos(cosAngle);
-  const double halfDiagonal = std::atan(
-      std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)));
-  const double angularRadius = std::asin(std::min(1.0, bounds.radius / distance));
-  return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
-}
-
 }  // namespace
 
 FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerConfig& config,

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "joint_solver.h"
+#include "scheduler_common.h"
 #include "selection.h"
 
 namespace thinlod::backbone {
@@ -88,7 +89,6 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
 // (24 rungs: 24 more triangles, or about 3.2x, whichever is more), plus the
 // representation's top when it fits: a step raises a leaf at most that far.
 inline constexpr int kMaxFillRungs = 24;
-inline constexpr double kOffScreenWeight = 0.02;
 inline constexpr double kNewGenerationGainScale = 0.8;
 
 }  // namespace thinlod::backbone

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scheduler_common.h"
+
 namespace thinlod::backbone {
 namespace {
 
@@ -561,15 +563,18 @@ bool JointSolver::feasible(double accuracy) {
   return paretoFeasible(accuracy);
 }
 
-std::size_t JointSolver::dropUntilFeasible() {
+std::size_t JointSolver::dropUntilFeasible(const ViewerState& viewer) {
   if (feasible(0.0)) return 0;
   std::vector<std::uint32_t> leaves;
-  for (std::uint32_t k = 0; k < nodes_.size(); ++k)
-    if (nodes_[k].kind == SceneNodeKind::kLeaf && nodes_[k].candidateCount > 0) leaves.push_back(k);
-  std::sort(leaves.begin(), leaves.end(), [this](std::uint32_t a, std::uint32_t b) {
-    const double ia = nodes_[a].diameter / nodes_[a].distance;
-    const double ib = nodes_[b].diameter / nodes_[b].distance;
-    if (ia != ib) return ia < ib;
+  std::vector<double> priority(nodes_.size(), 0.0);
+  for (std::uint32_t k = 0; k < nodes_.size(); ++k) {
+    const Node& n = nodes_[k];
+    if (n.kind != SceneNodeKind::kLeaf || n.candidateCount == 0) continue;
+    leaves.push_back(k);
+    priority[k] = keepPriority(viewer, scene_.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+  }
+  std::sort(leaves.begin(), leaves.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (priority[a] != priority[b]) return priority[a] < priority[b];
     return nodes_[a].sceneNode < nodes_[b].sceneNode;
   });
   auto apply = [&](std::size_t count) {

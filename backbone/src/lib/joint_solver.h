@@ -44,9 +44,9 @@ class JointSolver {
   double lowestAccuracy() const;
   double highestAccuracy() const;
   bool feasible(double accuracy);
-  // Drops the least visible leaves (smallest diameter / D) until the
-  // cheapest plan fits; returns how many.
-  std::size_t dropUntilFeasible();
+  // Drops the least visible leaves (lowest keepPriority, scheduler_common.h)
+  // until the cheapest plan fits; returns how many.
+  std::size_t dropUntilFeasible(const ViewerState& viewer);
   // The largest feasible accuracy <= cap, or nullopt when even the cheapest
   // plan does not fit. `hint` (optional) narrows the bisection.
   std::optional<double> maximise(std::optional<double> cap, std::optional<double> hint);

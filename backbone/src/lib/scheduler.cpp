@@ -14,15 +14,20 @@ namespace thinlod::backbone {
 namespace {
 
 // A method that overshoots a hard cap loses its least visible objects
-// (smallest diameter / distance first) until the plan fits: the budget is a
-// cap on every plan, whatever the method.
-void dropUntilWithin(std::vector<LeafSelection>& leaves, const JointBudget& hard) {
+// (lowest keepPriority first) until the plan fits: the budget is a cap on
+// every plan, whatever the method.
+void dropUntilWithin(const SchedulingScene& scene, const ViewerState& viewer,
+                     std::vector<LeafSelection>& leaves, const JointBudget& hard) {
   std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < leaves.size(); ++i)
-    if (leaves[i].rendered) order.push_back(i);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return leaves[a].diameter * leaves[b].distance < leaves[b].diameter * leaves[a].distance;
-  });
+  std::vector<double> priority(leaves.size(), 0.0);
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    if (!leaves[i].rendered) continue;
+    order.push_back(i);
+    priority[i] = keepPriority(viewer, scene.nodes[leaves[i].node].bounds, leaves[i].diameter,
+                               leaves[i].distance);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });
   for (std::size_t i : order) {
     if (withinBudget(leaves, hard)) return;
     leaves[i].rendered = false;
@@ -79,7 +84,7 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
   Result<Selection> selected = method_->select(step);
   if (!selected.ok()) return selected.status();
   Selection& selection = selected.value();
-  if (!withinBudget(selection.leaves, hard)) dropUntilWithin(selection.leaves, hard);
+  if (!withinBudget(selection.leaves, hard)) dropUntilWithin(scene, viewer, selection.leaves, hard);
   plan.mode = selection.mode ? selection.mode : modeName(budget);
   const double target = selection.targetAccuracy.value_or(lowestRenderedAccuracy(selection.leaves));
 

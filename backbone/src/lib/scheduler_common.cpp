@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <string>
 
 namespace thinlod::backbone {
@@ -240,6 +241,27 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     ++stats.hysteresisKeeps;
   }
   state.stepCandidates.reset();
+}
+
+double onScreenWeight(const ViewerState& viewer, const Sphere& bounds) {
+  const glm::dvec3 toObject = bounds.center - viewer.position;
+  const double distance = glm::length(toObject);
+  const double viewLength = glm::length(viewer.viewDirection);
+  if (!(distance > bounds.radius) || !(viewLength > 0.0)) return 1.0;  // viewer inside it
+  const double cosAngle =
+      std::clamp(glm::dot(toObject, viewer.viewDirection) / (distance * viewLength), -1.0, 1.0);
+  const double angle = std::acos(cosAngle);
+  const double halfDiagonal = std::atan(
+      std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)));
+  const double angularRadius = std::asin(std::min(1.0, bounds.radius / distance));
+  return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
+}
+
+double keepPriority(const ViewerState& viewer, const Sphere& bounds, double diameter,
+                    double distance) {
+  const double size = diameter / distance;
+  const double withinClass = size / (1.0 + size);  // monotone, in [0, 1)
+  return onScreenWeight(viewer, bounds) == 1.0 ? 1.0 + withinClass : withinClass;
 }
 
 }  // namespace thinlod::backbone

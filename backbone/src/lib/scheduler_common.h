@@ -18,6 +18,21 @@ JointBudget reserveShare(const JointBudget& budget, double share);
 CandidateCost renderedCost(const std::vector<LeafSelection>& selections);
 bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudget& budget);
 
+// What an object outside the current view cone counts for against one inside
+// it: it only shows after a turn within the planned lifetime.
+inline constexpr double kOffScreenWeight = 0.02;
+// 1 when `bounds` meets the current view cone (the diagonal half field of
+// view) or holds the viewer, else kOffScreenWeight.
+double onScreenWeight(const ViewerState& viewer, const Sphere& bounds);
+// The order in which every method drops objects when even its cheapest plan
+// overshoots a hard cap (lowest first): every object in the current view cone
+// ranks above every object outside it (those only a turn would show, and the
+// next step replans after a turn), and within each class the one that looks
+// larger from the predicted region (diameter / distance) ranks higher: in
+// [1, 2) in view, [0, 1) outside. Ties: the caller's order.
+double keepPriority(const ViewerState& viewer, const Sphere& bounds, double diameter,
+                    double distance);
+
 // Hysteresis: where a valid frontend (or in-flight) copy meets the need but
 // a different representation was picked, keep the copy when it costs at most
 // (1 + preferCurrentShare) x the pick, or while the switch has been wanted

@@ -9,6 +9,7 @@
 
 #include "active_set_optimiser.h"
 #include "frame_time_model.h"
+#include "scheduler_common.h"
 #include "selection_method.h"
 #include "visible_tree.h"
 
@@ -24,7 +25,7 @@ struct Item {
   double cost = 0.0;          // c: per unit of resolution (seconds or triangles)
   double fixed = 0.0;         // resolution-independent part (setup, fill when additive)
   double weight = 0.0;        // a = importance * acuity * N_pix / T_max
-  double visibility = 0.0;    // diameter / distance, for dropping
+  double visibility = 0.0;    // keepPriority, for dropping
 };
 
 // Triangles a candidate costs at its lowest and at its highest accuracy.
@@ -122,7 +123,7 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
     const ObjectFrameLoad load{item.maxTriangles, pixels};
     const double fill = pixels * costs.pixelSeconds;
     item.fixed = costs.setupSeconds + (costs.additive ? fill : 0.0);
-    item.visibility = n.diameter / n.distance;
+    item.visibility = keepPriority(step.viewer, bounds, n.diameter, n.distance);
     const double importance =
         object < config_.objectImportance.size() ? config_.objectImportance[object] : 1.0;
     if (item.maxTriangles > 0.0) {
