@@ -15,6 +15,7 @@
 #include <optional>
 #include <system_error>
 
+#include "thinlod/common/core/file_bytes.h"
 namespace thinlod {
 namespace {
 
@@ -346,22 +347,9 @@ Pose samplePose(const Trace& trace, double time) {
 }
 
 Result<Trace> loadTraceFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kNotFound, path + ": cannot open trace file");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) return Status(ErrorCode::kIoError, path + ": cannot determine file size");
-  if (static_cast<std::uint64_t>(size) > kMaxTraceFileBytes) {
-    return Status(ErrorCode::kResourceExhausted, path + ": trace file of " + std::to_string(size) +
-                                                     " bytes exceeds the limit of " +
-                                                     std::to_string(kMaxTraceFileBytes));
-  }
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (size > 0 && !in.read(text.data(), size)) {
-    return Status(ErrorCode::kIoError, path + ": read failed");
-  }
-  Result<Trace> trace = parseTrace(text);
+  Result<std::string> text = readFileBounded(path, kMaxTraceFileBytes);
+  if (!text.ok()) return text.status();
+  Result<Trace> trace = parseTrace(*text);
   if (!trace.ok()) {
     return Status(trace.status().code(), path + ": " + trace.status().message());
   }

@@ -13,7 +13,6 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <glm/geometric.hpp>
 #include <iostream>
 #include <limits>
@@ -23,6 +22,7 @@
 #include <sstream>
 
 #include "mesh/mesh_precheck.h"
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/mesh/tri_mesh.h"
 
 namespace thinlod {
@@ -301,29 +301,9 @@ Result<LoadedMesh> loadMeshFile(const std::string& path, const MeshLoadOptions& 
   Result<MeshFormat> format = formatFromExtension(ext, path);
   if (!format.ok()) return format.status();
 
-  std::error_code ec;
-  const std::filesystem::file_status st = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(st)) {
-    return Status(ErrorCode::kNotFound, path + ": no such file");
-  }
-  if (!std::filesystem::is_regular_file(st)) {
-    return Status(ErrorCode::kIoError, path + ": not a regular file");
-  }
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
-  if (size > options.maxFileBytes) {
-    return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
-                                                     " bytes exceed the limit of " +
-                                                     std::to_string(options.maxFileBytes));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return Status(ErrorCode::kIoError, path + ": short read");
-  }
-  return loadChecked(bytes, *format, ext, path, options);
+  Result<std::string> bytes = readFileBounded(path, options.maxFileBytes);
+  if (!bytes.ok()) return bytes.status();
+  return loadChecked(*bytes, *format, ext, path, options);
 }
 
 Status saveMeshFile(const IndexedMesh& mesh, const std::string& path, bool binary) {

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
@@ -20,6 +19,7 @@
 #include <optional>
 #include <set>
 
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_import.h"
 
 namespace thinlod::scene {
@@ -121,17 +121,6 @@ struct GltfDeclared {
   bool onlyTriangleLists = true;
 };
 
-Result<std::string> readBounded(const std::string& path, std::uint64_t size) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uint64_t>(in.gcount()) != size) {
-    return Status(ErrorCode::kIoError, path + ": short read");
-  }
-  return bytes;
-}
-
 std::uint32_t le32(const std::string& b, std::size_t at) {
   return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
          static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
@@ -141,7 +130,7 @@ std::uint32_t le32(const std::string& b, std::size_t at) {
 
 Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
                                   const ImportLimits& limits) {
-  Result<std::string> bytes = readBounded(path, size);
+  Result<std::string> bytes = readFileBounded(path, size);
   if (!bytes.ok()) return bytes.status();
   std::string json;
   if (lowerExtension(path) == ".glb") {

@@ -1,9 +1,9 @@
 // File edge of the scene module: reads the scene file, then the mesh files
 // its Inline urls name.
 #include <filesystem>
-#include <fstream>
 #include <map>
 
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/core/hash.h"
 #include "thinlod/common/scene/scene_parser.h"
 
@@ -164,28 +164,12 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
 }
 
 Result<Scene> loadSceneFile(const std::string& path, const SceneLoadOptions& options) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Status(ErrorCode::kNotFound, path + ": no such file");
-  if (!fs::is_regular_file(path, ec)) {
-    return Status(ErrorCode::kIoError, path + ": not a regular file");
-  }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
   const bool imported = isImportedSceneExtension(path);
   const std::uint64_t maxBytes =
       imported ? options.importLimits.maxFileBytes : std::uint64_t{options.limits.maxBytes};
-  if (size > maxBytes) {
-    return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
-                                                     " bytes exceed the limit of " +
-                                                     std::to_string(maxBytes));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return Status(ErrorCode::kIoError, path + ": short read");
-  }
+  Result<std::string> read = readFileBounded(path, maxBytes);
+  if (!read.ok()) return read.status();
+  const std::string& text = *read;
   Result<Scene> scene =
       imported ? importScene(path, options.importLimits) : parseScene(text, path, options.limits);
   if (!scene.ok()) return scene.status();

@@ -1,10 +1,10 @@
 #include "scene_setup.h"
 
-#include <fstream>
 #include <map>
 #include <utility>
 
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
 
@@ -13,20 +13,9 @@ namespace {
 
 // The bytes of a texture file, at most `limit` of them.
 Result<std::vector<std::uint8_t>> readTextureFile(const std::string& path, std::size_t limit) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open for reading");
-  const std::streamoff size = in.tellg();
-  if (size < 0) return Status(ErrorCode::kIoError, path + ": cannot tell its size");
-  if (static_cast<std::uint64_t>(size) > limit) {
-    return Status(
-        ErrorCode::kResourceExhausted,
-        path + ": " + std::to_string(size) + " bytes exceed the limit of " + std::to_string(limit));
-  }
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  in.seekg(0);
-  in.read(reinterpret_cast<char*>(bytes.data()), size);
-  if (in.gcount() != size) return Status(ErrorCode::kIoError, path + ": short read");
-  return bytes;
+  Result<std::string> bytes = readFileBounded(path, limit);
+  if (!bytes.ok()) return bytes.status();
+  return std::vector<std::uint8_t>(bytes->begin(), bytes->end());
 }
 
 }  // namespace

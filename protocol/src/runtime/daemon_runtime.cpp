@@ -13,7 +13,6 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -23,6 +22,8 @@
 #include <string_view>
 #include <variant>
 #include <vector>
+
+#include "thinlod/common/core/file_bytes.h"
 
 namespace thinlod::protocol {
 namespace {
@@ -229,12 +230,10 @@ Status DaemonRuntime::Impl::walk(const toml::table& table, const std::string& pr
 }
 
 Status DaemonRuntime::Impl::applyConfigFile(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Status(ErrorCode::kNotFound, file + ": cannot open the config file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) return Status(ErrorCode::kIoError, file + ": cannot read the config file");
-  return applyConfigText(text.str(), file);
+  constexpr std::uint64_t kMaxConfigBytes = 1 << 20;  // a config is a page of TOML
+  Result<std::string> text = readFileBounded(file, kMaxConfigBytes);
+  if (!text.ok()) return Status(text.status().code(), "config: " + text.status().message());
+  return applyConfigText(*text, file);
 }
 
 Status DaemonRuntime::Impl::applyConfigText(std::string_view text, const std::string& file) {

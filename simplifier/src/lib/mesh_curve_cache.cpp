@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "qem_collapse.h"
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/simplifier/mesh_curve.h"
 
 namespace thinlod::simplifier {
@@ -118,20 +119,7 @@ Status checkConservative(const AccuracyCurve& curve, const std::vector<AccuracyS
 }
 
 Result<std::string> readSmallFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return Status(ErrorCode::kIoError, path.string() + ": " + ec.message());
-  if (size > kMaxCacheFileBytes) {
-    return Status(ErrorCode::kResourceExhausted, path.string() + ": larger than 16 MiB");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kIoError, path.string() + ": cannot open");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (in.gcount() != static_cast<std::streamsize>(size)) {
-    return Status(ErrorCode::kIoError, path.string() + ": short read");
-  }
-  return text;
+  return readFileBounded(path.string(), kMaxCacheFileBytes);
 }
 
 // Write to a unique temporary name, then rename over the target: readers
