@@ -166,23 +166,12 @@ Result<FrameQuality> GlFrameProducer::measure(std::uint64_t frame, const Pose& p
     return Status(renderMs.status().code(),
                   "reference frame " + std::to_string(frame) + ": " + renderMs.status().message());
   }
-  Result<FrameComparison> comparison = compareFrames(frame_, referenceFrame_);
-  if (!comparison.ok()) return comparison.status();
-  FrameQuality quality;
-  quality.snrDb = comparison->snrDb;
-  quality.psnrDb = comparison->psnrDb;
-  quality.referenceMs = *renderMs;
-  if (!covered_.empty()) {
-    Result<Completeness> completeness =
-        frameCompleteness(extents_, covered_, *heldNow(), options_.visibleMinPixels);
-    if (!completeness.ok()) return completeness.status();
-    quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
-    quality.missingObjects = static_cast<long>(completeness->missingGroups);
-  }
-  // Uniform shown frame, non-uniform reference (as scoreShownFrames defines it).
-  Result<FrameComparison> referenceAlone = compareFrames(referenceFrame_, referenceFrame_);
-  quality.blank =
-      comparison->variance == 0.0 && referenceAlone.ok() && referenceAlone->variance > 0.0;
+  static const std::vector<std::uint64_t> kNothingHeld;
+  Result<FrameQuality> quality =
+      scoreFrame(frame_, referenceFrame_, extents_, covered_,
+                 covered_.empty() ? kNothingHeld : *heldNow(), options_.visibleMinPixels);
+  if (!quality.ok()) return quality.status();
+  quality->referenceMs = *renderMs;
   return quality;
 }
 

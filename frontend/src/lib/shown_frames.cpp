@@ -86,6 +86,25 @@ bool ShownFrameLog::record(std::uint64_t frame, const Pose& pose, std::int64_t s
   return true;
 }
 
+Result<FrameQuality> scoreFrame(const RgbaImage& shown, const RgbaImage& reference,
+                                const std::vector<ObjectExtent>& objects,
+                                const std::vector<std::uint32_t>& covered,
+                                const std::vector<std::uint64_t>& held, std::uint32_t minPixels) {
+  Result<FrameComparison> comparison = compareFrames(shown, reference);
+  if (!comparison.ok()) return comparison.status();
+  FrameQuality quality;
+  quality.snrDb = comparison->snrDb;
+  quality.psnrDb = comparison->psnrDb;
+  quality.blank = comparison->variance == 0.0 && !uniformRgb(reference) ? 1 : 0;
+  if (!covered.empty()) {
+    Result<Completeness> completeness = frameCompleteness(objects, covered, held, minPixels);
+    if (!completeness.ok()) return completeness.status();
+    quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
+    quality.missingObjects = static_cast<long>(completeness->missingGroups);
+  }
+  return quality;
+}
+
 Result<std::vector<FrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
                                                  ReferenceSource& references,
                                                  const std::vector<ObjectExtent>& objects,
@@ -105,27 +124,17 @@ Result<std::vector<FrameScore>> scoreShownFrames(const std::vector<ShownFrame>& 
                                                   std::to_string(shown.frame) + ": " +
                                                   renderMs.status().message());
     }
-    Result<FrameComparison> comparison = compareFrames(shown.image, reference);
-    if (!comparison.ok()) {
-      return Status(comparison.status().code(), "shown frame " + std::to_string(shown.frame) +
-                                                    ": " + comparison.status().message());
+    Result<FrameQuality> quality =
+        scoreFrame(shown.image, reference, objects, covered,
+                   shown.held != nullptr ? *shown.held : kNothingHeld, minPixels);
+    if (!quality.ok()) {
+      return Status(quality.status().code(), "shown frame " + std::to_string(shown.frame) + ": " +
+                                                 quality.status().message());
     }
     FrameScore score;
     score.frame = shown.frame;
-    score.quality.snrDb = comparison->snrDb;
-    score.quality.psnrDb = comparison->psnrDb;
+    score.quality = *quality;
     score.quality.referenceMs = *renderMs;
-    score.quality.blank = comparison->variance == 0.0 && !uniformRgb(reference) ? 1 : 0;
-    if (!covered.empty()) {
-      Result<Completeness> completeness = frameCompleteness(
-          objects, covered, shown.held != nullptr ? *shown.held : kNothingHeld, minPixels);
-      if (!completeness.ok()) {
-        return Status(completeness.status().code(), "shown frame " + std::to_string(shown.frame) +
-                                                        ": " + completeness.status().message());
-      }
-      score.quality.visibleObjects = static_cast<long>(completeness->visibleGroups);
-      score.quality.missingObjects = static_cast<long>(completeness->missingGroups);
-    }
     if (sink) sink(shown, reference, score);
     scores.push_back(score);
   }

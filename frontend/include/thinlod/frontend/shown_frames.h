@@ -117,10 +117,19 @@ class ReferenceSource {
 using ScoredFrameSink =
     std::function<void(const ShownFrame&, const RgbaImage& reference, const FrameScore&)>;
 
-// One FrameScore per kept frame (frame_record.h: the record's quality whole).
-// blank: 1 when the shown frame is one uniform grey (all RGB bytes equal)
-// while the reference is not one uniform colour. Completeness (visible /
-// missing objects) stays -1 when the source returns no coverage.
+// The one scoring of a shown frame against the reference of its pose, inline
+// (lockstep) and deferred (scoreShownFrames) alike: SNR, PSNR, blank and
+// completeness (referenceMs is the caller's). blank: 1 when the shown frame is
+// uniform (zero variance) while the reference is not one uniform colour.
+// Completeness (visible / missing objects) stays -1 when `covered` is empty.
+// Errors: sizes that differ (compareFrames), covered.size() != objects.size().
+Result<FrameQuality> scoreFrame(const RgbaImage& shown, const RgbaImage& reference,
+                                const std::vector<ObjectExtent>& objects,
+                                const std::vector<std::uint32_t>& covered,
+                                const std::vector<std::uint64_t>& held, std::uint32_t minPixels);
+
+// One FrameScore per kept frame (frame_record.h: the record's quality whole),
+// each scored by scoreFrame.
 Result<std::vector<FrameScore>> scoreShownFrames(const std::vector<ShownFrame>& frames,
                                                  ReferenceSource& references,
                                                  const std::vector<ObjectExtent>& objects,
