@@ -55,7 +55,8 @@ std::vector<double> fillTriangleLadder(double limit) {
   return ladder;
 }
 
-std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps) {
+std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps,
+                                    FillRetry retry) {
   std::vector<std::size_t> chosen(items.size(), 0);
   double usedTriangles = 0.0;
   double usedLink = 0.0;
@@ -101,6 +102,43 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     return (!caps.useTriangles || usedTriangles + extraTriangles <= caps.triangles) &&
            (!caps.useLink || usedLink + extraLink <= caps.linkBytes);
   };
+  // FillRetry::kIndexed: a stalled item waits in a min-heap keyed by the
+  // least extra it needs in the first capped resource (over its options
+  // with a lower error, fitting or not; they do not change while it is
+  // stalled). Floating-point addition is monotone, so "some option fits
+  // that resource" is exactly "used + least extra <= cap": when room grows,
+  // only items passing that test (and the same test on the second cap) can
+  // find an upgrade; the others would be pushed back unchanged.
+  struct StalledItem {
+    double keyExtra;    // least extra in the first capped resource
+    double otherExtra;  // least extra in the second capped resource (both caps)
+    std::size_t item;
+    bool operator>(const StalledItem& o) const {
+      if (keyExtra != o.keyExtra) return keyExtra > o.keyExtra;
+      return item > o.item;
+    }
+  };
+  std::priority_queue<StalledItem, std::vector<StalledItem>, std::greater<StalledItem>> waiting;
+  auto stall = [&](std::size_t i) {
+    const FillItem& item = items[i];
+    const FillOption& now = item.options[chosen[i]];
+    double leastTriangles = kInf;
+    double leastLink = kInf;
+    bool any = false;
+    for (std::size_t j = 0; j < item.options.size(); ++j) {
+      const FillOption& o = item.options[j];
+      if (j == chosen[i] || !finiteCost(o) || !(o.error < now.error)) continue;
+      any = true;
+      leastTriangles = std::min(leastTriangles, o.triangles - now.triangles);
+      leastLink = std::min(leastLink, o.linkBytes - now.linkBytes);
+    }
+    if (!any) return;  // no better option at all: it never moves again
+    if (caps.useTriangles) {
+      waiting.push({leastTriangles, leastLink, i});
+    } else {
+      waiting.push({leastLink, leastTriangles, i});
+    }
+  };
   auto pushBest = [&](std::size_t i) {
     const FillItem& item = items[i];
     const FillOption& now = item.options[chosen[i]];
@@ -123,8 +161,30 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     }
     if (found) {
       heap.push(best);
+    } else if (retry == FillRetry::kIndexed) {
+      stall(i);
     } else {
       stalled.push_back(i);
+    }
+  };
+  auto retryIndexed = [&]() {
+    std::vector<StalledItem> ready;
+    for (;;) {
+      if (waiting.empty()) break;
+      const StalledItem& top = waiting.top();
+      const bool keyFits = caps.useTriangles ? usedTriangles + top.keyExtra <= caps.triangles
+                                             : usedLink + top.keyExtra <= caps.linkBytes;
+      if (!keyFits) break;
+      ready.push_back(top);
+      waiting.pop();
+    }
+    for (const StalledItem& w : ready) {
+      if (caps.useTriangles && caps.useLink && !(usedLink + w.otherExtra <= caps.linkBytes)) {
+        waiting.push(w);  // still nothing fits the link cap
+        continue;
+      }
+      ++version[w.item];
+      pushBest(w.item);
     }
   };
   for (std::size_t i = 0; i < items.size(); ++i) pushBest(i);
@@ -145,12 +205,16 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     usedLink += extraLink;
     chosen[u.item] = u.option;
     pushBest(u.item);
-    if (extraTriangles < 0.0 || extraLink < 0.0) {
+    if (retry == FillRetry::kIndexed) {
+      // Only room grown in a capped resource lets a stalled item fit.
+      if ((caps.useTriangles && extraTriangles < 0.0) || (caps.useLink && extraLink < 0.0))
+        retryIndexed();
+    } else if (extraTriangles < 0.0 || extraLink < 0.0) {
       // Room grew in one resource: upgrades that did not fit may fit now
       // (only the stalled items; the others are re-checked when popped).
-      std::vector<std::size_t> retry;
-      retry.swap(stalled);
-      for (std::size_t i : retry) {
+      std::vector<std::size_t> again;
+      again.swap(stalled);
+      for (std::size_t i : again) {
         ++version[i];
         pushBest(i);
       }
@@ -200,6 +264,17 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   const double roomLink = hard.useLink ? hard.linkBytes - used.linkBytes : kInf;
   if (!(roomTriangles > 0.0) || !(roomLink > 0.0)) return outcome;
 
+  // The ladder is a prefix-stable sequence: one copy up to the largest
+  // limit any leaf can have serves every leaf (reuseLeafWork; the
+  // reference builds it per candidate).
+  std::vector<double> sharedLadder;
+  if (config.reuseLeafWork) {
+    double largest = 0.0;
+    for (const LeafSelection& s : selections)
+      if (s.rendered) largest = std::max(largest, s.cost.triangles + roomTriangles);
+    sharedLadder = fillTriangleLadder(std::min(largest, 1e7));
+  }
+  std::vector<double> ownLadder;
   std::vector<FillItem> items;
   std::vector<std::size_t> itemSelection;
   std::vector<std::vector<OptionSource>> sources;
@@ -249,10 +324,22 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
       if (!(low <= k.maxRelativeAccuracy)) continue;
       // Levels: the best accuracy within each rung of the ladder, up to what
       // the room allows, and the option's top when it fits.
-      const double limit = s.cost.triangles + roomTriangles;
+      const double limit = std::min(s.cost.triangles + roomTriangles, 1e7);
       std::vector<double> accuracies;
       int rungs = 0;
-      for (double rung : fillTriangleLadder(std::min(limit, 1e7))) {
+      const std::vector<double>* ladder = &sharedLadder;
+      std::size_t firstRung = 0;
+      if (config.reuseLeafWork) {  // the rungs from the pick up, as below
+        firstRung = static_cast<std::size_t>(
+            std::lower_bound(sharedLadder.begin(), sharedLadder.end(), s.cost.triangles) -
+            sharedLadder.begin());
+      } else {
+        ownLadder = fillTriangleLadder(limit);
+        ladder = &ownLadder;
+      }
+      for (std::size_t r = firstRung; r < ladder->size(); ++r) {
+        const double rung = (*ladder)[r];
+        if (!(rung <= limit)) break;  // the shared ladder runs to the largest limit
         if (rung < s.cost.triangles) continue;
         // Bounded work per leaf (the fill stays linear in the visible
         // leaves): at most kMaxFillRungs rungs above the pick, then the top.
@@ -298,7 +385,8 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   }
   caps.triangles -= fixedTriangles;
   caps.linkBytes -= fixedLink;
-  const std::vector<std::size_t> chosen = fillByGain(items, caps);
+  const std::vector<std::size_t> chosen = fillByGain(
+      items, caps, config.reuseLeafWork ? FillRetry::kIndexed : FillRetry::kEveryStalled);
 
   const std::vector<LeafSelection> before = selections;
   for (std::size_t k = 0; k < items.size(); ++k) {

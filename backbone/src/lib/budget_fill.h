@@ -52,8 +52,17 @@ struct FillCaps {
   double linkBytes = 0.0;
 };
 
-// Chosen option index per item (same order as `items`).
-std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps);
+// How stalled items (no upgrade fits) are re-checked when an upgrade frees
+// room. kEveryStalled: all of them after any cheaper move (the reference,
+// O(stalled) per such move: 13-15 s steps at 10^5 objects). kIndexed: only
+// after room grows in a capped resource, and only the items whose least
+// extra cost now fits (a min-heap; same choices, docs/scheduling.md).
+enum class FillRetry : std::uint8_t { kIndexed = 0, kEveryStalled = 1 };
+
+// Chosen option index per item (same order as `items`); identical for both
+// FillRetry values.
+std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps,
+                                    FillRetry retry = FillRetry::kIndexed);
 
 // Image error of showing a leaf at relative accuracy `frameAccuracy` (leaf
 // frame, relative to the diameter): the silhouette length in radians
