@@ -55,14 +55,29 @@ std::vector<double> fillTriangleLadder(double limit) {
   return ladder;
 }
 
-std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps,
-                                    FillRetry retry) {
-  std::vector<std::size_t> chosen(items.size(), 0);
+std::vector<std::size_t> fillByGain(const FillItems& flat, const FillCaps& caps, FillRetry retry) {
+  // A view of item i (its options in the flat pool), so the loops below read
+  // like the per-item layout.
+  struct ItemRef {
+    struct Options {
+      const FillOption* data;
+      std::size_t count;
+      std::size_t size() const { return count; }
+      const FillOption& operator[](std::size_t j) const { return data[j]; }
+    } options;
+    std::size_t current;
+  };
+  const std::size_t itemCount = flat.current.size();
+  auto itemAt = [&](std::size_t i) {
+    return ItemRef{{flat.options.data() + flat.begin[i], flat.begin[i + 1] - flat.begin[i]},
+                   flat.current[i]};
+  };
+  std::vector<std::size_t> chosen(itemCount, 0);
   double usedTriangles = 0.0;
   double usedLink = 0.0;
   bool sane = true;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    const FillItem& item = items[i];
+  for (std::size_t i = 0; i < itemCount; ++i) {
+    const ItemRef item = itemAt(i);
     if (item.current >= item.options.size()) {
       sane = false;
       continue;
@@ -81,8 +96,8 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
 
   // Free upgrades first: a lower error for no more of either resource (a
   // displayed copy better than the pick) never risks a cap.
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    const FillItem& item = items[i];
+  for (std::size_t i = 0; i < itemCount; ++i) {
+    const ItemRef item = itemAt(i);
     const FillOption& now = item.options[chosen[i]];
     std::size_t best = chosen[i];
     for (std::size_t j = 0; j < item.options.size(); ++j) {
@@ -95,7 +110,7 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     chosen[i] = best;
   }
 
-  std::vector<std::uint32_t> version(items.size(), 0);
+  std::vector<std::uint32_t> version(itemCount, 0);
   std::vector<std::size_t> stalled;  // items with no upgrade that fits
   std::priority_queue<Upgrade> heap;
   auto fits = [&](double extraTriangles, double extraLink) {
@@ -120,7 +135,7 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
   };
   std::priority_queue<StalledItem, std::vector<StalledItem>, std::greater<StalledItem>> waiting;
   auto stall = [&](std::size_t i) {
-    const FillItem& item = items[i];
+    const ItemRef item = itemAt(i);
     const FillOption& now = item.options[chosen[i]];
     double leastTriangles = kInf;
     double leastLink = kInf;
@@ -140,7 +155,7 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
     }
   };
   auto pushBest = [&](std::size_t i) {
-    const FillItem& item = items[i];
+    const ItemRef item = itemAt(i);
     const FillOption& now = item.options[chosen[i]];
     bool found = false;
     Upgrade best{0.0, 0.0, i, 0, version[i]};
@@ -187,13 +202,13 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
       pushBest(w.item);
     }
   };
-  for (std::size_t i = 0; i < items.size(); ++i) pushBest(i);
+  for (std::size_t i = 0; i < itemCount; ++i) pushBest(i);
   while (!heap.empty()) {
     const Upgrade u = heap.top();
     heap.pop();
     if (u.version != version[u.item]) continue;
-    const FillOption& now = items[u.item].options[chosen[u.item]];
-    const FillOption& next = items[u.item].options[u.option];
+    const FillOption& now = itemAt(u.item).options[chosen[u.item]];
+    const FillOption& next = itemAt(u.item).options[u.option];
     const double extraTriangles = next.triangles - now.triangles;
     const double extraLink = next.linkBytes - now.linkBytes;
     ++version[u.item];
@@ -223,6 +238,14 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
   return chosen;
 }
 
+std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps,
+                                    FillRetry retry) {
+  FillItems flat;
+  for (const FillItem& item : items)
+    flat.add(item.options.data(), item.options.size(), item.current);
+  return fillByGain(flat, caps, retry);
+}
+
 namespace {
 
 // What one option of the fill stands for in the selections.
@@ -247,12 +270,12 @@ double onScreenWeight(const ViewerState& viewer, const Sphere& bounds) {
   return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
 }
 
-}  // namespace
-
-FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerConfig& config,
-                                const ViewerState& viewer, const PredictedRegion& region,
-                                const PlannerStateImpl& state, const JointBudget& hard,
-                                std::vector<LeafSelection>& selections) {
+// The reference path (SchedulerConfig::reuseLeafWork = false): the fill as
+// first written, kept so the fast path below can be checked against it.
+FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& config,
+                          const ViewerState& viewer, const PredictedRegion& region,
+                          const PlannerStateImpl& state, const JointBudget& hard,
+                          std::vector<LeafSelection>& selections) {
   FillOutcome outcome;
   for (const LeafSelection& s : selections)
     if (s.rendered) outcome.trianglesBefore += s.cost.triangles;
@@ -264,17 +287,6 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   const double roomLink = hard.useLink ? hard.linkBytes - used.linkBytes : kInf;
   if (!(roomTriangles > 0.0) || !(roomLink > 0.0)) return outcome;
 
-  // The ladder is a prefix-stable sequence: one copy up to the largest
-  // limit any leaf can have serves every leaf (reuseLeafWork; the
-  // reference builds it per candidate).
-  std::vector<double> sharedLadder;
-  if (config.reuseLeafWork) {
-    double largest = 0.0;
-    for (const LeafSelection& s : selections)
-      if (s.rendered) largest = std::max(largest, s.cost.triangles + roomTriangles);
-    sharedLadder = fillTriangleLadder(std::min(largest, 1e7));
-  }
-  std::vector<double> ownLadder;
   std::vector<FillItem> items;
   std::vector<std::size_t> itemSelection;
   std::vector<std::vector<OptionSource>> sources;
@@ -324,22 +336,10 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
       if (!(low <= k.maxRelativeAccuracy)) continue;
       // Levels: the best accuracy within each rung of the ladder, up to what
       // the room allows, and the option's top when it fits.
-      const double limit = std::min(s.cost.triangles + roomTriangles, 1e7);
+      const double limit = s.cost.triangles + roomTriangles;
       std::vector<double> accuracies;
       int rungs = 0;
-      const std::vector<double>* ladder = &sharedLadder;
-      std::size_t firstRung = 0;
-      if (config.reuseLeafWork) {  // the rungs from the pick up, as below
-        firstRung = static_cast<std::size_t>(
-            std::lower_bound(sharedLadder.begin(), sharedLadder.end(), s.cost.triangles) -
-            sharedLadder.begin());
-      } else {
-        ownLadder = fillTriangleLadder(limit);
-        ladder = &ownLadder;
-      }
-      for (std::size_t r = firstRung; r < ladder->size(); ++r) {
-        const double rung = (*ladder)[r];
-        if (!(rung <= limit)) break;  // the shared ladder runs to the largest limit
+      for (double rung : fillTriangleLadder(std::min(limit, 1e7))) {
         if (rung < s.cost.triangles) continue;
         // Bounded work per leaf (the fill stays linear in the visible
         // leaves): at most kMaxFillRungs rungs above the pick, then the top.
@@ -385,8 +385,7 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   }
   caps.triangles -= fixedTriangles;
   caps.linkBytes -= fixedLink;
-  const std::vector<std::size_t> chosen = fillByGain(
-      items, caps, config.reuseLeafWork ? FillRetry::kIndexed : FillRetry::kEveryStalled);
+  const std::vector<std::size_t> chosen = fillByGain(items, caps, FillRetry::kEveryStalled);
 
   const std::vector<LeafSelection> before = selections;
   for (std::size_t k = 0; k < items.size(); ++k) {
@@ -409,6 +408,221 @@ FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerCon
   for (const LeafSelection& s : selections)
     if (s.rendered) outcome.trianglesAfter += s.cost.triangles;
   return outcome;
+}
+
+}  // namespace
+
+// Buffers of the fast path, kept in the planner state between steps.
+struct FillScratch {
+  FillItems items;
+  std::vector<std::size_t> itemSelection;
+  std::vector<OptionSource> sources;  // parallel to items.options
+  std::vector<LeafCandidate> candidatePool;
+  std::vector<std::uint32_t> candidateBegin;  // per item, into candidatePool
+  std::vector<LeafCandidate> collected;
+  std::vector<double> ladder;
+  std::vector<double> accuracies;
+  std::vector<std::pair<std::size_t, LeafSelection>> undo;
+};
+
+namespace {
+
+// The same fill with less work (reuseLeafWork): the push-down's stored
+// candidates instead of collecting them again, one pool for every item's
+// options and candidates (no allocation per leaf), one shared ladder with a
+// binary search for the pick's rung, the view-cone angle computed once, and
+// an undo log of the changed selections instead of a copy of all of them.
+// Every value is computed by the same expressions in the same order, so the
+// choices are those of fillReference (ReuseLeafWork tests, bench_scheduler).
+FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config,
+                     const ViewerState& viewer, const PredictedRegion& region,
+                     PlannerStateImpl& state, const JointBudget& hard,
+                     std::vector<LeafSelection>& selections) {
+  FillOutcome outcome;
+  for (const LeafSelection& s : selections)
+    if (s.rendered) outcome.trianglesBefore += s.cost.triangles;
+  outcome.trianglesAfter = outcome.trianglesBefore;
+  if (!hard.useTriangles && !hard.useLink) return outcome;
+
+  const CandidateCost used = renderedCost(selections);
+  const double roomTriangles = hard.useTriangles ? hard.triangles - used.triangles : kInf;
+  const double roomLink = hard.useLink ? hard.linkBytes - used.linkBytes : kInf;
+  if (!(roomTriangles > 0.0) || !(roomLink > 0.0)) return outcome;
+
+  if (!state.fillScratch) state.fillScratch.reset(new FillScratch);
+  FillScratch& w = *state.fillScratch;
+  w.items.clear();
+  w.itemSelection.clear();
+  w.sources.clear();
+  w.candidatePool.clear();
+  w.candidateBegin.clear();
+  w.undo.clear();
+  // The ladder is a prefix-stable sequence: one copy up to the largest limit
+  // any leaf can have serves every leaf.
+  double largest = 0.0;
+  for (const LeafSelection& s : selections)
+    if (s.rendered) largest = std::max(largest, s.cost.triangles + roomTriangles);
+  w.ladder = fillTriangleLadder(std::min(largest, 1e7));
+  const StepCandidates& kept = state.stepCandidates;
+  const bool stored = kept.valid && kept.begin.size() == selections.size() &&
+                      kept.count.size() == selections.size();
+  const double viewLength = glm::length(viewer.viewDirection);
+  const double halfDiagonal = std::atan(
+      std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)));
+  auto onScreen = [&](const Sphere& bounds) {  // onScreenWeight, constants hoisted
+    const glm::dvec3 toObject = bounds.center - viewer.position;
+    const double distance = glm::length(toObject);
+    if (!(distance > bounds.radius) || !(viewLength > 0.0)) return 1.0;
+    const double cosAngle =
+        std::clamp(glm::dot(toObject, viewer.viewDirection) / (distance * viewLength), -1.0, 1.0);
+    const double angle = std::acos(cosAngle);
+    const double angularRadius = std::asin(std::min(1.0, bounds.radius / distance));
+    return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
+  };
+
+  for (std::size_t i = 0; i < selections.size(); ++i) {
+    const LeafSelection& s = selections[i];
+    if (!s.rendered || !(s.diameter > 0.0)) continue;
+    const LeafCandidate* candidates = nullptr;
+    std::size_t candidateCount = 0;
+    bool displayed = false;
+    if (stored) {
+      candidates = kept.pool.data() + kept.begin[i];
+      candidateCount = kept.count[i];
+      for (std::size_t c = 0; c < candidateCount && !displayed; ++c)
+        displayed = candidates[c].source == CandidateSource::kFrontendCopy;
+    }
+    if (!displayed) {  // a copy on display may be invalid here: not a candidate
+      const SceneObject& object = scene.objects[s.object];
+      for (std::uint32_t k = 0; k < object.optionCount && !displayed; ++k)
+        displayed = scene.options[object.firstOption + k].atFrontend.present;
+    }
+    if (!displayed) continue;
+    const SceneNode& node = scene.nodes[s.node];
+    if (!stored) {
+      collectLeafCandidates(scene, s.object, region, config, CandidateContext::kExact,
+                            pendingFor(state, s.object), node.bounds, w.collected);
+      candidates = w.collected.data();
+      candidateCount = w.collected.size();
+    }
+    const double nowDistance =
+        conversionDistance(viewer.position, 0.0, node.bounds, config.minimalDistance);
+    const double weight = onScreen(node.bounds);
+    const std::size_t optionsBefore = w.items.options.size();
+    // The current pick first (its own cost, as the push-down charged it).
+    w.items.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, weight),
+                               s.cost.triangles, s.cost.linkBytes, 1.0});
+    w.sources.push_back({0, -1.0});
+    const double floor = s.need * (1.0 - kAccuracyTolerance);
+    for (std::uint32_t c = 0; c < candidateCount; ++c) {
+      const LeafCandidate& k = candidates[c];
+      if (!(k.maxRelativeAccuracy >= floor)) continue;
+      if (k.source != CandidateSource::kNew) {
+        if (k.fixedTriangles - s.cost.triangles > roomTriangles ||
+            k.fixedLinkBytes - s.cost.linkBytes > roomLink)
+          continue;
+        w.items.options.push_back(
+            {fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy, weight),
+             k.fixedTriangles, k.fixedLinkBytes, 1.0});
+        w.sources.push_back({c, -1.0});
+        continue;
+      }
+      const RepresentationOption& option = *k.representation;
+      const double start =
+          std::max(option.relativeTriangles.minAccuracy(), option.relativeLinkBytes.minAccuracy());
+      const double low = std::max(s.need, start);
+      if (!(low <= k.maxRelativeAccuracy)) continue;
+      const double limit = std::min(s.cost.triangles + roomTriangles, 1e7);
+      w.accuracies.clear();
+      int rungs = 0;
+      const std::size_t firstRung = static_cast<std::size_t>(
+          std::lower_bound(w.ladder.begin(), w.ladder.end(), s.cost.triangles) - w.ladder.begin());
+      for (std::size_t r = firstRung; r < w.ladder.size(); ++r) {
+        const double rung = w.ladder[r];
+        if (!(rung <= limit)) break;  // the shared ladder runs to the largest limit
+        if (rung < s.cost.triangles) continue;
+        if (++rungs > kMaxFillRungs) break;
+        const std::optional<double> a = option.relativeTriangles.maxAccuracyWithin(rung);
+        if (!a) continue;
+        const double at = std::min(*a, k.maxRelativeAccuracy);
+        if (at < low) continue;
+        if (w.accuracies.empty() || at > w.accuracies.back()) w.accuracies.push_back(at);
+        if (at >= k.maxRelativeAccuracy) break;
+      }
+      if (w.accuracies.empty() || w.accuracies.back() < k.maxRelativeAccuracy)
+        w.accuracies.push_back(k.maxRelativeAccuracy);
+      for (double at : w.accuracies) {
+        const CandidateCost cost = candidateCost(k, at);
+        if (cost.triangles - s.cost.triangles > roomTriangles ||
+            cost.linkBytes - s.cost.linkBytes > roomLink)
+          continue;
+        w.items.options.push_back({fillImageError(s.diameter, nowDistance, at, weight),
+                                   cost.triangles, cost.linkBytes, kNewGenerationGainScale});
+        w.sources.push_back({c, at});
+      }
+    }
+    if (w.items.options.size() - optionsBefore < 2) {  // nothing to gain: no item
+      w.items.options.resize(optionsBefore);
+      w.sources.resize(optionsBefore);
+      continue;
+    }
+    w.items.begin.push_back(static_cast<std::uint32_t>(w.items.options.size()));
+    w.items.current.push_back(0);
+    w.itemSelection.push_back(i);
+    w.candidateBegin.push_back(static_cast<std::uint32_t>(w.candidatePool.size()));
+    w.candidatePool.insert(w.candidatePool.end(), candidates, candidates + candidateCount);
+  }
+  if (w.items.size() == 0) return outcome;
+
+  FillCaps caps;
+  caps.useTriangles = hard.useTriangles;
+  caps.useLink = hard.useLink;
+  caps.triangles = hard.triangles;
+  caps.linkBytes = hard.linkBytes;
+  double fixedTriangles = used.triangles;
+  double fixedLink = used.linkBytes;
+  for (std::size_t k = 0; k < w.items.size(); ++k) {
+    fixedTriangles -= w.items.options[w.items.begin[k]].triangles;
+    fixedLink -= w.items.options[w.items.begin[k]].linkBytes;
+  }
+  caps.triangles -= fixedTriangles;
+  caps.linkBytes -= fixedLink;
+  const std::vector<std::size_t> chosen = fillByGain(w.items, caps, FillRetry::kIndexed);
+
+  for (std::size_t k = 0; k < w.items.size(); ++k) {
+    if (chosen[k] == 0) continue;
+    LeafSelection& s = selections[w.itemSelection[k]];
+    w.undo.emplace_back(w.itemSelection[k], s);
+    const OptionSource& source = w.sources[w.items.begin[k] + chosen[k]];
+    const LeafCandidate& candidate = w.candidatePool[w.candidateBegin[k] + source.candidate];
+    const double need = s.need;
+    const double at = source.generateAt > 0.0 ? source.generateAt : need;
+    s = makeSelection(s.node, s.object, candidate, at, s.distance, s.diameter);
+    s.need = need;
+    ++outcome.upgraded;
+  }
+  if (!withinBudget(selections, hard)) {
+    for (const auto& [index, before] : w.undo) selections[index] = before;
+    outcome.upgraded = 0;
+    return outcome;
+  }
+  outcome.trianglesAfter = 0.0;
+  for (const LeafSelection& s : selections)
+    if (s.rendered) outcome.trianglesAfter += s.cost.triangles;
+  return outcome;
+}
+
+}  // namespace
+
+void FillScratchDeleter::operator()(FillScratch* scratch) const { delete scratch; }
+
+FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerConfig& config,
+                                const ViewerState& viewer, const PredictedRegion& region,
+                                PlannerStateImpl& state, const JointBudget& hard,
+                                std::vector<LeafSelection>& selections) {
+  if (!config.reuseLeafWork)
+    return fillReference(scene, config, viewer, region, state, hard, selections);
+  return fillFast(scene, config, viewer, region, state, hard, selections);
 }
 
 }  // namespace thinlod::backbone

@@ -239,7 +239,8 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     counter = w.byDelay ? static_cast<std::uint16_t>(counter + 1) : 0;
     ++stats.hysteresisKeeps;
   }
-  state.stepCandidates.reset();
+  // The stored candidates stay valid (same region, scene and in-flight
+  // requests) for the budget fill; the accuracy-curve method resets them.
 }
 
 }  // namespace thinlod::backbone
