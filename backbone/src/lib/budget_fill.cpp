@@ -134,20 +134,7 @@ std::vector<std::size_t> fillByGain(const FillItems& flat, const FillCaps& caps,
     }
   };
   std::priority_queue<StalledItem, std::vector<StalledItem>, std::greater<StalledItem>> waiting;
-  auto stall = [&](std::size_t i) {
-    const ItemRef item = itemAt(i);
-    const FillOption& now = item.options[chosen[i]];
-    double leastTriangles = kInf;
-    double leastLink = kInf;
-    bool any = false;
-    for (std::size_t j = 0; j < item.options.size(); ++j) {
-      const FillOption& o = item.options[j];
-      if (j == chosen[i] || !finiteCost(o) || !(o.error < now.error)) continue;
-      any = true;
-      leastTriangles = std::min(leastTriangles, o.triangles - now.triangles);
-      leastLink = std::min(leastLink, o.linkBytes - now.linkBytes);
-    }
-    if (!any) return;  // no better option at all: it never moves again
+  auto stall = [&](std::size_t i, double leastTriangles, double leastLink) {
     if (caps.useTriangles) {
       waiting.push({leastTriangles, leastLink, i});
     } else {
@@ -158,12 +145,18 @@ std::vector<std::size_t> fillByGain(const FillItems& flat, const FillCaps& caps,
     const ItemRef item = itemAt(i);
     const FillOption& now = item.options[chosen[i]];
     bool found = false;
+    bool better = false;  // some option has a lower error (fitting or not)
+    double leastTriangles = kInf;
+    double leastLink = kInf;
     Upgrade best{0.0, 0.0, i, 0, version[i]};
     for (std::size_t j = 0; j < item.options.size(); ++j) {
       const FillOption& o = item.options[j];
       if (j == chosen[i] || !finiteCost(o) || !(o.error < now.error)) continue;
       const double extraTriangles = o.triangles - now.triangles;
       const double extraLink = o.linkBytes - now.linkBytes;
+      better = true;
+      leastTriangles = std::min(leastTriangles, extraTriangles);
+      leastLink = std::min(leastLink, extraLink);
       if (!fits(extraTriangles, extraLink)) continue;
       const double extra = caps.useTriangles ? extraTriangles : extraLink;
       const double gain = (now.error - o.error) * o.gainScale;
@@ -177,7 +170,7 @@ std::vector<std::size_t> fillByGain(const FillItems& flat, const FillCaps& caps,
     if (found) {
       heap.push(best);
     } else if (retry == FillRetry::kIndexed) {
-      stall(i);
+      if (better) stall(i, leastTriangles, leastLink);  // else it never moves again
     } else {
       stalled.push_back(i);
     }
