@@ -183,6 +183,51 @@ TEST(BudgetFillProperty, CapsHoldAndErrorsNeverRise) {
   }
 }
 
+// FillRetry::kIndexed (stalled items re-checked only when room grows in a
+// capped resource, through a heap of their least extra cost) chooses exactly
+// what the reference kEveryStalled does: random items with many moves that
+// free room in one resource (cheaper in triangles or bytes, costlier in the
+// other), ties, zero and extreme costs, every cap combination.
+TEST(BudgetFillProperty, IndexedRetryChoosesWhatTheReferenceChooses) {
+  int freeing = 0;
+  for (int seed = 1; seed <= 600; ++seed) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed) * 15485863u);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double scale = std::pow(10.0, -6.0 + 12.0 * u(rng));
+    std::vector<FillItem> items(1 + rng() % 300);
+    double currentTriangles = 0.0;
+    double currentLink = 0.0;
+    for (FillItem& item : items) {
+      const int options = 1 + static_cast<int>(rng() % 10);
+      for (int k = 0; k < options; ++k) {
+        // Coarse grids make ties in errors, costs and ratios common.
+        const double error = std::floor(8.0 * u(rng)) * scale;
+        const double triangles = std::floor(20.0 * u(rng)) * scale;
+        const double link = (u(rng) < 0.3 ? 0.0 : std::floor(50.0 * u(rng))) * scale;
+        item.options.push_back({error, triangles, link, u(rng) < 0.5 ? 1.0 : 0.8});
+      }
+      item.current = rng() % item.options.size();
+      currentTriangles += item.options[item.current].triangles;
+      currentLink += item.options[item.current].linkBytes;
+    }
+    FillCaps caps;
+    const int which = static_cast<int>(rng() % 3);
+    caps.useTriangles = which != 1;
+    caps.useLink = which != 0;
+    caps.triangles = currentTriangles * (1.0 + 0.3 * u(rng)) + 5.0 * scale * u(rng);
+    caps.linkBytes = currentLink * (1.0 + 0.3 * u(rng)) + 20.0 * scale * u(rng);
+    const std::vector<std::size_t> fast = fillByGain(items, caps, FillRetry::kIndexed);
+    const std::vector<std::size_t> reference = fillByGain(items, caps, FillRetry::kEveryStalled);
+    ASSERT_EQ(fast, reference) << "seed " << seed;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      const FillOption& from = items[i].options[items[i].current];
+      const FillOption& to = items[i].options[fast[i]];
+      freeing += (to.triangles < from.triangles) || (to.linkBytes < from.linkBytes);
+    }
+  }
+  EXPECT_GT(freeing, 1000);  // the room-freeing moves the retry is about really occur
+}
+
 // Fine ladders (every object has detail well beyond the budget): the fill
 // uses >= 95 % of the budget.
 TEST(BudgetFillProperty, UsesNearlyAllTheBudgetWhenThereIsMoreDetail) {

@@ -117,6 +117,7 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
   if (config.fillBudget && !budget.fixedAccuracy)
     stats.budgetFillUpgrades +=
         fillRemainingBudget(scene, config, step.viewer, region, state, hard, selections).upgraded;
+  state.stepCandidates.reset();  // valid for this step's selections only
   state.previousTarget = target;
   state.lastSelectionCount = selections.size();
 

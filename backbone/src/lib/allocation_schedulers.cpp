@@ -74,10 +74,10 @@ std::vector<std::uint8_t> dropLeastVisible(const SelectionStep& step, const Visi
   std::vector<std::size_t> order(leaves.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::vector<double> priority(leaves.size());
+  const ViewCone cone(step.viewer);
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     const VisibleNode& n = tree.nodes[leaves[i].treeNode];
-    priority[i] =
-        keepPriority(step.viewer, step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+    priority[i] = cone.keepPriority(step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
   }
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });

@@ -186,11 +186,11 @@ Result<Selection> GreedyMethod::select(const SelectionStep& step) const {
   if (used > cap) {
     std::vector<std::size_t> order(items.size());
     std::vector<double> priority(items.size());
+    const ViewCone cone(step.viewer);
     for (std::size_t i = 0; i < order.size(); ++i) {
       order[i] = i;
       const VisibleNode& n = tree.nodes[items[i].treeNode];
-      priority[i] =
-          keepPriority(step.viewer, step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+      priority[i] = cone.keepPriority(step.scene.nodes[n.sceneNode].bounds, n.diameter, n.distance);
     }
     std::sort(order.begin(), order.end(),
               [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });

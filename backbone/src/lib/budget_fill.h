@@ -53,8 +53,39 @@ struct FillCaps {
   double linkBytes = 0.0;
 };
 
-// Chosen option index per item (same order as `items`).
-std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps);
+// How stalled items (no upgrade fits) are re-checked when an upgrade frees
+// room. kEveryStalled: all of them after any cheaper move (the reference,
+// O(stalled) per such move: 13-15 s steps at 10^5 objects). kIndexed: only
+// after room grows in a capped resource, and only the items whose least
+// extra cost now fits (a min-heap; same choices, docs/scheduling.md).
+enum class FillRetry : std::uint8_t { kIndexed = 0, kEveryStalled = 1 };
+
+// The same items in one pool (no allocation per item): item i owns
+// options[begin[i], begin[i + 1]); current[i] indexes its own options.
+struct FillItems {
+  std::vector<FillOption> options;
+  std::vector<std::uint32_t> begin{0};
+  std::vector<std::size_t> current;
+
+  std::size_t size() const { return current.size(); }
+  void clear() {
+    options.clear();
+    begin.assign(1, 0);
+    current.clear();
+  }
+  void add(const FillOption* first, std::size_t count, std::size_t currentOption) {
+    options.insert(options.end(), first, first + count);
+    begin.push_back(static_cast<std::uint32_t>(options.size()));
+    current.push_back(currentOption);
+  }
+};
+
+// Chosen option index per item (same order as `items`); identical for both
+// FillRetry values and both layouts.
+std::vector<std::size_t> fillByGain(const FillItems& items, const FillCaps& caps,
+                                    FillRetry retry = FillRetry::kIndexed);
+std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const FillCaps& caps,
+                                    FillRetry retry = FillRetry::kIndexed);
 
 // Image error of showing a leaf at relative accuracy `frameAccuracy` (leaf
 // frame, relative to the diameter): the silhouette length in radians
@@ -82,7 +113,7 @@ struct FillOutcome {
 // outside the current view cone count kOffScreenWeight).
 FillOutcome fillRemainingBudget(const SchedulingScene& scene, const SchedulerConfig& config,
                                 const ViewerState& viewer, const PredictedRegion& region,
-                                const PlannerStateImpl& state, const JointBudget& hard,
+                                PlannerStateImpl& state, const JointBudget& hard,
                                 std::vector<LeafSelection>& selections);
 
 // Rungs offered per new representation, from the pick's triangle count up

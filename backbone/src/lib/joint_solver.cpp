@@ -58,6 +58,16 @@ std::int32_t JointSolver::build(std::uint32_t sceneNode, bool parentInside) {
     nodes_[k].firstCandidate = static_cast<std::uint32_t>(candidates_.size());
     nodes_[k].candidateCount = static_cast<std::uint32_t>(found.size());
     candidates_.insert(candidates_.end(), found.begin(), found.end());
+    if (config_.reuseLeafWork) {
+      for (const LeafCandidate& c : found) {
+        PooledCosts costs;
+        if (c.source == CandidateSource::kNew) {
+          costs.triangles = poolCurve(c.representation->relativeTriangles);
+          costs.link = poolCurve(c.representation->relativeLinkBytes);
+        }
+        pooled_.push_back(costs);
+      }
+    }
     ++leafCount_;
     return static_cast<std::int32_t>(k);
   }
@@ -80,6 +90,31 @@ std::int32_t JointSolver::build(std::uint32_t sceneNode, bool parentInside) {
     stages_.resize(stages_.size() + kids.size());
   }
   return static_cast<std::int32_t>(k);
+}
+
+JointSolver::PooledCurve JointSolver::poolCurve(const AccuracyCurve& curve) {
+  PooledCurve pooled;
+  pooled.begin = static_cast<std::uint32_t>(segmentPool_.size());
+  pooled.count = static_cast<std::uint32_t>(curve.segments().size());
+  pooled.maxAccuracy = curve.maxAccuracy();
+  segmentPool_.insert(segmentPool_.end(), curve.segments().begin(), curve.segments().end());
+  return pooled;
+}
+
+// AccuracyCurve::resourcesFor on the pooled copy, step for step (the same
+// comparisons, the same segment search, the same expression for the value),
+// so the result is the same double. ReuseLeafWork's randomized both-budget
+// tests and bench_scheduler's same_plans check it against the reference.
+double JointSolver::curveCost(const PooledCurve& curve, double a) const {
+  if (curve.count == 0) return 0.0;
+  if (std::isnan(a) || a > curve.maxAccuracy) return kInf;
+  const CurveSegment* first = segmentPool_.data() + curve.begin;
+  const CurveSegment* last = first + curve.count;
+  if (a <= first->start) return first->value;
+  const CurveSegment* it = std::upper_bound(
+      first, last, a, [](double value, const CurveSegment& s) { return value < s.start; });
+  const CurveSegment& s = it == first ? *first : *(it - 1);
+  return s.value + s.slope * (a - s.start);
 }
 
 void JointSolver::refreshAccuracyBounds() {
@@ -187,6 +222,18 @@ void JointSolver::prepareCosts(std::uint32_t k, double accuracy) {
       const LeafCandidate& candidate = candidates_[c];
       if (!(candidate.maxRelativeAccuracy >= x * (1.0 - kAccuracyTolerance))) {
         costTriangles_[c] = std::nan("");
+        continue;
+      }
+      if (config_.reuseLeafWork) {  // candidateCost from the pooled curves
+        if (candidate.source != CandidateSource::kNew) {
+          costTriangles_[c] = candidate.fixedTriangles;
+          costLink_[c] = candidate.fixedLinkBytes;
+          continue;
+        }
+        const double a =
+            std::min(std::min(x, candidate.maxRelativeAccuracy), candidate.maxRelativeAccuracy);
+        costTriangles_[c] = curveCost(pooled_[c].triangles, a);
+        costLink_[c] = curveCost(pooled_[c].link, a);
         continue;
       }
       const CandidateCost cost =
@@ -567,11 +614,12 @@ std::size_t JointSolver::dropUntilFeasible(const ViewerState& viewer) {
   if (feasible(0.0)) return 0;
   std::vector<std::uint32_t> leaves;
   std::vector<double> priority(nodes_.size(), 0.0);
+  const ViewCone cone(viewer);
   for (std::uint32_t k = 0; k < nodes_.size(); ++k) {
     const Node& n = nodes_[k];
     if (n.kind != SceneNodeKind::kLeaf || n.candidateCount == 0) continue;
     leaves.push_back(k);
-    priority[k] = keepPriority(viewer, scene_.nodes[n.sceneNode].bounds, n.diameter, n.distance);
+    priority[k] = cone.keepPriority(scene_.nodes[n.sceneNode].bounds, n.diameter, n.distance);
   }
   std::sort(leaves.begin(), leaves.end(), [&](std::uint32_t a, std::uint32_t b) {
     if (priority[a] != priority[b]) return priority[a] < priority[b];

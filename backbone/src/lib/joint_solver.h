@@ -121,6 +121,23 @@ class JointSolver {
   std::vector<Span> stages_;
   std::vector<double> minTriangles_;
   std::vector<double> minLink_;
+  // reuseLeafWork: the curves of every new-representation candidate copied
+  // once per solver into one pool in tree order, so the ~40 prepareCosts
+  // passes of a bisection read contiguous memory instead of two scattered
+  // heap blocks per candidate (same values: curveCost mirrors resourcesFor).
+  struct PooledCurve {
+    std::uint32_t begin = 0;
+    std::uint32_t count = 0;  // 0: empty curve
+    double maxAccuracy = 0.0;
+  };
+  struct PooledCosts {
+    PooledCurve triangles;
+    PooledCurve link;
+  };
+  PooledCurve poolCurve(const AccuracyCurve& curve);
+  double curveCost(const PooledCurve& curve, double accuracy) const;
+  std::vector<CurveSegment> segmentPool_;
+  std::vector<PooledCosts> pooled_;    // per candidate (copies: unused)
   std::vector<double> costTriangles_;  // per candidate, for the prepared accuracy
   std::vector<double> costLink_;
   std::vector<std::uint8_t> levelOk_;  // per children_ entry of LODs

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -101,6 +102,13 @@ struct LinkSend {
   bool settled = false;
 };
 
+// Buffers of the budget fill's fast path (budget_fill.cpp), kept between
+// steps so a step does not allocate and page-fault them in again.
+struct FillScratch;
+struct FillScratchDeleter {
+  void operator()(FillScratch* scratch) const;
+};
+
 struct PlannerStateImpl {
   std::uint64_t steps = 0;
   std::uint64_t configFingerprint = 0;
@@ -116,6 +124,7 @@ struct PlannerStateImpl {
   std::vector<LeafSelection> spareSelections;  // complete in selection.h
   std::vector<DeferredLeaf> deferredLeaves;
   std::vector<DeferredLeaf> deferredSorted;  // radix-sort buffer
+  std::unique_ptr<FillScratch, FillScratchDeleter> fillScratch;
   std::uint64_t pendingGeneration = 1;
   std::uint64_t nextRequestId = 1;
   std::unordered_map<std::uint32_t, std::vector<PendingCopy>> pending;  // by object

@@ -20,11 +20,12 @@ void dropUntilWithin(const SchedulingScene& scene, const ViewerState& viewer,
                      std::vector<LeafSelection>& leaves, const JointBudget& hard) {
   std::vector<std::size_t> order;
   std::vector<double> priority(leaves.size(), 0.0);
+  const ViewCone cone(viewer);
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     if (!leaves[i].rendered) continue;
     order.push_back(i);
-    priority[i] = keepPriority(viewer, scene.nodes[leaves[i].node].bounds, leaves[i].diameter,
-                               leaves[i].distance);
+    priority[i] = cone.keepPriority(scene.nodes[leaves[i].node].bounds, leaves[i].diameter,
+                                    leaves[i].distance);
   }
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });

@@ -240,28 +240,32 @@ void preferCurrentCopies(const SchedulingScene& scene, const SchedulerConfig& co
     counter = w.byDelay ? static_cast<std::uint16_t>(counter + 1) : 0;
     ++stats.hysteresisKeeps;
   }
-  state.stepCandidates.reset();
+  // The stored candidates stay valid (same region, scene and in-flight
+  // requests) for the budget fill; the accuracy-curve method resets them.
 }
 
-double onScreenWeight(const ViewerState& viewer, const Sphere& bounds) {
-  const glm::dvec3 toObject = bounds.center - viewer.position;
+ViewCone::ViewCone(const ViewerState& viewer)
+    : position_(viewer.position),
+      direction_(viewer.viewDirection),
+      directionLength_(glm::length(viewer.viewDirection)),
+      halfDiagonal_(std::atan(
+          std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)))) {}
+
+double ViewCone::onScreenWeight(const Sphere& bounds) const {
+  const glm::dvec3 toObject = bounds.center - position_;
   const double distance = glm::length(toObject);
-  const double viewLength = glm::length(viewer.viewDirection);
-  if (!(distance > bounds.radius) || !(viewLength > 0.0)) return 1.0;  // viewer inside it
+  if (!(distance > bounds.radius) || !(directionLength_ > 0.0)) return 1.0;  // viewer inside it
   const double cosAngle =
-      std::clamp(glm::dot(toObject, viewer.viewDirection) / (distance * viewLength), -1.0, 1.0);
+      std::clamp(glm::dot(toObject, direction_) / (distance * directionLength_), -1.0, 1.0);
   const double angle = std::acos(cosAngle);
-  const double halfDiagonal = std::atan(
-      std::hypot(std::tan(0.5 * viewer.horizontalFov), std::tan(0.5 * viewer.verticalFov)));
   const double angularRadius = std::asin(std::min(1.0, bounds.radius / distance));
-  return angle - angularRadius <= halfDiagonal ? 1.0 : kOffScreenWeight;
+  return angle - angularRadius <= halfDiagonal_ ? 1.0 : kOffScreenWeight;
 }
 
-double keepPriority(const ViewerState& viewer, const Sphere& bounds, double diameter,
-                    double distance) {
+double ViewCone::keepPriority(const Sphere& bounds, double diameter, double distance) const {
   const double size = diameter / distance;
   const double withinClass = size / (1.0 + size);  // monotone, in [0, 1)
-  return onScreenWeight(viewer, bounds) == 1.0 ? 1.0 + withinClass : withinClass;
+  return onScreenWeight(bounds) == 1.0 ? 1.0 + withinClass : withinClass;
 }
 
 }  // namespace thinlod::backbone

@@ -21,17 +21,27 @@ bool withinBudget(const std::vector<LeafSelection>& selections, const JointBudge
 // What an object outside the current view cone counts for against one inside
 // it: it only shows after a turn within the planned lifetime.
 inline constexpr double kOffScreenWeight = 0.02;
-// 1 when `bounds` meets the current view cone (the diagonal half field of
-// view) or holds the viewer, else kOffScreenWeight.
-double onScreenWeight(const ViewerState& viewer, const Sphere& bounds);
-// The order in which every method drops objects when even its cheapest plan
-// overshoots a hard cap (lowest first): every object in the current view cone
-// ranks above every object outside it (those only a turn would show, and the
-// next step replans after a turn), and within each class the one that looks
-// larger from the predicted region (diameter / distance) ranks higher: in
-// [1, 2) in view, [0, 1) outside. Ties: the caller's order.
-double keepPriority(const ViewerState& viewer, const Sphere& bounds, double diameter,
-                    double distance);
+// The current view cone (the diagonal half field of view), its constants
+// computed once per step.
+class ViewCone {
+ public:
+  explicit ViewCone(const ViewerState& viewer);
+  // 1 when `bounds` meets the cone or holds the viewer, else kOffScreenWeight.
+  double onScreenWeight(const Sphere& bounds) const;
+  // The order in which every method drops objects when even its cheapest
+  // plan overshoots a hard cap (lowest first): every object in the cone ranks
+  // above every object outside it (those only a turn would show, and the
+  // next step replans after a turn), and within each class the one that
+  // looks larger from the predicted region (diameter / distance) ranks
+  // higher: in [1, 2) in view, [0, 1) outside. Ties: the caller's order.
+  double keepPriority(const Sphere& bounds, double diameter, double distance) const;
+
+ private:
+  glm::dvec3 position_;
+  glm::dvec3 direction_;
+  double directionLength_ = 0.0;
+  double halfDiagonal_ = 0.0;
+};
 
 // Hysteresis: where a valid frontend (or in-flight) copy meets the need but
 // a different representation was picked, keep the copy when it costs at most

@@ -95,6 +95,7 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
   }
   const ScreenProjection screen{config_.viewportWidth, config_.viewportHeight,
                                 step.viewer.verticalFov};
+  const ViewCone cone(step.viewer);
 
   std::vector<Item> items;
   for (const std::uint32_t k : visibleLeaves(tree, ChildOrder::kLastChildFirst)) {
@@ -123,7 +124,7 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
     const ObjectFrameLoad load{item.maxTriangles, pixels};
     const double fill = pixels * costs.pixelSeconds;
     item.fixed = costs.setupSeconds + (costs.additive ? fill : 0.0);
-    item.visibility = keepPriority(step.viewer, bounds, n.diameter, n.distance);
+    item.visibility = cone.keepPriority(bounds, n.diameter, n.distance);
     const double importance =
         object < config_.objectImportance.size() ? config_.objectImportance[object] : 1.0;
     if (item.maxTriangles > 0.0) {
