@@ -178,7 +178,7 @@ Result<RegionMesh> RegionMesh::buildClean(IndexedMesh clean, std::vector<std::ui
   }
 
   // Kept vertices: per pair of corners in different regions, the higher
-  // region's corner (or both without border collapses).
+  // region's corner (both, or none, under the other rules).
   const std::size_t triangleCount = clean.indices.size() / 3;
   std::vector<std::uint8_t> kept(vertexCount, 0);
   for (std::size_t t = 0; t < triangleCount; ++t) {
@@ -186,10 +186,15 @@ Result<RegionMesh> RegionMesh::buildClean(IndexedMesh clean, std::vector<std::ui
       const std::uint32_t a = clean.indices[3 * t + k];
       const std::uint32_t b = clean.indices[3 * t + (k + 1) % 3];
       if (labels[a] == labels[b]) continue;
-      if (!options.borderCollapses) {
-        kept[a] = kept[b] = 1;
-      } else {
-        kept[labels[a] > labels[b] ? a : b] = 1;
+      switch (options.borderRule) {
+        case BorderRule::kLowerIdSide:
+          kept[labels[a] > labels[b] ? a : b] = 1;
+          break;
+        case BorderRule::kBothSidesKept:
+          kept[a] = kept[b] = 1;
+          break;
+        case BorderRule::kPaperUnchecked:
+          break;
       }
     }
   }

@@ -10,15 +10,18 @@
 //   corners; when its three corners lie in three regions, to the lowest
 //   region id (triangleRegion). Collapses keep a vertex in its region, so the
 //   owner of a triangle is the same at every level.
-// - Border rule (borderCollapses = true): for two neighbouring regions the
-//   lower id owns the border. A vertex is kept (never removed) when it has a
-//   neighbour in a region with a lower id; every other vertex may collapse,
-//   onto any neighbour of its own region, including along the border. With
-//   borderCollapses = false every vertex with a neighbour in another region
-//   is kept (both sides of each border at full resolution).
+// - Border rule (BorderRule::kLowerIdSide, the default): for two
+//   neighbouring regions the lower id owns the border. A vertex is kept
+//   (never removed) when it has a neighbour in a region with a lower id;
+//   every other vertex may collapse, onto any neighbour of its own region,
+//   including along the border. kBothSidesKept keeps every vertex with a
+//   neighbour in another region (both sides of each border at full
+//   resolution). kPaperUnchecked keeps none (the paper's rule: both sides
+//   collapse along the border); it cannot crack (see docs/regions.md) but
+//   is not guaranteed manifold, and exists for the comparison only.
 // - Each region's progressive mesh is built on every input triangle that
 //   touches the region; the other regions' vertices in it are pinned (never
-//   removed, never a target). Under the border rule no triangle and no
+//   removed, never a target). Under the first two rules no triangle and no
 //   neighbour set read by one region's collapse is changed by another
 //   region's collapses, so every combination of levels is the result of a
 //   valid sequence of collapses of the whole mesh: no cracks, no
@@ -66,12 +69,14 @@ std::uint32_t triangleRegion(std::uint32_t a, std::uint32_t b, std::uint32_t c);
 Result<std::vector<std::uint32_t>> partitionVertices(const std::vector<glm::vec3>& positions,
                                                      std::size_t regionCount);
 
+enum class BorderRule : std::uint8_t { kLowerIdSide, kBothSidesKept, kPaperUnchecked };
+
 struct RegionBuildOptions {
   // Per-region simplification (vertexConstraints and stopAtTriangles must
   // stay empty / 0: the builder sets the constraints, and every region
   // simplifies as far as its rules allow).
   BuildOptions mesh{};
-  bool borderCollapses = true;  // the lower id's side of a border may collapse
+  BorderRule borderRule = BorderRule::kLowerIdSide;
 };
 
 // What one assemble() call did (for benchmarks and tests).
