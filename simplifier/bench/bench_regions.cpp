@@ -23,7 +23,6 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -111,17 +110,41 @@ std::size_t trianglesForError(const IndexedMesh& original, const ProgressiveMesh
   return pm.triangleCountAt(hi);
 }
 
+// Every directed edge once and its reverse present: each edge on exactly two
+// consistently oriented triangles.
 bool closedManifold(const IndexedMesh& mesh) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  std::vector<std::uint64_t> directed;
+  directed.reserve(mesh.indices.size());
   for (std::size_t i = 0; i < mesh.indices.size(); i += 3) {
-    for (int k = 0; k < 3; ++k) {
-      if (++directed[{mesh.indices[i + k], mesh.indices[i + (k + 1) % 3]}] > 1) return false;
+    for (std::size_t k = 0; k < 3; ++k) {
+      directed.push_back(std::uint64_t{mesh.indices[i + k]} << 32 | mesh.indices[i + (k + 1) % 3]);
     }
   }
-  for (const auto& [edge, n] : directed) {
-    if (directed.find({edge.second, edge.first}) == directed.end()) return false;
+  std::sort(directed.begin(), directed.end());
+  if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return false;
+  for (std::uint64_t e : directed) {
+    const std::uint64_t reverse = (e << 32) | (e >> 32);
+    if (!std::binary_search(directed.begin(), directed.end(), reverse)) return false;
   }
   return true;
+}
+
+// Smallest owned target of region r whose progressive-mesh collapse cost
+// stays <= cost (quadricErrorAt is monotone in the target).
+std::size_t regionTargetForCost(const RegionMesh& regions, std::size_t r, double cost) {
+  const ProgressiveMesh& pm = regions.progressiveMesh(r);
+  const std::size_t foreign = pm.maxTriangles() - regions.maxTriangles(r);
+  std::size_t lo = regions.minTriangles(r), hi = regions.maxTriangles(r);
+  if (pm.quadricErrorAt(lo + foreign) <= cost) return lo;
+  while (hi - lo > 1) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (pm.quadricErrorAt(mid + foreign) <= cost) {
+      hi = mid;
+    } else {
+      lo = mid;
+    }
+  }
+  return hi;
 }
 
 }  // namespace
@@ -182,122 +205,131 @@ int main(int argc, char** argv) {
 
     std::cerr << model.name << ": equal error\n";
     std::printf(
-        "Every region at the same fraction of its triangles vs the whole mesh at the same "
-        "error (Hausdorff max / bbox diagonal, %zu samples per side):\n\n",
+        "Regions at the levels of one collapse-cost threshold (the whole mesh's cost at a "
+        "fraction of its triangles; each region takes its smallest level within that cost) "
+        "and, naively, every region at the same fraction of its triangles; against the fewest "
+        "whole-mesh triangles with the same error (Hausdorff max / bbox diagonal, %zu samples "
+        "per side):\n\n",
         samples);
     std::printf(
-        "| fraction | region triangles | region error | whole-mesh triangles at that error | "
-        "whole-mesh error at the region triangles |\n|---|---|---|---|---|\n");
-    for (double fraction : {0.5, 0.2, 0.1, 0.05, 0.02}) {
-      std::vector<std::size_t> levels;
-      for (std::size_t r = 0; r < regions->regionCount(); ++r) {
-        levels.push_back(
-            static_cast<std::size_t>(std::lround(fraction * regions->maxTriangles(r))));
-      }
-      Result<IndexedMesh> assembled = regions->assemble(levels);
-      if (!assembled.ok()) return 1;
-      const double regionError = relativeError(original, *assembled, samples);
-      const std::size_t equal = trianglesForError(original, *whole, regionError, samples);
-      const double wholeError =
-          relativeError(original, whole->extract(assembled->triangleCount()), samples);
-      std::printf("| %.2f | %zu | %.5f | %zu | %.5f |\n", fraction, assembled->triangleCount(),
-                  regionError, equal, wholeError);
-    }
-
-    std::cerr << model.name << ": frames\n";
-    std::mt19937 rng(42);
-    std::vector<std::vector<std::size_t>> frameLevels;
-    for (int f = 0; f < frames; ++f) {
-      std::vector<std::size_t> levels;
-      for (std::size_t r = 0; r < regions->regionCount(); ++r) {
-        levels.push_back(std::uniform_int_distribution<std::size_t>(regions->minTriangles(r),
-                                                                    regions->maxTriangles(r))(rng));
-      }
-      frameLevels.push_back(std::move(levels));
-    }
-    IndexedMesh out, scratch;
-    AssembleStats stats;
-    std::size_t triangles = 0;
-    t0 = threadSeconds();
-    for (const auto& levels : frameLevels) {
-      if (!regions->assembleInto(levels, out, &stats).ok()) return 1;
-      triangles += out.triangleCount();
-    }
-    const double assembleSeconds = threadSeconds() - t0;
-    t0 = threadSeconds();
-    std::size_t bareTriangles = 0;
-    for (const auto& levels : frameLevels) {
-      for (std::size_t r = 0; r < regions->regionCount(); ++r) {
-        // The region meshes' own targets (owned + the foreign-owned triangles
-        // they also hold), as assembleInto extracts them.
-        const std::size_t target =
-            levels[r] >= regions->maxTriangles(r)
-                ? regions->progressiveMesh(r).maxTriangles()
-                : levels[r] + regions->progressiveMesh(r).maxTriangles() - regions->maxTriangles(r);
-        regions->progressiveMesh(r).extractInto(target, scratch);
-        bareTriangles += scratch.triangleCount();
-      }
-    }
-    const double bareSeconds = threadSeconds() - t0;
-    t0 = threadSeconds();
-    for (const auto& levels : frameLevels) {
-      std::size_t total = 0;
-      for (std::size_t r = 0; r < levels.size(); ++r)
-        total += regions->triangleCountAt(r, levels[r]);
-      whole->extractInto(total, scratch);
-    }
-    const double wholeExtractSeconds = threadSeconds() - t0;
-    const double perFrame = 1e6 / frames;
-    std::printf(
-        "\nPer frame (%d frames, random per-region levels, seed 42; mean %.0f triangles, %.0f "
-        "foreign lookups of which %.0f moved):\n\n",
-        frames, static_cast<double>(triangles) / frames,
-        static_cast<double>(stats.foreignLookups) / frames,
-        static_cast<double>(stats.lookupsThatMoved) / frames);
-    std::printf("| per frame | CPU us |\n|---|---|\n");
-    std::printf("| whole-mesh extractInto, same triangles (baseline) | %.1f |\n",
-                wholeExtractSeconds * perFrame);
-    std::printf("| region extractInto only (no filter, no lookup) | %.1f |\n",
-                bareSeconds * perFrame);
-    std::printf("| assembleInto (crack-free: filter + lookup + compaction) | %.1f |\n",
-                assembleSeconds * perFrame);
-    std::printf("| crack-free overhead over bare extraction | %.1f |\n\n",
-                (assembleSeconds - bareSeconds) * perFrame);
-    (void)bareTriangles;
-
-    std::cerr << model.name << ": border rules\n";
-    std::printf(
-        "| border rule | coarsest triangles | kept vertices | frames not a closed manifold |\n");
-    std::printf("|---|---|---|---|\n");
-    for (auto [rule, name] :
-         {std::pair{BorderRule::kLowerIdSide, "lower-id side collapses"},
-          std::pair{BorderRule::kBothSidesKept, "both sides kept"},
-          std::pair{BorderRule::kPaperUnchecked, "paper (both sides, unchecked)"}}) {
-      Result<RegionMesh> r = buildRegions(model, rule);
-      if (!r.ok()) return 1;
-      std::size_t k = 0;
-      std::vector<std::size_t> coarsest(r->regionCount(), 0);
-      for (std::size_t i = 0; i < r->regionCount(); ++i) k += r->keptVertices(i);
-      Result<IndexedMesh> c = r->assemble(coarsest);
-      if (!c.ok()) return 1;
-      const bool openInput = !closedManifold(r->mesh());
-      int bad = 0;
-      std::mt19937 frameRng(42);
-      for (int f = 0; f < frames; ++f) {
+        "| allocation | fraction | region triangles | region error | whole-mesh triangles at "
+        "that error | whole-mesh error at the region triangles |\n|---|---|---|---|---|---|\n");
+    for (int byCost = 1; byCost >= 0; --byCost) {
+      for (double fraction : {0.5, 0.2, 0.1, 0.05, 0.02}) {
         std::vector<std::size_t> levels;
-        for (std::size_t i = 0; i < r->regionCount(); ++i) {
-          levels.push_back(std::uniform_int_distribution<std::size_t>(
-              r->minTriangles(i), r->maxTriangles(i))(frameRng));
+        const double cost = whole->quadricErrorAt(
+            static_cast<std::size_t>(std::lround(fraction * whole->maxTriangles())));
+        for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+          levels.push_back(
+              byCost ? regionTargetForCost(*regions, r, cost)
+                     : static_cast<std::size_t>(std::lround(fraction * regions->maxTriangles(r))));
         }
-        Result<IndexedMesh> m = r->assemble(levels);
-        if (!m.ok()) return 1;
-        bad += closedManifold(*m) ? 0 : 1;
+        Result<IndexedMesh> assembled = regions->assemble(levels);
+        if (!assembled.ok()) return 1;
+        const double regionError = relativeError(original, *assembled, samples);
+        const std::size_t equal = trianglesForError(original, *whole, regionError, samples);
+        const double wholeError =
+            relativeError(original, whole->extract(assembled->triangleCount()), samples);
+        std::printf("| %s | %.2f | %zu | %.5f | %zu | %.5f |\n",
+                    byCost ? "equal collapse cost" : "equal fraction", fraction,
+                    assembled->triangleCount(), regionError, equal, wholeError);
       }
-      std::printf("| %s | %zu | %zu | %s |\n", name, c->triangleCount(), k,
-                  openInput ? "n/a (open input)"
-                            : (std::to_string(bad) + " / " + std::to_string(frames)).c_str());
     }
-    std::printf("\n");
   }
-  return 0;
+
+  std::cerr << model.name << ": frames\n";
+  std::mt19937 rng(42);
+  std::vector<std::vector<std::size_t>> frameLevels;
+  for (int f = 0; f < frames; ++f) {
+    std::vector<std::size_t> levels;
+    for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+      levels.push_back(std::uniform_int_distribution<std::size_t>(regions->minTriangles(r),
+                                                                  regions->maxTriangles(r))(rng));
+    }
+    frameLevels.push_back(std::move(levels));
+  }
+  IndexedMesh out, scratch;
+  AssembleStats stats;
+  std::size_t triangles = 0;
+  t0 = threadSeconds();
+  for (const auto& levels : frameLevels) {
+    if (!regions->assembleInto(levels, out, &stats).ok()) return 1;
+    triangles += out.triangleCount();
+  }
+  const double assembleSeconds = threadSeconds() - t0;
+  t0 = threadSeconds();
+  std::size_t bareTriangles = 0;
+  for (const auto& levels : frameLevels) {
+    for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+      // The region meshes' own targets (owned + the foreign-owned triangles
+      // they also hold), as assembleInto extracts them.
+      const std::size_t target =
+          levels[r] >= regions->maxTriangles(r)
+              ? regions->progressiveMesh(r).maxTriangles()
+              : levels[r] + regions->progressiveMesh(r).maxTriangles() - regions->maxTriangles(r);
+      regions->progressiveMesh(r).extractInto(target, scratch);
+      bareTriangles += scratch.triangleCount();
+    }
+  }
+  const double bareSeconds = threadSeconds() - t0;
+  t0 = threadSeconds();
+  for (const auto& levels : frameLevels) {
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < levels.size(); ++r) total += regions->triangleCountAt(r, levels[r]);
+    whole->extractInto(total, scratch);
+  }
+  const double wholeExtractSeconds = threadSeconds() - t0;
+  const double perFrame = 1e6 / frames;
+  std::printf(
+      "\nPer frame (%d frames, random per-region levels, seed 42; mean %.0f triangles, %.0f "
+      "foreign lookups of which %.0f moved):\n\n",
+      frames, static_cast<double>(triangles) / frames,
+      static_cast<double>(stats.foreignLookups) / frames,
+      static_cast<double>(stats.lookupsThatMoved) / frames);
+  std::printf("| per frame | CPU us |\n|---|---|\n");
+  std::printf("| whole-mesh extractInto, same triangles (baseline) | %.1f |\n",
+              wholeExtractSeconds * perFrame);
+  std::printf("| region extractInto only (no filter, no lookup) | %.1f |\n",
+              bareSeconds * perFrame);
+  std::printf("| assembleInto (crack-free: filter + lookup + compaction) | %.1f |\n",
+              assembleSeconds * perFrame);
+  std::printf("| crack-free overhead over bare extraction | %.1f |\n\n",
+              (assembleSeconds - bareSeconds) * perFrame);
+  (void)bareTriangles;
+
+  std::cerr << model.name << ": border rules\n";
+  std::printf(
+      "| border rule | coarsest triangles | kept vertices | frames not a closed manifold |\n");
+  std::printf("|---|---|---|---|\n");
+  for (auto [rule, name] :
+       {std::pair{BorderRule::kLowerIdSide, "lower-id side collapses"},
+        std::pair{BorderRule::kBothSidesKept, "both sides kept"},
+        std::pair{BorderRule::kPaperUnchecked, "paper (both sides, unchecked)"}}) {
+    Result<RegionMesh> r = buildRegions(model, rule);
+    if (!r.ok()) return 1;
+    std::size_t k = 0;
+    std::vector<std::size_t> coarsest(r->regionCount(), 0);
+    for (std::size_t i = 0; i < r->regionCount(); ++i) k += r->keptVertices(i);
+    Result<IndexedMesh> c = r->assemble(coarsest);
+    if (!c.ok()) return 1;
+    const bool openInput = !closedManifold(r->mesh());
+    int bad = 0;
+    std::mt19937 frameRng(42);
+    for (int f = 0; f < frames && !openInput; ++f) {
+      std::vector<std::size_t> levels;
+      for (std::size_t i = 0; i < r->regionCount(); ++i) {
+        levels.push_back(std::uniform_int_distribution<std::size_t>(r->minTriangles(i),
+                                                                    r->maxTriangles(i))(frameRng));
+      }
+      Result<IndexedMesh> m = r->assemble(levels);
+      if (!m.ok()) return 1;
+      bad += closedManifold(*m) ? 0 : 1;
+    }
+    std::printf("| %s | %zu | %zu | %s |\n", name, c->triangleCount(), k,
+                openInput ? "n/a (open input)"
+                          : (std::to_string(bad) + " / " + std::to_string(frames)).c_str());
+  }
+  std::printf("\n");
+}
+return 0;
 }

@@ -257,9 +257,13 @@ Result<RegionMesh> RegionMesh::buildClean(IndexedMesh clean, std::vector<std::ui
                                               ": the progressive mesh changed the cleaned input");
     }
     region.vertexOfTom.resize(globalOf.size());
+    region.regionOfTom.resize(globalOf.size());
+    region.ownRank.assign(globalOf.size() + 1, 0);
     for (std::uint32_t tom = 0; tom < globalOf.size(); ++tom) {
       const std::uint32_t g = globalOf[region.pm.sourceVertexOf(tom)];
       region.vertexOfTom[tom] = g;
+      region.regionOfTom[tom] = labels[g];
+      region.ownRank[tom + 1] = region.ownRank[tom] + (labels[g] == r ? 1 : 0);
       if (labels[g] == r) out.tomOfVertex_[g] = tom;
     }
     for (std::uint32_t g : globalOf) localOf[g] = kUnmapped;
@@ -302,46 +306,6 @@ std::uint32_t RegionMesh::lookupForeign(std::uint32_t vertex, std::size_t target
   return rep == ProgressiveMesh::kNoRepresentative ? vertex : region.vertexOfTom[rep];
 }
 
-void RegionMesh::emitRegion(std::size_t r, std::size_t targetTriangles,
-                            const std::vector<std::size_t>& liveVertices, IndexedMesh& scratch,
-                            std::vector<std::uint32_t>& indices, AssembleStats* stats) const {
-  const Region& region = regions_[r];
-  region.pm.extractInto(pmTarget(r, targetTriangles), scratch);
-  const std::uint32_t self = static_cast<std::uint32_t>(r);
-  std::size_t lookups = 0, moved = 0, dropped = 0;
-  for (std::size_t i = 0; i < scratch.indices.size(); i += 3) {
-    std::uint32_t g[3];
-    std::uint32_t owner[3];
-    for (int k = 0; k < 3; ++k) {
-      g[k] = region.vertexOfTom[scratch.indices[i + k]];
-      owner[k] = regionOfVertex_[g[k]];
-    }
-    if (triangleRegion(owner[0], owner[1], owner[2]) != self) {
-      ++dropped;
-      continue;
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (owner[k] != self && !liveVertices.empty()) {
-        const Region& other = regions_[owner[k]];
-        const std::uint32_t rep =
-            other.pm.representative(tomOfVertex_[g[k]], liveVertices[owner[k]]);
-        assert(rep != ProgressiveMesh::kNoRepresentative);
-        const std::uint32_t mapped =
-            rep == ProgressiveMesh::kNoRepresentative ? g[k] : other.vertexOfTom[rep];
-        ++lookups;
-        moved += mapped != g[k] ? 1 : 0;
-        g[k] = mapped;
-      }
-      indices.push_back(g[k]);
-    }
-  }
-  if (stats) {
-    stats->foreignLookups += lookups;
-    stats->lookupsThatMoved += moved;
-    stats->droppedForeignOwned += dropped;
-  }
-}
-
 void RegionMesh::compactInto(const std::vector<std::uint32_t>& indices, IndexedMesh& out) const {
   std::vector<std::uint32_t> outIndex(mesh_.positions.size(), kUnmapped);
   out.positions.clear();
@@ -376,23 +340,94 @@ Status RegionMesh::assembleInto(const std::vector<std::size_t>& targets, Indexed
                                                    " levels for " +
                                                    std::to_string(regions_.size()) + " regions");
   }
-  std::vector<std::size_t> live(regions_.size());
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    live[r] = regions_[r].pm.vertexCountAt(pmTarget(r, targets[r]));
+  // Output vertices: region by region, the own vertices of each live prefix
+  // in TOM order, so a vertex's output index is offset[s] + ownRank[tom]
+  // without a vertex-sized remap table.
+  const std::size_t regionCount = regions_.size();
+  std::vector<std::size_t> pmTargets(regionCount), live(regionCount);
+  std::vector<std::uint32_t> offset(regionCount + 1, 0);
+  for (std::size_t r = 0; r < regionCount; ++r) {
+    pmTargets[r] = pmTarget(r, targets[r]);
+    live[r] = regions_[r].pm.vertexCountAt(pmTargets[r]);
+    offset[r + 1] = offset[r] + regions_[r].ownRank[live[r]];
   }
+  out.positions.clear();
+  out.normals.clear();
+  out.uvs.clear();
+  out.colors.clear();
+  out.positions.reserve(offset[regionCount]);
+  for (std::size_t r = 0; r < regionCount; ++r) {
+    const Region& region = regions_[r];
+    for (std::size_t tom = 0; tom < live[r]; ++tom) {
+      if (region.regionOfTom[tom] != r) continue;
+      const std::uint32_t g = region.vertexOfTom[tom];
+      out.positions.push_back(mesh_.positions[g]);
+      if (!mesh_.normals.empty()) out.normals.push_back(mesh_.normals[g]);
+      if (!mesh_.uvs.empty()) out.uvs.push_back(mesh_.uvs[g]);
+      if (!mesh_.colors.empty()) out.colors.push_back(mesh_.colors[g]);
+    }
+  }
+  out.indices.clear();
   IndexedMesh scratch;
-  std::vector<std::uint32_t> indices;
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    emitRegion(r, targets[r], live, scratch, indices, stats);
+  std::size_t lookups = 0, moved = 0, dropped = 0;
+  for (std::size_t r = 0; r < regionCount; ++r) {
+    const Region& region = regions_[r];
+    region.pm.extractInto(pmTargets[r], scratch);
+    const std::uint32_t self = static_cast<std::uint32_t>(r);
+    const std::uint32_t* corner = scratch.indices.data();
+    for (std::size_t i = 0; i < scratch.indices.size(); i += 3) {
+      const std::uint32_t ra = region.regionOfTom[corner[i]];
+      const std::uint32_t rb = region.regionOfTom[corner[i + 1]];
+      const std::uint32_t rc = region.regionOfTom[corner[i + 2]];
+      if (triangleRegion(ra, rb, rc) != self) {
+        ++dropped;
+        continue;
+      }
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t tom = corner[i + k];
+        const std::uint32_t s = region.regionOfTom[tom];
+        if (s == self) {
+          out.indices.push_back(offset[r] + region.ownRank[tom]);
+          continue;
+        }
+        // The crack-free lookup: the foreign corner's representative in
+        // its own region's current level.
+        const Region& other = regions_[s];
+        const std::uint32_t own = tomOfVertex_[region.vertexOfTom[tom]];
+        const std::uint32_t rep = other.pm.representative(own, live[s]);
+        assert(rep != ProgressiveMesh::kNoRepresentative);
+        const std::uint32_t mapped = rep == ProgressiveMesh::kNoRepresentative ? own : rep;
+        ++lookups;
+        moved += mapped != own ? 1 : 0;
+        out.indices.push_back(offset[s] + other.ownRank[mapped]);
+      }
+    }
   }
-  compactInto(indices, out);
+  if (stats) {
+    stats->foreignLookups += lookups;
+    stats->lookupsThatMoved += moved;
+    stats->droppedForeignOwned += dropped;
+  }
   return Status::okStatus();
 }
 
 IndexedMesh RegionMesh::extractRegion(std::size_t r, std::size_t targetTriangles) const {
+  // One region with its foreign corners at full resolution: the pinned
+  // foreign vertices are live in its own mesh, so no lookup is needed.
   IndexedMesh scratch, out;
+  const Region& region = regions_[r];
+  region.pm.extractInto(pmTarget(r, targetTriangles), scratch);
   std::vector<std::uint32_t> indices;
-  emitRegion(r, targetTriangles, {}, scratch, indices, nullptr);
+  indices.reserve(scratch.indices.size());
+  const std::uint32_t self = static_cast<std::uint32_t>(r);
+  for (std::size_t i = 0; i < scratch.indices.size(); i += 3) {
+    const std::uint32_t* c = &scratch.indices[i];
+    if (triangleRegion(region.regionOfTom[c[0]], region.regionOfTom[c[1]],
+                       region.regionOfTom[c[2]]) != self) {
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) indices.push_back(region.vertexOfTom[c[k]]);
+  }
   compactInto(indices, out);
   return out;
 }
@@ -405,7 +440,9 @@ std::size_t RegionMesh::memoryBytes() const {
                       mesh_.uvs.capacity() * sizeof(glm::vec2) + mesh_.colors.capacity() * 4 +
                       mesh_.indices.capacity() * sizeof(std::uint32_t);
   for (const Region& region : regions_) {
-    bytes += region.pm.memoryBytes() + region.vertexOfTom.capacity() * sizeof(std::uint32_t);
+    bytes += region.pm.memoryBytes() + (region.vertexOfTom.capacity() +
+                                        region.regionOfTom.capacity() + region.ownRank.capacity()) *
+                                           sizeof(std::uint32_t);
   }
   return bytes;
 }

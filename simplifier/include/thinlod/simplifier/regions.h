@@ -114,8 +114,9 @@ class RegionMesh {
   // region is at `targetTriangles`: the crack-free lookup of a foreign corner.
   std::uint32_t lookupForeign(std::uint32_t vertex, std::size_t targetTriangles) const;
 
-  // Every region at its level (targets.size() == regionCount()): one mesh,
-  // vertices compacted in first-use order, attributes of the cleaned mesh.
+  // Every region at its level (targets.size() == regionCount()): one mesh;
+  // vertices region by region, each region's live vertices in its
+  // progressive mesh's order (coarse first); attributes of the cleaned mesh.
   Result<IndexedMesh> assemble(const std::vector<std::size_t>& targets,
                                AssembleStats* stats = nullptr) const;
   Status assembleInto(const std::vector<std::size_t>& targets, IndexedMesh& out,
@@ -133,15 +134,14 @@ class RegionMesh {
     std::size_t foreignOwned = 0;  // triangles in pm owned by other regions (never removed)
     std::size_t keptVertices = 0;
     std::vector<std::uint32_t> vertexOfTom;  // pm's TOM vertex -> cleaned vertex
+    std::vector<std::uint32_t> regionOfTom;  // pm's TOM vertex -> its region
+    // Own vertices before each TOM index (size vertexCount + 1): an own live
+    // vertex's place among the region's output vertices.
+    std::vector<std::uint32_t> ownRank;
   };
   static Result<RegionMesh> buildClean(IndexedMesh clean, std::vector<std::uint32_t> labels,
                                        std::size_t regionCount, const RegionBuildOptions& options);
   std::size_t pmTarget(std::size_t r, std::size_t targetTriangles) const;
-  // Appends region r's owned triangles (cleaned numbering) with foreign
-  // corners mapped through `liveVertices` (per region; empty: full resolution).
-  void emitRegion(std::size_t r, std::size_t targetTriangles,
-                  const std::vector<std::size_t>& liveVertices, IndexedMesh& scratch,
-                  std::vector<std::uint32_t>& indices, AssembleStats* stats) const;
   void compactInto(const std::vector<std::uint32_t>& indices, IndexedMesh& out) const;
 
   IndexedMesh mesh_;
