@@ -235,101 +235,101 @@ int main(int argc, char** argv) {
                     assembled->triangleCount(), regionError, equal, wholeError);
       }
     }
-  }
 
-  std::cerr << model.name << ": frames\n";
-  std::mt19937 rng(42);
-  std::vector<std::vector<std::size_t>> frameLevels;
-  for (int f = 0; f < frames; ++f) {
-    std::vector<std::size_t> levels;
-    for (std::size_t r = 0; r < regions->regionCount(); ++r) {
-      levels.push_back(std::uniform_int_distribution<std::size_t>(regions->minTriangles(r),
-                                                                  regions->maxTriangles(r))(rng));
-    }
-    frameLevels.push_back(std::move(levels));
-  }
-  IndexedMesh out, scratch;
-  AssembleStats stats;
-  std::size_t triangles = 0;
-  t0 = threadSeconds();
-  for (const auto& levels : frameLevels) {
-    if (!regions->assembleInto(levels, out, &stats).ok()) return 1;
-    triangles += out.triangleCount();
-  }
-  const double assembleSeconds = threadSeconds() - t0;
-  t0 = threadSeconds();
-  std::size_t bareTriangles = 0;
-  for (const auto& levels : frameLevels) {
-    for (std::size_t r = 0; r < regions->regionCount(); ++r) {
-      // The region meshes' own targets (owned + the foreign-owned triangles
-      // they also hold), as assembleInto extracts them.
-      const std::size_t target =
-          levels[r] >= regions->maxTriangles(r)
-              ? regions->progressiveMesh(r).maxTriangles()
-              : levels[r] + regions->progressiveMesh(r).maxTriangles() - regions->maxTriangles(r);
-      regions->progressiveMesh(r).extractInto(target, scratch);
-      bareTriangles += scratch.triangleCount();
-    }
-  }
-  const double bareSeconds = threadSeconds() - t0;
-  t0 = threadSeconds();
-  for (const auto& levels : frameLevels) {
-    std::size_t total = 0;
-    for (std::size_t r = 0; r < levels.size(); ++r) total += regions->triangleCountAt(r, levels[r]);
-    whole->extractInto(total, scratch);
-  }
-  const double wholeExtractSeconds = threadSeconds() - t0;
-  const double perFrame = 1e6 / frames;
-  std::printf(
-      "\nPer frame (%d frames, random per-region levels, seed 42; mean %.0f triangles, %.0f "
-      "foreign lookups of which %.0f moved):\n\n",
-      frames, static_cast<double>(triangles) / frames,
-      static_cast<double>(stats.foreignLookups) / frames,
-      static_cast<double>(stats.lookupsThatMoved) / frames);
-  std::printf("| per frame | CPU us |\n|---|---|\n");
-  std::printf("| whole-mesh extractInto, same triangles (baseline) | %.1f |\n",
-              wholeExtractSeconds * perFrame);
-  std::printf("| region extractInto only (no filter, no lookup) | %.1f |\n",
-              bareSeconds * perFrame);
-  std::printf("| assembleInto (crack-free: filter + lookup + compaction) | %.1f |\n",
-              assembleSeconds * perFrame);
-  std::printf("| crack-free overhead over bare extraction | %.1f |\n\n",
-              (assembleSeconds - bareSeconds) * perFrame);
-  (void)bareTriangles;
-
-  std::cerr << model.name << ": border rules\n";
-  std::printf(
-      "| border rule | coarsest triangles | kept vertices | frames not a closed manifold |\n");
-  std::printf("|---|---|---|---|\n");
-  for (auto [rule, name] :
-       {std::pair{BorderRule::kLowerIdSide, "lower-id side collapses"},
-        std::pair{BorderRule::kBothSidesKept, "both sides kept"},
-        std::pair{BorderRule::kPaperUnchecked, "paper (both sides, unchecked)"}}) {
-    Result<RegionMesh> r = buildRegions(model, rule);
-    if (!r.ok()) return 1;
-    std::size_t k = 0;
-    std::vector<std::size_t> coarsest(r->regionCount(), 0);
-    for (std::size_t i = 0; i < r->regionCount(); ++i) k += r->keptVertices(i);
-    Result<IndexedMesh> c = r->assemble(coarsest);
-    if (!c.ok()) return 1;
-    const bool openInput = !closedManifold(r->mesh());
-    int bad = 0;
-    std::mt19937 frameRng(42);
-    for (int f = 0; f < frames && !openInput; ++f) {
+    std::cerr << model.name << ": frames\n";
+    std::mt19937 rng(42);
+    std::vector<std::vector<std::size_t>> frameLevels;
+    for (int f = 0; f < frames; ++f) {
       std::vector<std::size_t> levels;
-      for (std::size_t i = 0; i < r->regionCount(); ++i) {
-        levels.push_back(std::uniform_int_distribution<std::size_t>(r->minTriangles(i),
-                                                                    r->maxTriangles(i))(frameRng));
+      for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+        levels.push_back(std::uniform_int_distribution<std::size_t>(regions->minTriangles(r),
+                                                                    regions->maxTriangles(r))(rng));
       }
-      Result<IndexedMesh> m = r->assemble(levels);
-      if (!m.ok()) return 1;
-      bad += closedManifold(*m) ? 0 : 1;
+      frameLevels.push_back(std::move(levels));
     }
-    std::printf("| %s | %zu | %zu | %s |\n", name, c->triangleCount(), k,
-                openInput ? "n/a (open input)"
-                          : (std::to_string(bad) + " / " + std::to_string(frames)).c_str());
+    IndexedMesh out, scratch;
+    AssembleStats stats;
+    std::size_t triangles = 0;
+    t0 = threadSeconds();
+    for (const auto& levels : frameLevels) {
+      if (!regions->assembleInto(levels, out, &stats).ok()) return 1;
+      triangles += out.triangleCount();
+    }
+    const double assembleSeconds = threadSeconds() - t0;
+    t0 = threadSeconds();
+    std::size_t bareTriangles = 0;
+    for (const auto& levels : frameLevels) {
+      for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+        // The region meshes' own targets (owned + the foreign-owned triangles
+        // they also hold), as assembleInto extracts them.
+        const std::size_t target =
+            levels[r] >= regions->maxTriangles(r)
+                ? regions->progressiveMesh(r).maxTriangles()
+                : levels[r] + regions->progressiveMesh(r).maxTriangles() - regions->maxTriangles(r);
+        regions->progressiveMesh(r).extractInto(target, scratch);
+        bareTriangles += scratch.triangleCount();
+      }
+    }
+    const double bareSeconds = threadSeconds() - t0;
+    t0 = threadSeconds();
+    for (const auto& levels : frameLevels) {
+      std::size_t total = 0;
+      for (std::size_t r = 0; r < levels.size(); ++r)
+        total += regions->triangleCountAt(r, levels[r]);
+      whole->extractInto(total, scratch);
+    }
+    const double wholeExtractSeconds = threadSeconds() - t0;
+    const double perFrame = 1e6 / frames;
+    std::printf(
+        "\nPer frame (%d frames, random per-region levels, seed 42; mean %.0f triangles, %.0f "
+        "foreign lookups of which %.0f moved):\n\n",
+        frames, static_cast<double>(triangles) / frames,
+        static_cast<double>(stats.foreignLookups) / frames,
+        static_cast<double>(stats.lookupsThatMoved) / frames);
+    std::printf("| per frame | CPU us |\n|---|---|\n");
+    std::printf("| whole-mesh extractInto, same triangles (baseline) | %.1f |\n",
+                wholeExtractSeconds * perFrame);
+    std::printf("| region extractInto only (no filter, no lookup) | %.1f |\n",
+                bareSeconds * perFrame);
+    std::printf("| assembleInto (crack-free: filter + lookup + compaction) | %.1f |\n",
+                assembleSeconds * perFrame);
+    std::printf("| crack-free overhead over bare extraction | %.1f |\n\n",
+                (assembleSeconds - bareSeconds) * perFrame);
+    (void)bareTriangles;
+
+    std::cerr << model.name << ": border rules\n";
+    std::printf(
+        "| border rule | coarsest triangles | kept vertices | frames not a closed manifold |\n");
+    std::printf("|---|---|---|---|\n");
+    for (auto [rule, name] :
+         {std::pair{BorderRule::kLowerIdSide, "lower-id side collapses"},
+          std::pair{BorderRule::kBothSidesKept, "both sides kept"},
+          std::pair{BorderRule::kPaperUnchecked, "paper (both sides, unchecked)"}}) {
+      Result<RegionMesh> r = buildRegions(model, rule);
+      if (!r.ok()) return 1;
+      std::size_t k = 0;
+      std::vector<std::size_t> coarsest(r->regionCount(), 0);
+      for (std::size_t i = 0; i < r->regionCount(); ++i) k += r->keptVertices(i);
+      Result<IndexedMesh> c = r->assemble(coarsest);
+      if (!c.ok()) return 1;
+      const bool openInput = !closedManifold(r->mesh());
+      int bad = 0;
+      std::mt19937 frameRng(42);
+      for (int f = 0; f < frames && !openInput; ++f) {
+        std::vector<std::size_t> levels;
+        for (std::size_t i = 0; i < r->regionCount(); ++i) {
+          levels.push_back(std::uniform_int_distribution<std::size_t>(
+              r->minTriangles(i), r->maxTriangles(i))(frameRng));
+        }
+        Result<IndexedMesh> m = r->assemble(levels);
+        if (!m.ok()) return 1;
+        bad += closedManifold(*m) ? 0 : 1;
+      }
+      std::printf("| %s | %zu | %zu | %s |\n", name, c->triangleCount(), k,
+                  openInput ? "n/a (open input)"
+                            : (std::to_string(bad) + " / " + std::to_string(frames)).c_str());
+    }
+    std::printf("\n");
   }
-  std::printf("\n");
-}
-return 0;
+  return 0;
 }
