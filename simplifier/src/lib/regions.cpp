@@ -257,16 +257,22 @@ Result<RegionMesh> RegionMesh::buildClean(IndexedMesh clean, std::vector<std::ui
                                               ": the progressive mesh changed the cleaned input");
     }
     region.vertexOfTom.resize(globalOf.size());
-    region.regionOfTom.resize(globalOf.size());
     region.ownRank.assign(globalOf.size() + 1, 0);
     for (std::uint32_t tom = 0; tom < globalOf.size(); ++tom) {
       const std::uint32_t g = globalOf[region.pm.sourceVertexOf(tom)];
       region.vertexOfTom[tom] = g;
-      region.regionOfTom[tom] = labels[g];
       region.ownRank[tom + 1] = region.ownRank[tom] + (labels[g] == r ? 1 : 0);
       if (labels[g] == r) out.tomOfVertex_[g] = tom;
     }
     for (std::uint32_t g : globalOf) localOf[g] = kUnmapped;
+  }
+  for (std::size_t r = 0; r < regionCount; ++r) {
+    Region& region = out.regions_[r];
+    region.corners.resize(region.vertexOfTom.size());
+    for (std::size_t tom = 0; tom < region.vertexOfTom.size(); ++tom) {
+      const std::uint32_t g = region.vertexOfTom[tom];
+      region.corners[tom] = {labels[g], labels[g] == r ? region.ownRank[tom] : out.tomOfVertex_[g]};
+    }
   }
   out.mesh_ = std::move(clean);
   out.regionOfVertex_ = std::move(labels);
@@ -356,10 +362,12 @@ Status RegionMesh::assembleInto(const std::vector<std::size_t>& targets, Indexed
   out.uvs.clear();
   out.colors.clear();
   out.positions.reserve(offset[regionCount]);
+  std::size_t corners = 0;
   for (std::size_t r = 0; r < regionCount; ++r) {
     const Region& region = regions_[r];
+    corners += 3 * region.pm.triangleCountAt(pmTargets[r]);
     for (std::size_t tom = 0; tom < live[r]; ++tom) {
-      if (region.regionOfTom[tom] != r) continue;
+      if (region.corners[tom].region != r) continue;
       const std::uint32_t g = region.vertexOfTom[tom];
       out.positions.push_back(mesh_.positions[g]);
       if (!mesh_.normals.empty()) out.normals.push_back(mesh_.normals[g]);
@@ -367,42 +375,41 @@ Status RegionMesh::assembleInto(const std::vector<std::size_t>& targets, Indexed
       if (!mesh_.colors.empty()) out.colors.push_back(mesh_.colors[g]);
     }
   }
-  out.indices.clear();
+  out.indices.resize(corners);  // an upper bound: foreign-owned triangles are dropped
+  std::uint32_t* write = out.indices.data();
   IndexedMesh scratch;
   std::size_t lookups = 0, moved = 0, dropped = 0;
   for (std::size_t r = 0; r < regionCount; ++r) {
     const Region& region = regions_[r];
     region.pm.extractInto(pmTargets[r], scratch);
     const std::uint32_t self = static_cast<std::uint32_t>(r);
+    const std::uint32_t base = offset[r];
+    const Region::Corner* info = region.corners.data();
     const std::uint32_t* corner = scratch.indices.data();
     for (std::size_t i = 0; i < scratch.indices.size(); i += 3) {
-      const std::uint32_t ra = region.regionOfTom[corner[i]];
-      const std::uint32_t rb = region.regionOfTom[corner[i + 1]];
-      const std::uint32_t rc = region.regionOfTom[corner[i + 2]];
-      if (triangleRegion(ra, rb, rc) != self) {
+      const Region::Corner c[3] = {info[corner[i]], info[corner[i + 1]], info[corner[i + 2]]};
+      if (triangleRegion(c[0].region, c[1].region, c[2].region) != self) {
         ++dropped;
         continue;
       }
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::uint32_t tom = corner[i + k];
-        const std::uint32_t s = region.regionOfTom[tom];
-        if (s == self) {
-          out.indices.push_back(offset[r] + region.ownRank[tom]);
+      for (const Region::Corner& k : c) {
+        if (k.region == self) {
+          *write++ = base + k.index;
           continue;
         }
         // The crack-free lookup: the foreign corner's representative in
         // its own region's current level.
-        const Region& other = regions_[s];
-        const std::uint32_t own = tomOfVertex_[region.vertexOfTom[tom]];
-        const std::uint32_t rep = other.pm.representative(own, live[s]);
+        const Region& other = regions_[k.region];
+        const std::uint32_t rep = other.pm.representative(k.index, live[k.region]);
         assert(rep != ProgressiveMesh::kNoRepresentative);
-        const std::uint32_t mapped = rep == ProgressiveMesh::kNoRepresentative ? own : rep;
+        const std::uint32_t mapped = rep == ProgressiveMesh::kNoRepresentative ? k.index : rep;
         ++lookups;
-        moved += mapped != own ? 1 : 0;
-        out.indices.push_back(offset[s] + other.ownRank[mapped]);
+        moved += mapped != k.index ? 1 : 0;
+        *write++ = offset[k.region] + other.ownRank[mapped];
       }
     }
   }
+  out.indices.resize(static_cast<std::size_t>(write - out.indices.data()));
   if (stats) {
     stats->foreignLookups += lookups;
     stats->lookupsThatMoved += moved;
@@ -422,8 +429,8 @@ IndexedMesh RegionMesh::extractRegion(std::size_t r, std::size_t targetTriangles
   const std::uint32_t self = static_cast<std::uint32_t>(r);
   for (std::size_t i = 0; i < scratch.indices.size(); i += 3) {
     const std::uint32_t* c = &scratch.indices[i];
-    if (triangleRegion(region.regionOfTom[c[0]], region.regionOfTom[c[1]],
-                       region.regionOfTom[c[2]]) != self) {
+    if (triangleRegion(region.corners[c[0]].region, region.corners[c[1]].region,
+                       region.corners[c[2]].region) != self) {
       continue;
     }
     for (int k = 0; k < 3; ++k) indices.push_back(region.vertexOfTom[c[k]]);
@@ -440,9 +447,9 @@ std::size_t RegionMesh::memoryBytes() const {
                       mesh_.uvs.capacity() * sizeof(glm::vec2) + mesh_.colors.capacity() * 4 +
                       mesh_.indices.capacity() * sizeof(std::uint32_t);
   for (const Region& region : regions_) {
-    bytes += region.pm.memoryBytes() + (region.vertexOfTom.capacity() +
-                                        region.regionOfTom.capacity() + region.ownRank.capacity()) *
-                                           sizeof(std::uint32_t);
+    bytes += region.pm.memoryBytes() +
+             (region.vertexOfTom.capacity() + region.ownRank.capacity()) * sizeof(std::uint32_t) +
+             region.corners.capacity() * sizeof(Region::Corner);
   }
   return bytes;
 }

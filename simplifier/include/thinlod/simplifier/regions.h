@@ -134,10 +134,16 @@ class RegionMesh {
     std::size_t foreignOwned = 0;  // triangles in pm owned by other regions (never removed)
     std::size_t keptVertices = 0;
     std::vector<std::uint32_t> vertexOfTom;  // pm's TOM vertex -> cleaned vertex
-    std::vector<std::uint32_t> regionOfTom;  // pm's TOM vertex -> its region
-    // Own vertices before each TOM index (size vertexCount + 1): an own live
-    // vertex's place among the region's output vertices.
-    std::vector<std::uint32_t> ownRank;
+    // Per TOM vertex, what assembly needs in one load: its region and, for
+    // an own vertex, its place among the region's output vertices (own
+    // vertices before it in TOM order), for a foreign one its TOM index in
+    // its own region's mesh.
+    struct Corner {
+      std::uint32_t region;
+      std::uint32_t index;
+    };
+    std::vector<Corner> corners;
+    std::vector<std::uint32_t> ownRank;  // own vertices before each TOM index (size + 1)
   };
   static Result<RegionMesh> buildClean(IndexedMesh clean, std::vector<std::uint32_t> labels,
                                        std::size_t regionCount, const RegionBuildOptions& options);
