@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <map>
 #include <random>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "qem_test_meshes.h"
+#include "thinlod/common/core/relative_accuracy.h"
 
 namespace thinlod::simplifier {
 namespace {
@@ -515,6 +517,74 @@ TEST(RegionCurves, EachRegionHasItsOwnConservativeCurve) {
                 static_cast<double>(cheapest) * (1.0 - 1e-6));
     }
   }
+}
+
+TEST(RegionCurves, NearRegionsGetMoreTrianglesAtOneAbsoluteAccuracy) {
+  // The paper's set-up at small scale: a bumpy 41 x 41 height grid in 6 x 6
+  // grid regions, the viewer above one corner. Each region is a leaf with its
+  // own curve; one absolute accuracy A (rad^-1) asks a relative accuracy
+  // A * D / L of a region at distance D with reference length L, so near
+  // regions need more triangles than far ones, and the levels the curves
+  // give assemble into one mesh with the input's topology.
+  const int n = 41, cells = 6;
+  IndexedMesh grid;
+  std::vector<std::uint32_t> labels;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const float x = static_cast<float>(i) / (n - 1), y = static_cast<float>(j) / (n - 1);
+      grid.positions.push_back(
+          {x, y, 0.05f * std::sin(9.0f * x) * std::cos(7.0f * y) + 0.02f * std::sin(23.0f * x)});
+      labels.push_back(static_cast<std::uint32_t>(std::min(cells - 1, j * cells / (n - 1)) * cells +
+                                                  std::min(cells - 1, i * cells / (n - 1))));
+    }
+  }
+  for (int j = 0; j + 1 < n; ++j) {
+    for (int i = 0; i + 1 < n; ++i) {
+      const std::uint32_t a = static_cast<std::uint32_t>(j * n + i), b = a + 1, c = a + n,
+                          d = c + 1;
+      grid.indices.insert(grid.indices.end(), {a, b, d, a, d, c});
+    }
+  }
+  Result<RegionMesh> regions = RegionMesh::build(grid, labels, cells * cells);
+  ASSERT_TRUE(regions.ok()) << regions.status().toString();
+  MeshCurveOptions options;
+  options.levels = 6;
+  options.measureEncodedBytes = false;
+  options.error.samplesPerMesh = 5000;
+  const glm::vec3 eye(-0.1f, -0.1f, 0.3f);
+  std::vector<MeshCurves> curves;
+  std::vector<double> distance, length;
+  for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+    Result<MeshCurves> c = measureRegionCurves(*regions, r, options);
+    ASSERT_TRUE(c.ok()) << c.status().toString();
+    curves.push_back(std::move(c.value()));
+    const IndexedMesh patch = regions->extractRegion(r, regions->maxTriangles(r));
+    const BoundingSphere sphere = referenceSphere(patch);
+    distance.push_back(std::max(1e-3, static_cast<double>(glm::length(sphere.center - eye))));
+    length.push_back(referenceLength(sphere));
+  }
+  const std::size_t nearest = static_cast<std::size_t>(
+      std::min_element(distance.begin(), distance.end()) - distance.begin());
+  const std::size_t farthest = static_cast<std::size_t>(
+      std::max_element(distance.begin(), distance.end()) - distance.begin());
+  EXPECT_EQ(nearest, 0u);  // the corner cell under the viewer
+  const Topology input = topologyOf(regions->mesh());
+  bool strictlyMore = false;
+  for (double absolute : {20.0, 50.0, 100.0, 200.0, 500.0}) {
+    std::vector<std::size_t> levels;
+    for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+      const double relative = absolute * distance[r] / length[r];
+      const double triangles = curves[r].triangles.resourcesForClamped(relative);
+      levels.push_back(static_cast<std::size_t>(std::ceil(triangles)));
+    }
+    EXPECT_GE(regions->triangleCountAt(nearest, levels[nearest]),
+              regions->triangleCountAt(farthest, levels[farthest]))
+        << "A = " << absolute;
+    strictlyMore = strictlyMore || regions->triangleCountAt(nearest, levels[nearest]) >
+                                       regions->triangleCountAt(farthest, levels[farthest]);
+    expectSameTopology(*regions, levels, input);
+  }
+  EXPECT_TRUE(strictlyMore);
 }
 
 }  // namespace

@@ -25,7 +25,8 @@
 //   neighbour set read by one region's collapse is changed by another
 //   region's collapses, so every combination of levels is the result of a
 //   valid sequence of collapses of the whole mesh: no cracks, no
-//   T-junctions, no non-manifold edge, the input's topology.
+//   T-junctions, no non-manifold edge where the input had none, the input's
+//   Euler characteristic.
 // - assemble(): each region emits the triangles it owns at its level; a
 //   corner in another region (a foreign vertex) is replaced by that vertex's
 //   representative in its own region's current level (lookupForeign).
@@ -39,8 +40,10 @@
 //   no regions, more regions than vertices, a label >= regionCount, a region
 //   left without a vertex after cleanup, options the builder owns
 //   (vertexConstraints, stopAtTriangles) set, a level vector of the wrong
-//   size. Pure: no I/O, no logging; immutable after build, concurrent const
-//   calls are safe.
+//   size. Accessors taking a region r or a vertex expect r < regionCount()
+//   and vertex < mesh().vertexCount() (unchecked, like vector::operator[]);
+//   measureRegionCurves checks r. Pure: no I/O, no logging; immutable after
+//   build, concurrent const calls are safe.
 #pragma once
 
 #include <cstddef>
