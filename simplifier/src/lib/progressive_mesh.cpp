@@ -78,11 +78,25 @@ Result<ProgressiveMesh> ProgressiveMesh::build(const IndexedMesh& mesh,
     return Status(ErrorCode::kInvalidArgument,
                   "build options: boundaryWeight and attributeWeight must be >= 0");
   }
+  if (!options.vertexConstraints.empty() &&
+      options.vertexConstraints.size() != mesh.positions.size()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "build options: " + std::to_string(options.vertexConstraints.size()) +
+                      " vertex constraints for " + std::to_string(mesh.positions.size()) +
+                      " vertices");
+  }
   Result<qem::CleanMesh> cleaned = qem::cleanMesh(mesh, options.weldEpsilon);
   if (!cleaned.ok()) return cleaned.status();
   const qem::CleanMesh& clean = cleaned.value();
   const qem::VertexAttributes attributes = attributesFor(mesh, clean, options);
-  const qem::CollapseRecord record = qem::runCollapses(clean, attributes, options);
+  std::vector<VertexConstraint> constraints;
+  if (!options.vertexConstraints.empty()) {
+    constraints.reserve(clean.sourceVertex.size());
+    for (std::uint32_t source : clean.sourceVertex) {
+      constraints.push_back(options.vertexConstraints[source]);
+    }
+  }
+  const qem::CollapseRecord record = qem::runCollapses(clean, attributes, constraints, options);
 
   const std::size_t vertexCount = clean.positions.size();
   const std::size_t triangleCount = clean.indices.size() / 3;
@@ -113,6 +127,8 @@ Result<ProgressiveMesh> ProgressiveMesh::build(const IndexedMesh& mesh,
   pm.normals_ = gatherAttribute(mesh.normals, clean.sourceVertex, order);
   pm.uvs_ = gatherAttribute(mesh.uvs, clean.sourceVertex, order);
   pm.colors_ = gatherAttribute(mesh.colors, clean.sourceVertex, order);
+  pm.sourceVertex_.resize(vertexCount);
+  for (std::size_t i = 0; i < vertexCount; ++i) pm.sourceVertex_[i] = clean.sourceVertex[order[i]];
   pm.parent_.assign(vertexCount, kNoParent);
   for (std::size_t i = 0; i < removals; ++i) {
     const std::uint32_t parent = record.removedParent[i];
@@ -222,7 +238,7 @@ std::size_t ProgressiveMesh::memoryBytes() const {
   return positions_.capacity() * sizeof(glm::vec3) + normals_.capacity() * sizeof(glm::vec3) +
          uvs_.capacity() * sizeof(glm::vec2) + colors_.capacity() * 4 +
          parent_.capacity() * sizeof(std::uint32_t) + indices_.capacity() * sizeof(std::uint32_t) +
-         levels_.capacity() * sizeof(Level);
+         sourceVertex_.capacity() * sizeof(std::uint32_t) + levels_.capacity() * sizeof(Level);
 }
 
 }  // namespace thinlod::simplifier

@@ -61,8 +61,9 @@ enum class VertexKind : std::uint8_t {
 
 class Collapser {
  public:
-  Collapser(const CleanMesh& mesh, const VertexAttributes& attributes, const BuildOptions& options)
-      : options_(options), attributes_(attributes) {
+  Collapser(const CleanMesh& mesh, const VertexAttributes& attributes,
+            const std::vector<VertexConstraint>& constraints, const BuildOptions& options)
+      : options_(options), attributes_(attributes), constraints_(constraints) {
     const std::size_t vertexCount = mesh.positions.size();
     const std::size_t triangleCount = mesh.indices.size() / 3;
     // Quadrics in coordinates centred on the bounding box: costs are
@@ -210,7 +211,13 @@ class Collapser {
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
       gather(v, neighborsU_);
       kind_[v] = classify(neighborsU_);
-      if (kind_[v] == VertexKind::kInterior || !options_.preserveBoundaries) continue;
+      // A kept or pinned vertex never moves; its quadric is built as usual
+      // (it still prices the collapses onto it).
+      const bool interior = kind_[v] == VertexKind::kInterior;
+      if (!constraints_.empty() && constraints_[v] != VertexConstraint::kFree) {
+        kind_[v] = VertexKind::kLocked;
+      }
+      if (interior || !options_.preserveBoundaries) continue;
       for (const Neighbor& nb : neighborsU_) {
         // Each border edge once, from its lower vertex.
         if (nb.triangles != 1 || nb.vertex < v) continue;
@@ -467,7 +474,7 @@ class Collapser {
       gather(u, neighborsU_);
       for (const Neighbor& nb : neighborsU_) {
         // Stay on the border: only along border edges.
-        if (nb.triangles == 1) candidateVertices_.push_back(nb.vertex);
+        if (nb.triangles == 1 && mayTarget(nb.vertex)) candidateVertices_.push_back(nb.vertex);
       }
     } else {
       // Interior of an oriented manifold: every neighbour is the next
@@ -475,7 +482,8 @@ class Collapser {
       compact(u);
       for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
         const std::uint32_t entry = pool_[i];
-        candidateVertices_.push_back(triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]]);
+        const std::uint32_t w = triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]];
+        if (mayTarget(w)) candidateVertices_.push_back(w);
       }
     }
     if (!exact) {
@@ -514,7 +522,7 @@ class Collapser {
 
   // Topology and geometry checks for u -> w; u's list is compacted.
   bool isValidCollapse(std::uint32_t u, std::uint32_t w) {
-    if (w == kNone) return false;
+    if (w == kNone || !mayTarget(w)) return false;
     // Opposite corners of the triangles on edge uw (they die with it).
     opposite_.clear();
     const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
@@ -585,6 +593,11 @@ class Collapser {
       if (d <= 0.0 || d * d < kMinFlipCos2 * beforeLength2 * glm::dot(after, after)) return false;
     }
     return true;
+  }
+
+  // A pinned vertex absorbs no neighbour (BuildOptions::vertexConstraints).
+  bool mayTarget(std::uint32_t w) const {
+    return constraints_.empty() || constraints_[w] != VertexConstraint::kPin;
   }
 
   bool hasTriangleOn(std::uint32_t w, std::uint32_t a, std::uint32_t b) const {
@@ -677,6 +690,7 @@ class Collapser {
   // when x reaches the top) unless its new option x -> w is cheaper.
   void rekeyAround(std::uint32_t u, std::uint32_t w) {
     rekey(w, chooseTarget(w, /*exact=*/false));  // also compacts w's list
+    const bool wMayTarget = mayTarget(w);
     const std::uint32_t seen = ++stamp_;
     for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
@@ -689,7 +703,7 @@ class Collapser {
           rekey(x, chooseTarget(x, /*exact=*/false));
           continue;
         }
-        if (kind_[x] == VertexKind::kLocked) continue;
+        if (kind_[x] == VertexKind::kLocked || !wMayTarget) continue;
         // A huge fan (a pole, a cone apex) would pay O(valence) here on every
         // collapse around it; its key may stay high until it is re-chosen.
         if (liveCount_[x] > kLargeFan) continue;
@@ -715,6 +729,7 @@ class Collapser {
 
   const BuildOptions& options_;
   const VertexAttributes& attributes_;
+  const std::vector<VertexConstraint>& constraints_;  // empty or per vertex
   double diagonal_ = 0.0;
   double meanArea_ = 1.0;
   // Position and the vertex's own quadric error there, side by side: a
@@ -769,8 +784,9 @@ class Collapser {
 }  // namespace
 
 CollapseRecord runCollapses(const CleanMesh& mesh, const VertexAttributes& attributes,
+                            const std::vector<VertexConstraint>& constraints,
                             const BuildOptions& options) {
-  Collapser collapser(mesh, attributes, options);
+  Collapser collapser(mesh, attributes, constraints, options);
   return collapser.run();
 }
 

@@ -46,7 +46,9 @@ struct VertexAttributes {
   std::vector<float> values;  // dimension floats per clean vertex
 };
 
+// constraints: empty or one per clean vertex (see VertexConstraint).
 CollapseRecord runCollapses(const CleanMesh& mesh, const VertexAttributes& attributes,
+                            const std::vector<VertexConstraint>& constraints,
                             const BuildOptions& options);
 
 }  // namespace thinlod::simplifier::qem

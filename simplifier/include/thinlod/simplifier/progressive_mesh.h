@@ -16,6 +16,9 @@
 //   boundary, never create a non-manifold edge or close a hole, never move a
 //   vertex on a non-manifold edge of the input, and (preventFlips) reject
 //   triangles that turn over or face against the input surface.
+// - vertexConstraints (optional, per input vertex) keep vertices (never
+//   removed) or pin them (never removed, never a target); regions.h uses
+//   them to simplify one region of a larger mesh with its border fixed.
 // - extract(n): the state after the first collapse that leaves at most n
 //   triangles; exactly n when the order passes through n, else the next lower
 //   count (a collapse removes >= 1 triangle). n >= maxTriangles(): the cleaned
@@ -39,6 +42,15 @@
 
 namespace thinlod::simplifier {
 
+// What a collapse may do with one input vertex (BuildOptions::vertexConstraints).
+// Regions (regions.h) keep their border vertices with kKeep and freeze the
+// neighbours' vertices they see with kPin.
+enum class VertexConstraint : std::uint8_t {
+  kFree,  // may collapse onto a neighbour and neighbours may collapse onto it
+  kKeep,  // never removed by a collapse; neighbours may collapse onto it
+  kPin,   // never removed and never a collapse target
+};
+
 struct BuildOptions {
   bool preserveBoundaries = true;  // add perpendicular penalty planes on boundary edges
   float boundaryWeight = 10.0f;    // weight of those planes relative to face planes
@@ -48,6 +60,10 @@ struct BuildOptions {
   float attributeWeight = 0.0f;
   float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
   std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
+  // Empty (every vertex kFree) or one per input vertex; a welded group takes
+  // the constraint of its first input vertex. Another size: kInvalidArgument.
+  // Quadrics and costs are unchanged: constraints only forbid moves.
+  std::vector<VertexConstraint> vertexConstraints;
   // Called on the building thread about every 1% of the collapses with the
   // fraction of triangles removed so far (0..1); may be empty.
   std::function<void(double fraction)> progress;
@@ -77,6 +93,21 @@ class ProgressiveMesh {
   double quadricErrorAt(std::size_t targetTriangles) const;
   std::size_t memoryBytes() const;  // heap bytes held by this object
 
+  // The input vertex TOM vertex `tomVertex` (< vertexCount()) came from: the
+  // first input vertex of its weld group. Output vertex i of extract() is TOM
+  // vertex i.
+  std::uint32_t sourceVertexOf(std::uint32_t tomVertex) const { return sourceVertex_[tomVertex]; }
+  // The live vertex that stands for TOM vertex `tomVertex` in a resolution
+  // with `liveVertices` (vertexCountAt(n)) vertices: itself when live, else
+  // the first live vertex on its substitution chain; kNoRepresentative when
+  // the vertex left the mesh without a parent (no triangle used it any more).
+  static constexpr std::uint32_t kNoRepresentative = 0xffffffffu;
+  std::uint32_t representative(std::uint32_t tomVertex, std::size_t liveVertices) const {
+    std::uint32_t v = tomVertex;
+    while (v != kNoParent && v >= liveVertices) v = parent_[v];
+    return v;
+  }
+
  private:
   // One state of the collapse order: after `collapse` collapses, the first
   // activeVertices vertices and the first activeTriangles triangles are live.
@@ -94,6 +125,7 @@ class ProgressiveMesh {
   std::vector<glm::vec3> normals_;    // empty or per vertex
   std::vector<glm::vec2> uvs_;
   std::vector<std::array<std::uint8_t, 4>> colors_;
+  std::vector<std::uint32_t> sourceVertex_;  // per TOM vertex: its input vertex
   // parent_[v] < v: the vertex v was substituted by; kNoParent when v never
   // was (it survives, or it was dropped once no triangle used it).
   std::vector<std::uint32_t> parent_;
