@@ -192,7 +192,8 @@ class Lane {
 
   // Shows `triangles` per cow (absent: not drawn) and times two frames.
   void show(const std::map<std::uint32_t, std::size_t>& triangles, const std::vector<Cow>& cows,
-            const simplifier::ProgressiveMesh& pm, const render::Camera& camera, FrameResult& out) {
+            const simplifier::ProgressiveMesh& pm, const render::Camera& camera, int repeats,
+            FrameResult& out) {
     SceneBatch batch;
     batch.plan = ++plan_;
     for (auto it = held_.begin(); it != held_.end();) {

@@ -11,10 +11,11 @@
 //    hops; the paper's "extra vertices traversed" = traversed / (3 T) - 1);
 // 3. rates across resolutions (triangles/s, median of --frames): TOM
 //    traversal alone (extractInto into reused buffers), TOM rendering
-//    (extract + upload + draw each frame) and streamlined rendering (the same
-//    resolution uploaded once and drawn), with the mesh drawn K times so one
-//    frame holds about --frame-triangles triangles and shrunk to a few pixels
-//    so fill does not bound it (the paper's set-up); GL is EGL or OSMesa.
+//    (extract + replicate + upload + draw each frame) and streamlined rendering (the same
+//    resolution uploaded once and drawn), with K copies of the mesh merged
+//    into one mesh (one draw call) so one frame holds about --frame-triangles
+//    triangles, shrunk to a few pixels so fill does not bound it (the
+//    paper's set-up); GL is EGL or OSMesa.
 //
 //   bench_tom --backend osmesa
 //
@@ -165,14 +166,14 @@ int main(int argc, char** argv) {
   std::printf(
       "\n## Rates across resolutions (million triangles/s, median of %d frames of ~%.0fk "
       "triangles, %s)\n\n| mesh | resolution | triangles | TOM traversal | TOM rendering "
-      "(extract + upload + draw) | streamlined rendering (draw only) |\n| --- | --- | --- | --- "
+      "(extract + replicate + upload + draw) | streamlined rendering (draw only) |\n| --- | --- | --- | --- "
       "| --- | --- |\n",
       frames, frameTriangles / 1000, render::backendName(context->backend()));
   render::Camera camera;
   camera.view = glm::lookAt(glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
   camera.projection = glm::perspective(0.785f, 1.0f, 0.1f, 1000.0f);
   for (const Built& b : built) {
-    // Shrink the mesh to a few pixels: about 2 % of the view's width at 100 m.
+    // Shrink the mesh to a few pixels (radius 1 m at 100 m: about 6 px).
     const IndexedMesh full = b.pm.extract(b.pm.maxTriangles());
     const BoundingSphere sphere = full.boundingSphere();
     const float scale = 1.0f / sphere.radius;
@@ -181,29 +182,46 @@ int main(int argc, char** argv) {
       const auto n = static_cast<std::size_t>(f * double(b.pm.maxTriangles()));
       const std::size_t triangles = b.pm.triangleCountAt(n);
       const int copies = std::max(1, static_cast<int>(std::ceil(frameTriangles / triangles)));
-      std::vector<render::DrawItem> items(copies);
-      const glm::mat4 model =
-          glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -100.0f)), glm::vec3(scale));
-      for (render::DrawItem& item : items) item.model = glm::translate(model, -sphere.center);
-      // TOM traversal alone (the extraction into reused buffers).
+      // The copies merged into one mesh (one draw call: our renderers batch,
+      // and per-call overhead would otherwise dominate small resolutions).
+      auto replicate = [copies](const IndexedMesh& one, IndexedMesh& many) {
+        const std::size_t v = one.positions.size();
+        many.positions.resize(v * copies);
+        many.normals.resize(one.normals.size() * copies);
+        many.indices.resize(one.indices.size() * copies);
+        for (int c = 0; c < copies; ++c) {
+          std::copy(one.positions.begin(), one.positions.end(), many.positions.begin() + c * v);
+          std::copy(one.normals.begin(), one.normals.end(), many.normals.begin() + c * v);
+          const std::size_t base = one.indices.size() * std::size_t(c);
+          for (std::size_t i = 0; i < one.indices.size(); ++i)
+            many.indices[base + i] = one.indices[i] + static_cast<std::uint32_t>(c * v);
+        }
+      };
+      render::DrawItem item;
+      item.model = glm::translate(
+          glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -100.0f)), glm::vec3(scale)),
+          -sphere.center);
       std::vector<double> traversal, tomRendering, streamlined;
+      // TOM traversal alone (the extraction into reused buffers).
       for (int k = 0; k < frames; ++k) {
         const auto t0 = Clock::now();
         for (int c = 0; c < copies; ++c) b.pm.extractInto(n, work);
         traversal.push_back(double(triangles) * copies / seconds(t0, Clock::now()));
       }
       // Streamlined: uploaded once, drawn.
+      IndexedMesh merged;
       b.pm.extractInto(n, work);
-      const render::MeshHandle fixed = orDie(renderer->uploadMesh(work), "upload");
-      const render::MeshHandle rebuilt = orDie(renderer->uploadMesh(work), "upload");
-      for (render::DrawItem& item : items) item.mesh = fixed;
+      replicate(work, merged);
+      const render::MeshHandle fixed = orDie(renderer->uploadMesh(merged), "upload");
+      const render::MeshHandle rebuilt = orDie(renderer->uploadMesh(merged), "upload");
+      item.mesh = fixed;
       orDie(renderer->beginFrame(*target, glm::vec4(0, 0, 0, 1)), "begin");  // warm-up
-      orDie(renderer->draw(items, camera, lighting), "draw");
+      orDie(renderer->draw(&item, 1, camera, lighting), "draw");
       orDie(renderer->finish(), "finish");
       for (int k = 0; k < frames; ++k) {
         const auto t0 = Clock::now();
         orDie(renderer->beginFrame(*target, glm::vec4(0, 0, 0, 1)), "begin");
-        orDie(renderer->draw(items, camera, lighting), "draw");
+        orDie(renderer->draw(&item, 1, camera, lighting), "draw");
         orDie(renderer->finish(), "finish");
         streamlined.push_back(double(triangles) * copies / seconds(t0, Clock::now()));
         if (renderer->stats().triangles != triangles * copies) {
@@ -212,15 +230,16 @@ int main(int argc, char** argv) {
           return 1;
         }
       }
-      // TOM rendering: each frame extracts and re-uploads the resolution,
-      // then draws it (one extraction per frame, shared by the copies).
-      for (render::DrawItem& item : items) item.mesh = rebuilt;
+      // TOM rendering: each frame extracts the resolution, replicates it,
+      // re-uploads and draws it (a client switching resolution every frame).
+      item.mesh = rebuilt;
       for (int k = 0; k < frames; ++k) {
         const auto t0 = Clock::now();
         b.pm.extractInto(n, work);
-        orDie(renderer->updateMesh(rebuilt, work), "update");
+        replicate(work, merged);
+        orDie(renderer->updateMesh(rebuilt, merged), "update");
         orDie(renderer->beginFrame(*target, glm::vec4(0, 0, 0, 1)), "begin");
-        orDie(renderer->draw(items, camera, lighting), "draw");
+        orDie(renderer->draw(&item, 1, camera, lighting), "draw");
         orDie(renderer->finish(), "finish");
         tomRendering.push_back(double(triangles) * copies / seconds(t0, Clock::now()));
       }
