@@ -189,6 +189,25 @@ std::vector<NamedMessage> seedMessages() {
 
   out.push_back({"heartbeat", Heartbeat{1'700'000'000'300'000'000, 9}});
   out.push_back({"shutdown", Shutdown{"SIGTERM"}});
+
+  // A frontend's Hello with its calibrated frame-cost constants (appended
+  // last: tests index the seeds above by position).
+  Hello frontend;
+  frontend.role = Role::kFrontend;
+  frontend.name = "frontend@host-2#77";
+  frontend.instanceId = 0x0badc0ffee000001ull;
+  frontend.capacity = 0;
+  frontend.sceneFingerprint = 0x0123456789abcdefull;
+  frontend.sceneFile = "deploy/data/paper-room.wrl";
+  FrameCostConstants costs;
+  costs.initSeconds = 4.0e-4;
+  costs.finalSeconds = 6.0e-4;
+  costs.setupSeconds = 3.0e-5;
+  costs.triangleSeconds = 1.5e-7;
+  costs.pixelSeconds = 6.8e-8;
+  costs.additive = true;
+  frontend.frameCost = costs;
+  out.push_back({"hello_frontend_frame_cost", frontend});
   return out;
 }
 

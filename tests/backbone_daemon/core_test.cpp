@@ -1107,3 +1107,148 @@ TEST(BackboneCoreOptions, BaselineSchedulersServePoses) {
 
 }  // namespace
 }  // namespace thinlod::backbone_daemon
+
+// ------------------------------------------------ frame cost per frontend session
+
+namespace thinlod::backbone_daemon {
+namespace {
+
+FrameCostConstants costsWithTriangleSeconds(double triangleSeconds) {
+  FrameCostConstants c;
+  c.initSeconds = 5e-4;
+  c.finalSeconds = 5e-4;
+  c.setupSeconds = 2e-5;
+  c.triangleSeconds = triangleSeconds;
+  c.pixelSeconds = 1e-9;
+  c.additive = true;
+  return c;
+}
+
+CoreOptions frameBudget(double milliseconds, std::optional<FrameCostConstants> fallback) {
+  CoreOptions options;
+  options.config.maxSpeed = 0.1;
+  options.scheduler = "active-set";
+  options.budget.maxFrameSeconds = milliseconds * 1e-3;
+  options.defaultFrameCost = fallback;
+  return options;
+}
+
+protocol::Hello frontendHello(std::optional<FrameCostConstants> costs) {
+  protocol::Hello hello;
+  hello.role = protocol::Role::kFrontend;
+  hello.name = "frontend@test";
+  hello.frameCost = costs;
+  return hello;
+}
+
+// Plans a few poses at the entrance for one session and returns the last
+// plan's triangles.
+double sessionTriangles(BackboneCore& core, const protocol::Hello& hello) {
+  EXPECT_TRUE(core.startFrontendSession(hello).ok());
+  FakeSimplifier fake(core);
+  double triangles = -1.0;
+  for (int step = 0; step < 3; ++step) {
+    EXPECT_TRUE(core.beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(core, fake, submitAll(core));
+    PoseOutcome outcome = core.finishPose();
+    EXPECT_TRUE(outcome.planned) << outcome.planError.toString();
+    EXPECT_STREQ(outcome.row.mode, "frame-time");
+    triangles = outcome.row.predictedTriangles;
+  }
+  return triangles;
+}
+
+// A triangle budget of the frame time the constants leave (additive model:
+// every triangle costs t_tri on top of the fixed and per-object parts).
+double trianglesWithin(double milliseconds, const FrameCostConstants& c) {
+  return (milliseconds * 1e-3 - c.initSeconds - c.finalSeconds) / c.triangleSeconds;
+}
+
+TEST(BackboneCoreFrameCost, TheFrontendsConstantsComeFirstThenTheBackboneDefault) {
+  const FrameCostConstants slow = costsWithTriangleSeconds(4e-6);  // ~2k triangles in 10 ms
+  const FrameCostConstants fast = costsWithTriangleSeconds(1e-9);  // everything at full
+  auto core = makeCore(frameBudget(10.0, slow));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  EXPECT_EQ(core->sessionFrameCost().source, FrameCostSource::kBackboneDefault);
+
+  const double withFast = sessionTriangles(*core, frontendHello(fast));
+  EXPECT_EQ(core->sessionFrameCost().source, FrameCostSource::kFrontend);
+  EXPECT_EQ(core->sessionFrameCost().constants.triangleSeconds, fast.triangleSeconds);
+
+  const double withDefault = sessionTriangles(*core, frontendHello(std::nullopt));
+  EXPECT_EQ(core->sessionFrameCost().source, FrameCostSource::kBackboneDefault);
+  EXPECT_EQ(core->sessionFrameCost().constants.triangleSeconds, slow.triangleSeconds);
+
+  const double withSlow = sessionTriangles(*core, frontendHello(slow));
+  EXPECT_EQ(core->sessionFrameCost().source, FrameCostSource::kFrontend);
+
+  // The slow machine's plans fit its own model; the fast one gets far more.
+  EXPECT_GT(withFast, 0.0);
+  EXPECT_GT(withSlow, 0.0);
+  EXPECT_LE(withSlow, trianglesWithin(10.0, slow));
+  EXPECT_LE(withDefault, trianglesWithin(10.0, slow));
+  EXPECT_GT(withFast, 2.0 * withSlow) << withFast << " vs " << withSlow;
+  EXPECT_GT(withFast, 2.0 * withDefault) << withFast << " vs " << withDefault;
+}
+
+TEST(BackboneCoreFrameCost, WithoutADefaultAFrontendWithoutConstantsIsRefused) {
+  auto core = makeCore(frameBudget(10.0, std::nullopt));
+  ASSERT_NE(core, nullptr);
+  const Status refused = core->admitFrontend(frontendHello(std::nullopt));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.code(), ErrorCode::kInvalidArgument);
+  for (const char* part : {"--budget-frame-ms", "--frame-cost", "bench_calibrate"})
+    EXPECT_NE(refused.message().find(part), std::string::npos) << refused.message();
+  EXPECT_FALSE(core->startFrontendSession(frontendHello(std::nullopt)).ok());
+  EXPECT_TRUE(core->admitFrontend(frontendHello(costsWithTriangleSeconds(1e-7))).ok());
+  // Simplifiers and tools are not asked for frame costs.
+  protocol::Hello worker = frontendHello(std::nullopt);
+  worker.role = protocol::Role::kSimplifier;
+  EXPECT_TRUE(core->admitFrontend(worker).ok());
+}
+
+TEST(BackboneCoreFrameCost, UnusableConstantsInAHelloAreRefusedWithTheReason) {
+  auto core = makeCore(frameBudget(10.0, costsWithTriangleSeconds(1e-7)));
+  ASSERT_NE(core, nullptr);
+  struct Case {
+    double FrameCostConstants::*field;
+    double value;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {&FrameCostConstants::triangleSeconds, std::numeric_limits<double>::quiet_NaN(),
+       "triangleSeconds must be finite"},
+      {&FrameCostConstants::pixelSeconds, -1e-9, "pixelSeconds must be finite and >= 0"},
+      {&FrameCostConstants::initSeconds, std::numeric_limits<double>::infinity(), "initSeconds"},
+      {&FrameCostConstants::setupSeconds, 5.0, "exceeds the limit"},
+      {&FrameCostConstants::triangleSeconds, 0.0, "must be > 0"},
+  };
+  for (const Case& c : cases) {
+    FrameCostConstants bad = costsWithTriangleSeconds(1e-7);
+    bad.*c.field = c.value;
+    const Status refused = core->admitFrontend(frontendHello(bad));
+    ASSERT_FALSE(refused.ok()) << c.expected;
+    EXPECT_NE(refused.message().find("the frontend's frame cost"), std::string::npos)
+        << refused.message();
+    EXPECT_NE(refused.message().find(c.expected), std::string::npos) << refused.message();
+  }
+  // A bad default is an option error at start-up.
+  CoreOptions options = frameBudget(10.0, costsWithTriangleSeconds(-1.0));
+  const Status invalidDefault = validateCoreOptions(options);
+  ASSERT_FALSE(invalidDefault.ok());
+  EXPECT_NE(invalidDefault.message().find("default frame cost"), std::string::npos);
+}
+
+TEST(BackboneCoreFrameCost, APolygonBudgetIgnoresTheConstants) {
+  CoreOptions options = polygonBudget(300);
+  options.scheduler = "active-set";
+  auto core = makeCore(options);
+  ASSERT_NE(core, nullptr);
+  EXPECT_TRUE(core->admitFrontend(frontendHello(std::nullopt)).ok());
+  ASSERT_TRUE(core->startFrontendSession(frontendHello(costsWithTriangleSeconds(1e-3))).ok());
+  EXPECT_EQ(core->sessionFrameCost().source, FrameCostSource::kUnused);
+}
+
+}  // namespace
+}  // namespace thinlod::backbone_daemon

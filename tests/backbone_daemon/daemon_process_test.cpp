@@ -14,6 +14,7 @@
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -477,6 +478,111 @@ TEST(BackboneDaemonProcess, RefusesAFrontendThatLoadedAnotherScene) {
       },
       [&] { return (*same)->connected(); }))
       << daemon.log();
+  EXPECT_EQ(daemon.stopWith(SIGTERM), 0);
+}
+
+// --budget-frame-ms without --frame-cost: each frontend brings its own
+// constants in its Hello (bench_calibrate on its machine); one without them
+// is refused with a reason it can act on, and the session's plans use the
+// constants of the frontend being served.
+TEST(BackboneDaemonProcess, FrameTimeBudgetUsesTheConstantsEachFrontendSends) {
+  BackboneProcess daemon({"--scheduler", "active-set", "--budget-frame-ms", "10",
+                          "--curve-timeout-s", "20", "--simple-impostor-radii", "0",
+                          "--meshed-impostor-radii", "0"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+  FakeWorker worker(daemon.simplifierAddress());
+  ASSERT_TRUE(
+      pumpUntil([&] { worker.poll(10ms); }, [&] { return daemon.logContains("event=ready"); }))
+      << daemon.log();
+
+  auto connect = [&](const std::string& name, std::optional<FrameCostConstants> costs) {
+    Channel::Options options;
+    options.address = daemon.frontendAddress();
+    options.hello.role = Role::kFrontend;
+    options.hello.name = name;
+    options.hello.frameCost = costs;
+    options.transport = testTransport();
+    return Channel::connect(options);
+  };
+  auto without = connect("frontend-without-costs", std::nullopt);
+  ASSERT_TRUE(without.ok());
+  Status refused;
+  bool rejected = false;
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        worker.poll(5ms);
+        for (ChannelEvent& e : (*without)->poll(5ms))
+          if (e.kind == ChannelEvent::Kind::kRejected) {
+            rejected = true;
+            refused = e.reason;
+          }
+      },
+      [&] { return rejected; }))
+      << daemon.log();
+  EXPECT_NE(refused.message().find("--frame-cost"), std::string::npos) << refused.toString();
+  EXPECT_NE(refused.message().find("bench_calibrate"), std::string::npos) << refused.toString();
+
+  // Two machines: triangles 1 ns (everything fits) and 4 us (about 2k in 10 ms).
+  auto triangles = [&](const std::string& name, double triangleSeconds,
+                       std::uint64_t firstSequence) {
+    FrameCostConstants costs;
+    costs.initSeconds = 5e-4;
+    costs.finalSeconds = 5e-4;
+    costs.setupSeconds = 2e-5;
+    costs.triangleSeconds = triangleSeconds;
+    costs.pixelSeconds = 1e-9;
+    costs.additive = true;
+    auto frontend = connect(name, costs);
+    EXPECT_TRUE(frontend.ok());
+    if (!frontend.ok()) return -1.0;
+    EXPECT_TRUE(pumpUntil(
+        [&] {
+          worker.poll(5ms);
+          (void)(*frontend)->poll(5ms);
+        },
+        [&] { return (*frontend)->connected(); }))
+        << daemon.log();
+    double planned = 0.0;
+    for (std::uint64_t k = 0; k < 3; ++k) {
+      const std::uint64_t sequence = firstSequence + k;
+      EXPECT_TRUE((*frontend)->send(entrancePose(sequence, 0.5 * double(k))).ok());
+      bool answered = false;
+      EXPECT_TRUE(pumpUntil(
+          [&] {
+            worker.poll(5ms);
+            for (ChannelEvent& e : (*frontend)->poll(5ms))
+              if (auto* u = std::get_if<SceneUpdate>(&e.message); u && u->frame == sequence)
+                answered = true;
+          },
+          [&] { return answered; }))
+          << daemon.log();
+    }
+    // The last decision row of this session: its predicted triangles.
+    std::istringstream rows(daemon.decisions());
+    std::string line, header, last;
+    std::getline(rows, header);
+    while (std::getline(rows, line))
+      if (!line.empty()) last = line;
+    std::vector<std::string> names, values;
+    for (std::istringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+    for (std::istringstream v(last); std::getline(v, line, ',');) values.push_back(line);
+    for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) {
+      if (names[i] == "predicted_triangles") planned = std::stod(values[i]);
+      if (names[i] == "mode") {
+        EXPECT_EQ(values[i], "frame-time") << last;
+      }
+    }
+    (*frontend).reset();
+    return planned;
+  };
+  const double fast = triangles("frontend-fast", 1e-9, 10);
+  const double slow = triangles("frontend-slow", 4e-6, 20);
+  EXPECT_TRUE(daemon.logContains("source=frontend")) << daemon.log();
+  EXPECT_TRUE(daemon.logContains("triangle_ns=4000")) << daemon.log();
+  EXPECT_TRUE(daemon.logContains("triangle_ns=1 ")) << daemon.log();
+  EXPECT_GT(slow, 0.0);
+  EXPECT_LE(slow, (10e-3 - 1e-3) / 4e-6);
+  EXPECT_GT(fast, 2.0 * slow) << fast << " vs " << slow;
   EXPECT_EQ(daemon.stopWith(SIGTERM), 0);
 }
 

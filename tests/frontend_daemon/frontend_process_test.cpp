@@ -17,12 +17,14 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "daemon_test_util.h"
+#include "thinlod/common/core/frame_cost.h"
 #include "thinlod/common/core/trace.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
@@ -531,6 +533,92 @@ TEST(FrontendProcess, FollowsALivePoseStreamFromAFifoSkippingABadLine) {
   EXPECT_EQ(json["pose_stream_received"], 3);
   EXPECT_EQ(json["pose_stream_lines_rejected"], 1);
   EXPECT_EQ(json["poses_skipped"], 0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace thinlod::frontend::daemon
+
+namespace thinlod::frontend::daemon {
+namespace {
+
+// --frame-cost FILE: the constants reach the backbone in the Hello, bit for
+// bit as bench_calibrate wrote them.
+TEST(FrontendProcess, SendsItsFrameCostConstantsInTheHello) {
+  protocol::Endpoint::Options endpointOptions;
+  endpointOptions.address = "tcp://127.0.0.1:0";
+  endpointOptions.name = "fake-backbone";
+  endpointOptions.acceptedRoles = {protocol::Role::kFrontend};
+  std::optional<protocol::Hello> seen;
+  endpointOptions.admit = [&seen](const protocol::Hello& hello) {
+    seen = hello;
+    return Status();
+  };
+  auto endpoint = protocol::Endpoint::bind(endpointOptions);
+  ASSERT_TRUE(endpoint.ok()) << endpoint.status().toString();
+  const std::string dir = makeTempDir();
+  FrameCostConstants costs;
+  costs.initSeconds = 3.1e-4;
+  costs.finalSeconds = 2.7e-4;
+  costs.setupSeconds = 1.25e-5;
+  costs.triangleSeconds = 1.48e-7;
+  costs.pixelSeconds = 6.8e-8;
+  costs.additive = true;
+  const std::string costFile = dir + "/frame_cost.toml";
+  std::ofstream(costFile) << formatFrameCostToml(costs, "test machine");
+  FrontendProcess process(
+      {"--backbone.address", (*endpoint)->address(), "--trace", writeTrace(dir, 3, 0.02),
+       "--no-reference", "--frame-cost", costFile, "--width", "160", "--height", "120"},
+      dir + "/frontend.log");
+  const int exitCode = process.waitExit([&] {
+    for (auto& event : (*endpoint)->poll(20ms)) {
+      if (event.kind != protocol::EndpointEvent::Kind::kMessage) continue;
+      if (const auto* pose = std::get_if<protocol::ViewerPose>(&event.message)) {
+        protocol::SceneUpdate empty;
+        empty.frame = pose->sequence;
+        (void)(*endpoint)->send(event.peer, empty);
+      }
+    }
+  });
+  const std::string log = readFile(dir + "/frontend.log");
+  ASSERT_EQ(exitCode, 0) << log;
+  ASSERT_TRUE(seen.has_value()) << log;
+  ASSERT_TRUE(seen->frameCost.has_value());
+  EXPECT_EQ(seen->frameCost->initSeconds, costs.initSeconds);
+  EXPECT_EQ(seen->frameCost->finalSeconds, costs.finalSeconds);
+  EXPECT_EQ(seen->frameCost->setupSeconds, costs.setupSeconds);
+  EXPECT_EQ(seen->frameCost->triangleSeconds, costs.triangleSeconds);
+  EXPECT_EQ(seen->frameCost->pixelSeconds, costs.pixelSeconds);
+  EXPECT_TRUE(seen->frameCost->additive);
+  fs::remove_all(dir);
+}
+
+TEST(FrontendProcess, RefusesAnUnusableFrameCostFileBeforeConnecting) {
+  const std::string dir = makeTempDir();
+  FrameCostConstants free;
+  free.pixelSeconds = 1e-8;  // triangles cost nothing: no use for a frame-time budget
+  const std::string freeFile = dir + "/free.toml";
+  std::ofstream(freeFile) << formatFrameCostToml(free, "");
+  const std::string nanFile = dir + "/nan.toml";
+  std::ofstream(nanFile) << "version = 1\ninit_seconds = 0\nfinal_seconds = 0\n"
+                            "setup_seconds = 0\ntriangle_seconds = nan\npixel_seconds = 0\n"
+                            "additive = 0\n";
+  struct Case {
+    std::string file;
+    const char* expected;
+  };
+  for (const Case& c : {Case{freeFile, "must be > 0"}, Case{nanFile, "must be finite"},
+                        Case{dir + "/missing.toml", "cannot open"}}) {
+    FrontendProcess process({"--backbone.address", "tcp://127.0.0.1:1", "--trace",
+                             writeTrace(dir, 2, 0.02), "--no-reference", "--frame-cost", c.file},
+                            dir + "/frontend.log");
+    const int exitCode = process.waitExit([] { std::this_thread::sleep_for(10ms); });
+    const std::string log = readFile(dir + "/frontend.log");
+    EXPECT_EQ(exitCode, 2) << log;
+    EXPECT_NE(log.find("--frame-cost"), std::string::npos) << log;
+    EXPECT_NE(log.find(c.file), std::string::npos) << log;
+    EXPECT_NE(log.find(c.expected), std::string::npos) << log;
+  }
   fs::remove_all(dir);
 }
 

@@ -410,3 +410,124 @@ TEST(SceneIdentity, FingerprintsAndRejectedPlansSurviveTheWire) {
 
 }  // namespace
 }  // namespace thinlod::protocol
+
+namespace thinlod::protocol {
+namespace {
+
+namespace fb = flatbuffers;
+namespace w = thinlod::wire;
+
+FrameCostConstants someFrameCost() {
+  FrameCostConstants c;
+  c.initSeconds = 4.0e-4;
+  c.finalSeconds = 6.0e-4;
+  c.setupSeconds = 3.0e-5;
+  c.triangleSeconds = 1.5e-7;
+  c.pixelSeconds = 6.8e-8;
+  c.additive = true;
+  return c;
+}
+
+Hello frontendHello() {
+  Hello hello;
+  hello.role = Role::kFrontend;
+  hello.name = "frontend@test";
+  return hello;
+}
+
+// A Hello whose FrameCost table holds what the sender wrote, bypassing the
+// encoder's checks (a hostile or broken peer).
+Bytes wireHelloWithFrameCost(const FrameCostConstants& c) {
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("frontend@hostile");
+  auto cost = w::CreateFrameCost(b, c.initSeconds, c.finalSeconds, c.setupSeconds,
+                                 c.triangleSeconds, c.pixelSeconds, c.additive);
+  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name, 7, 0, 0, 0, 0, cost).Union();
+  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
+TEST(HelloFrameCost, ConstantsSurviveTheWireBitForBit) {
+  Hello hello = frontendHello();
+  hello.frameCost = someFrameCost();
+  Result<Bytes> bytes = encode(Message(hello));
+  ASSERT_TRUE(bytes.ok()) << bytes.status().toString();
+  Result<Message> back = decode(*bytes);
+  ASSERT_TRUE(back.ok()) << back.status().toString();
+  const Hello& got = std::get<Hello>(*back);
+  ASSERT_TRUE(got.frameCost.has_value());
+  EXPECT_EQ(got.frameCost->initSeconds, 4.0e-4);
+  EXPECT_EQ(got.frameCost->finalSeconds, 6.0e-4);
+  EXPECT_EQ(got.frameCost->setupSeconds, 3.0e-5);
+  EXPECT_EQ(got.frameCost->triangleSeconds, 1.5e-7);
+  EXPECT_EQ(got.frameCost->pixelSeconds, 6.8e-8);
+  EXPECT_TRUE(got.frameCost->additive);
+  EXPECT_TRUE(got == hello);
+}
+
+TEST(HelloFrameCost, AbsentConstantsStayAbsentAndOlderHellosDecode) {
+  Result<Bytes> bytes = encode(Message(frontendHello()));
+  ASSERT_TRUE(bytes.ok());
+  Result<Message> back = decode(*bytes);
+  ASSERT_TRUE(back.ok());
+  EXPECT_FALSE(std::get<Hello>(*back).frameCost.has_value());
+  // A Hello built without the new field at all (an older frontend's).
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("frontend@old");
+  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
+  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
+  Result<Message> old = decode(Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()));
+  ASSERT_TRUE(old.ok()) << old.status().toString();
+  EXPECT_FALSE(std::get<Hello>(*old).frameCost.has_value());
+}
+
+TEST(HelloFrameCost, NonFiniteNegativeAndImplausibleConstantsAreRefusedNamingTheField) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    const char* what;
+    double FrameCostConstants::*field;
+    double value;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"NaN t_tri", &FrameCostConstants::triangleSeconds, nan, "triangleSeconds"},
+      {"Inf t_pix", &FrameCostConstants::pixelSeconds, inf, "pixelSeconds"},
+      {"-Inf t_init", &FrameCostConstants::initSeconds, -inf, "initSeconds"},
+      {"negative t_setup", &FrameCostConstants::setupSeconds, -1e-6, "setupSeconds"},
+      {"negative t_final", &FrameCostConstants::finalSeconds, -0.5, "finalSeconds"},
+      {"1 s per triangle", &FrameCostConstants::triangleSeconds, 1.0, "exceeds the limit"},
+      {"1 s per pixel", &FrameCostConstants::pixelSeconds, 1.0, "exceeds the limit"},
+      {"1 s setup", &FrameCostConstants::setupSeconds, 1.0, "exceeds the limit"},
+      {"a minute to clear", &FrameCostConstants::initSeconds, 60.0, "exceeds the limit"},
+      {"free triangles", &FrameCostConstants::triangleSeconds, 0.0, "must be > 0"},
+      {"negative zero t_tri", &FrameCostConstants::triangleSeconds, -0.0, "must be > 0"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    FrameCostConstants bad = someFrameCost();
+    bad.*c.field = c.value;
+    Result<Message> decoded = decode(wireHelloWithFrameCost(bad));
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(decoded.status().message().find("Hello.frame_cost"), std::string::npos)
+        << decoded.status().toString();
+    EXPECT_NE(decoded.status().message().find(c.expected), std::string::npos)
+        << decoded.status().toString();
+    // We never send what a peer would refuse either.
+    Hello hello = frontendHello();
+    hello.frameCost = bad;
+    EXPECT_FALSE(encode(Message(hello)).ok());
+  }
+  // The limits themselves are accepted.
+  FrameCostConstants edge;
+  edge.initSeconds = kMaxFrameFixedSeconds;
+  edge.finalSeconds = kMaxFrameFixedSeconds;
+  edge.setupSeconds = kMaxObjectSetupSeconds;
+  edge.triangleSeconds = kMaxTriangleSeconds;
+  edge.pixelSeconds = kMaxPixelSeconds;
+  EXPECT_TRUE(decode(wireHelloWithFrameCost(edge)).ok());
+}
+
+}  // namespace
+}  // namespace thinlod::protocol

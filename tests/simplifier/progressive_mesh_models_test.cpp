@@ -158,6 +158,29 @@ TEST_P(ModelTest, NoFlippedTrianglesWhereTheSurfaceIsSmooth) {
   }
 }
 
+// Traversal cost (Gobbetti-Bouvier's TOM measure): no chain at full
+// resolution; below it every corner whose vertex was substituted costs at
+// least one extra visit (checked against the full-resolution corners, which
+// are the input vertices of the same triangles in TOM order).
+TEST_P(ModelTest, TraversedVerticesCountTheSubstitutionChains) {
+  const Model& m = model(GetParam());
+  const ProgressiveMesh& pm = m.pm;
+  EXPECT_EQ(pm.traversedVerticesAt(pm.maxTriangles()), 3 * pm.maxTriangles());
+  for (std::size_t target : targetsOf(pm)) {
+    const IndexedMesh mesh = pm.extract(target);
+    const std::size_t corners = mesh.indices.size();
+    std::size_t substituted = 0;
+    for (std::size_t i = 0; i < corners; ++i)
+      substituted += mesh.indices[i] != m.welded.indices[i] ? 1 : 0;
+    const std::size_t traversed = pm.traversedVerticesAt(target);
+    EXPECT_GE(traversed, corners + substituted) << target;
+    EXPECT_GT(substituted, 0u) << target;
+    // Chains are short (the paper: the overhead stays small at every resolution).
+    EXPECT_LT(traversed, 10 * corners) << target;
+  }
+  EXPECT_EQ(ProgressiveMesh().traversedVerticesAt(10), 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(SharedModels, ModelTest,
                          ::testing::Values("cow.obj", "fandisk.obj", "teapot.obj", "suzanne.obj"),
                          [](const ::testing::TestParamInfo<std::string>& info) {

@@ -76,6 +76,10 @@ Status validateCoreOptions(const CoreOptions& o) {
       backbone::makeScheduler(o.scheduler, schedulerOptions(o));
   if (!scheduler.ok()) return invalid(scheduler.status().message());
   THINLOD_RETURN_IF_ERROR((*scheduler)->accepts(o.budget));
+  if (o.defaultFrameCost) {
+    const Status usable = validateCalibratedFrameCost(*o.defaultFrameCost);
+    if (!usable.ok()) return invalid("default frame cost: " + usable.message());
+  }
   if (o.textureSize < 8 || o.textureSize > 4096)
     return invalid("texture size " + std::to_string(o.textureSize) + ": expected 8..4096");
   if (o.textureCodec == protocol::TextureCodec::kNone)
@@ -123,8 +127,60 @@ const char* BackboneCore::schedulerName() const { return scheduler_->name(); }
 
 Status BackboneCore::admitFrontend(const protocol::Hello& hello) const {
   if (hello.role != protocol::Role::kFrontend) return Status();
-  return protocol::checkSameScene("backbone", sceneGraph_.fingerprint, scenePath_, "frontend",
-                                  hello.sceneFingerprint, hello.sceneFile);
+  THINLOD_RETURN_IF_ERROR(protocol::checkSameScene("backbone", sceneGraph_.fingerprint, scenePath_,
+                                                   "frontend", hello.sceneFingerprint,
+                                                   hello.sceneFile));
+  return frameCostFor(hello).status();
+}
+
+const char* frameCostSourceName(FrameCostSource source) {
+  switch (source) {
+    case FrameCostSource::kUnused:
+      return "unused";
+    case FrameCostSource::kFrontend:
+      return "frontend";
+    case FrameCostSource::kBackboneDefault:
+      return "backbone-default";
+  }
+  return "invalid";
+}
+
+Result<SessionFrameCost> BackboneCore::frameCostFor(const protocol::Hello& hello) const {
+  SessionFrameCost session;
+  if (!options_.budget.maxFrameSeconds) return session;
+  if (hello.frameCost) {
+    // The decoder checked them already; the core does not rely on its caller.
+    const Status usable = validateCalibratedFrameCost(*hello.frameCost);
+    if (!usable.ok()) return invalid("the frontend's frame cost: " + usable.message());
+    session.source = FrameCostSource::kFrontend;
+    session.constants = *hello.frameCost;
+    return session;
+  }
+  if (options_.defaultFrameCost) {
+    session.source = FrameCostSource::kBackboneDefault;
+    session.constants = *options_.defaultFrameCost;
+    return session;
+  }
+  return invalid(
+      "the backbone plans a frame-time budget (--budget-frame-ms) and has no default frame cost "
+      "(--frame-cost): the frontend must send its calibrated constants (thinlod-frontend "
+      "--frame-cost FILE, written by bench_calibrate)");
+}
+
+Status BackboneCore::startFrontendSession(const protocol::Hello& hello) {
+  resetFrontend();
+  Result<SessionFrameCost> session = frameCostFor(hello);
+  if (!session.ok()) return session.status();
+  if (session->source != FrameCostSource::kUnused) {
+    CoreOptions withCosts = options_;
+    withCosts.timeCritical.costs = session->constants;
+    Result<std::unique_ptr<backbone::Scheduler>> scheduler =
+        backbone::makeScheduler(options_.scheduler, schedulerOptions(withCosts));
+    if (!scheduler.ok()) return scheduler.status();
+    scheduler_ = std::move(scheduler).value();
+  }
+  sessionFrameCost_ = *session;
+  return Status();
 }
 
 Status BackboneCore::initialize() {
@@ -137,10 +193,15 @@ Status BackboneCore::initialize() {
   scene_ = std::move(converted_.scheduling);
   converted_.scheduling = backbone::SchedulingScene();
 
+  // Until a frontend session says otherwise: the default frame cost.
+  CoreOptions initial = options_;
+  if (options_.defaultFrameCost) initial.timeCritical.costs = *options_.defaultFrameCost;
   Result<std::unique_ptr<backbone::Scheduler>> scheduler =
-      backbone::makeScheduler(options_.scheduler, schedulerOptions(options_));
+      backbone::makeScheduler(options_.scheduler, schedulerOptions(initial));
   if (!scheduler.ok()) return scheduler.status();
   scheduler_ = std::move(scheduler).value();
+  if (options_.budget.maxFrameSeconds && options_.defaultFrameCost)
+    sessionFrameCost_ = {FrameCostSource::kBackboneDefault, *options_.defaultFrameCost};
 
   const std::size_t count = converted_.records.size();
   meshBytesPerTriangle_.assign(count, kDefaultMeshBytesPerTriangle);

@@ -34,6 +34,11 @@
 // - Time is the pose timestamp (clamped to never run backwards).
 // - Not thread-safe; one frontend session at a time (resetFrontend() when it
 //   changes).
+// - Frame cost (Budget::maxFrameSeconds): a frontend session's frame-time
+//   model uses the constants the frontend's Hello carries (its own renderer,
+//   calibrated by bench_calibrate), else CoreOptions::defaultFrameCost (the
+//   daemon's --frame-cost); with neither, admitFrontend refuses the
+//   frontend. Without a frame-time budget the constants are not used.
 #pragma once
 
 #include <cstdint>
@@ -72,7 +77,13 @@ struct CoreOptions {
   std::string scheduler = "accuracy-curve";  // a name of backbone::schedulerCatalogue()
   backbone::SchedulerConfig config;
   backbone::Budget budget;
-  backbone::TimeCriticalConfig timeCritical;  // active-set: the frontend's frame costs
+  // active-set options; its `costs` are replaced by each frontend session's
+  // frame-cost constants (startFrontendSession).
+  backbone::TimeCriticalConfig timeCritical;
+  // The frame-cost constants of a session whose frontend sent none (the
+  // daemon's --frame-cost); unset: such a frontend is refused when the
+  // budget has a frame time.
+  std::optional<FrameCostConstants> defaultFrameCost;
   std::uint32_t textureSize = 256;
   protocol::TextureCodec textureCodec = protocol::TextureCodec::kPng;
   double simpleImpostorRadii = 10.0;      // usable from this many bounding radii; 0: disabled
@@ -88,6 +99,19 @@ struct CoreOptions {
   std::uint64_t firstRequestId = 1;
 };
 Status validateCoreOptions(const CoreOptions& options);
+
+// Where a session's frame-cost constants came from.
+enum class FrameCostSource : std::uint8_t {
+  kUnused = 0,          // no frame-time budget: the constants play no part
+  kFrontend = 1,        // the frontend's Hello
+  kBackboneDefault = 2  // CoreOptions::defaultFrameCost
+};
+const char* frameCostSourceName(FrameCostSource source);
+
+struct SessionFrameCost {
+  FrameCostSource source = FrameCostSource::kUnused;
+  FrameCostConstants constants;  // meaningful unless kUnused
+};
 
 struct OutgoingRequest {
   std::uint64_t requestId = 0;  // == the message's requestId
@@ -140,7 +164,18 @@ class BackboneCore {
   // Answers a pose without planning (e.g. superseded by a newer one).
   protocol::SceneUpdate emptyUpdate(const protocol::ViewerPose& pose);
 
+  // Forgets the frontend (mirror, planner state, shaper); the frame-cost
+  // constants stay those of the last session.
   void resetFrontend();
+  // A new frontend session: resetFrontend(), then the scheduler's frame-cost
+  // constants are the ones this frontend's Hello earns (frameCostFor). Errors
+  // as frameCostFor's; the core is then reset but keeps its old constants.
+  Status startFrontendSession(const protocol::Hello& hello);
+  // The constants a session of this frontend would use (see the contract);
+  // kInvalidArgument when the frame-time budget has none for it or the
+  // Hello's are unusable (validateCalibratedFrameCost).
+  Result<SessionFrameCost> frameCostFor(const protocol::Hello& hello) const;
+  const SessionFrameCost& sessionFrameCost() const { return sessionFrameCost_; }
   // The frontend's acknowledgement: corrects the mirror for refused updates
   // (FrontendMirror::acknowledge); returns the objects corrected.
   std::size_t onFrameStats(const protocol::FrameStats& stats);
@@ -167,7 +202,8 @@ class BackboneCore {
   const char* schedulerName() const;
   std::uint64_t sceneFingerprint() const { return sceneGraph_.fingerprint; }
   // The frontend handshake: a frontend that loaded another scene is refused
-  // (protocol::checkSameScene); other roles pass.
+  // (protocol::checkSameScene), so is one frameCostFor() refuses; other
+  // roles pass.
   Status admitFrontend(const protocol::Hello& hello) const;
 
  private:
@@ -219,6 +255,7 @@ class BackboneCore {
   std::vector<double> meshBytesPerTriangle_;  // per object
   std::vector<bool> meshBytesLearned_;
   std::unique_ptr<backbone::Scheduler> scheduler_;
+  SessionFrameCost sessionFrameCost_;
   backbone::PlannerState planner_{options_.firstRequestId};
   bool dirty_ = true;
 

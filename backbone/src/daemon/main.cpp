@@ -10,6 +10,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -69,8 +70,8 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("budget-frame-ms", &s.budgetFrameMs,
                     "modelled frame time at the frontend in ms (0: none; --scheduler active-set)");
   runtime.addOption("frame-cost", &s.frameCost,
-                    "the frontend's frame-cost constants (TOML written by bench_calibrate); "
-                    "required with --budget-frame-ms");
+                    "frame-cost constants (TOML written by bench_calibrate) for frontends whose "
+                    "Hello carries none; a frontend's own constants come first");
   thinlod::backbone::SchedulerConfig& config = s.core.config;
   runtime.addOption("max-speed", &config.maxSpeed, "viewer speed bound (m/s) for prediction");
   runtime.addOption("max-angular-speed", &config.maxAngularSpeed, "viewer turn rate bound (rad/s)");
@@ -116,28 +117,13 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
   if (s.budgetPolygons > 0.0) o.budget.maxTriangles = s.budgetPolygons;
   if (s.budgetLink > 0.0) o.budget.maxLinkBytesPerSecond = s.budgetLink;
   if (s.accuracy > 0.0) o.budget.fixedAccuracy = s.accuracy;
-  if (s.budgetFrameMs > 0.0) {
-    o.budget.maxFrameSeconds = s.budgetFrameMs * 1e-3;
-    if (s.frameCost.empty())
-      return Status(thinlod::ErrorCode::kInvalidArgument,
-                    "--budget-frame-ms needs --frame-cost FILE (bench_calibrate --out FILE)");
-  }
+  if (s.budgetFrameMs > 0.0) o.budget.maxFrameSeconds = s.budgetFrameMs * 1e-3;
   if (!s.frameCost.empty()) {
-    std::ifstream in(s.frameCost);
-    if (!in)
-      return Status(thinlod::ErrorCode::kNotFound, "--frame-cost " + s.frameCost + ": cannot read");
-    constexpr std::size_t kMaxFrameCostBytes = 1 << 16;  // a few lines of TOML
-    std::string text(kMaxFrameCostBytes + 1, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    text.resize(static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxFrameCostBytes)
-      return Status(thinlod::ErrorCode::kResourceExhausted,
-                    "--frame-cost " + s.frameCost + ": larger than 64 KiB");
-    thinlod::Result<thinlod::FrameCostConstants> costs = thinlod::parseFrameCostToml(text);
+    // The default for frontends whose Hello carries no constants of their own.
+    thinlod::Result<thinlod::FrameCostConstants> costs = thinlod::loadFrameCostFile(s.frameCost);
     if (!costs.ok())
-      return Status(costs.status().code(),
-                    "--frame-cost " + s.frameCost + ": " + costs.status().message());
-    o.timeCritical.costs = *costs;
+      return Status(costs.status().code(), "--frame-cost " + costs.status().message());
+    o.defaultFrameCost = *costs;
   }
   if (!o.budget.maxTriangles && !o.budget.maxLinkBytesPerSecond && !o.budget.fixedAccuracy &&
       !o.budget.maxFrameSeconds)
@@ -272,14 +258,18 @@ class Daemon {
 
   void onFrontendEvent(protocol::EndpointEvent& event) {
     switch (event.kind) {
-      case protocol::EndpointEvent::Kind::kJoined:
-        spdlog::info("event=frontend_joined peer={} name={}", event.peer.value,
-                     std::get<protocol::Hello>(event.message).name);
+      case protocol::EndpointEvent::Kind::kJoined: {
+        const protocol::Hello& hello = std::get<protocol::Hello>(event.message);
+        spdlog::info("event=frontend_joined peer={} name={} frame_cost={}", event.peer.value,
+                     hello.name, hello.frameCost ? "sent" : "none");
+        hellos_[event.peer.value] = hello;
         break;
+      }
       case protocol::EndpointEvent::Kind::kLeft:
         spdlog::info("event=frontend_left peer={} reason=\"{}\"", event.peer.value,
                      event.reason.toString());
         if (active_ && *active_ == event.peer) active_.reset();
+        hellos_.erase(event.peer.value);
         break;
       case protocol::EndpointEvent::Kind::kMessage:
         if (auto* pose = std::get_if<protocol::ViewerPose>(&event.message)) {
@@ -350,7 +340,25 @@ class Daemon {
     if (!active_ || *active_ != peer) {
       if (hadFrontend_)
         spdlog::info("event=frontend_session peer={} note=\"state reset\"", peer.value);
-      core_.resetFrontend();
+      const auto hello = hellos_.find(peer.value);
+      const Status session =
+          core_.startFrontendSession(hello != hellos_.end() ? hello->second : protocol::Hello{});
+      if (!session.ok()) {
+        // Admission checked the same: only a changed configuration gets here.
+        spdlog::error("event=frontend_session_failed peer={} error=\"{}\"", peer.value,
+                      session.toString());
+        send(peer, core_.emptyUpdate(pose));
+        return;
+      }
+      const thinlod::backbone_daemon::SessionFrameCost& cost = core_.sessionFrameCost();
+      if (cost.source != thinlod::backbone_daemon::FrameCostSource::kUnused)
+        spdlog::info(
+            "event=frame_cost peer={} source={} init_ms={:.4g} final_ms={:.4g} setup_us={:.4g} "
+            "triangle_ns={:.4g} pixel_ns={:.4g} additive={}",
+            peer.value, thinlod::backbone_daemon::frameCostSourceName(cost.source),
+            cost.constants.initSeconds * 1e3, cost.constants.finalSeconds * 1e3,
+            cost.constants.setupSeconds * 1e6, cost.constants.triangleSeconds * 1e9,
+            cost.constants.pixelSeconds * 1e9, cost.constants.additive ? 1 : 0);
       active_ = peer;
       hadFrontend_ = true;
     }
@@ -432,6 +440,7 @@ class Daemon {
   protocol::Poller poller_;
   std::deque<std::pair<protocol::PeerId, protocol::ViewerPose>> poses_;
   std::optional<protocol::PeerId> active_;
+  std::map<std::uint64_t, protocol::Hello> hellos_;  // joined frontends by peer id
   bool hadFrontend_ = false;
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;

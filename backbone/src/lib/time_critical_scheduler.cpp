@@ -264,6 +264,22 @@ Result<Selection> TimeCriticalMethod::select(const SelectionStep& step) const {
         pickTriangles = triangles;
       }
     }
+    // Hysteresis: the displayed copy stays while it fits the allowance and
+    // is within the band of the best accuracy (no churn from small moves
+    // of r; the budget holds since the copy fits r * T_max).
+    if (pick >= 0 && n.candidates[pick].source != CandidateSource::kFrontendCopy &&
+        config_.keepCopyAccuracyShare > 0.0) {
+      for (std::size_t c = 0; c < n.candidates.size(); ++c) {
+        const LeafCandidate& cand = n.candidates[c];
+        if (cand.source != CandidateSource::kFrontendCopy || cand.fixedTriangles > allowed)
+          continue;
+        if (cand.maxRelativeAccuracy * (1.0 + config_.keepCopyAccuracyShare) < pickAccuracy)
+          continue;
+        pick = static_cast<int>(c);
+        pickAccuracy = cand.maxRelativeAccuracy;
+        break;
+      }
+    }
     if (pick < 0) {  // rounding below every candidate: its cheapest form
       pick = cheapest;
       const LeafCandidate& cand = n.candidates[cheapest];
@@ -302,6 +318,9 @@ Status validateTimeCriticalConfig(const TimeCriticalConfig& c) {
       return Status(
           ErrorCode::kInvalidArgument,
           "TimeCriticalConfig.objectImportance[" + std::to_string(i) + "] must be finite and >= 0");
+  if (!(std::isfinite(c.keepCopyAccuracyShare) && c.keepCopyAccuracyShare >= 0.0))
+    return Status(ErrorCode::kInvalidArgument,
+                  "TimeCriticalConfig.keepCopyAccuracyShare must be finite and >= 0");
   if (c.maxIterations < 1)
     return Status(ErrorCode::kInvalidArgument, "TimeCriticalConfig.maxIterations must be >= 1");
   if (std::isnan(c.timeBoxSeconds) || c.timeBoxSeconds < 0.0)

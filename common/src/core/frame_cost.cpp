@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 
 namespace thinlod {
@@ -132,10 +133,28 @@ Status validateFrameCostConstants(const FrameCostConstants& c) {
                            c.pixelSeconds};
   const char* names[] = {"initSeconds", "finalSeconds", "setupSeconds", "triangleSeconds",
                          "pixelSeconds"};
-  for (int i = 0; i < 5; ++i)
+  const double limits[] = {kMaxFrameFixedSeconds, kMaxFrameFixedSeconds, kMaxObjectSetupSeconds,
+                           kMaxTriangleSeconds, kMaxPixelSeconds};
+  for (int i = 0; i < 5; ++i) {
     if (!finiteNonNegative(values[i]))
       return Status(ErrorCode::kInvalidArgument,
                     std::string("FrameCostConstants.") + names[i] + " must be finite and >= 0");
+    if (values[i] > limits[i]) {
+      char text[160];
+      std::snprintf(text, sizeof text, "FrameCostConstants.%s = %.6g s exceeds the limit %.6g s",
+                    names[i], values[i], limits[i]);
+      return Status(ErrorCode::kInvalidArgument, text);
+    }
+  }
+  return Status::okStatus();
+}
+
+Status validateCalibratedFrameCost(const FrameCostConstants& c) {
+  THINLOD_RETURN_IF_ERROR(validateFrameCostConstants(c));
+  if (!(c.triangleSeconds > 0.0))
+    return Status(ErrorCode::kInvalidArgument,
+                  "FrameCostConstants.triangleSeconds must be > 0 for a frame-time budget (a "
+                  "model in which triangles cost nothing cannot trade detail for time)");
   return Status::okStatus();
 }
 
@@ -286,7 +305,7 @@ std::string formatFrameCostToml(const FrameCostConstants& c, const std::string& 
 }
 
 Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
-  constexpr std::size_t kMaxBytes = 64 * 1024;
+  constexpr std::size_t kMaxBytes = kMaxFrameCostFileBytes;
   if (text.size() > kMaxBytes)
     return Status(ErrorCode::kInvalidArgument,
                   "frame cost file: " + std::to_string(text.size()) + " bytes exceed 64 KiB");
@@ -345,7 +364,27 @@ Result<FrameCostConstants> parseFrameCostToml(const std::string& text) {
   c.triangleSeconds = values[4];
   c.pixelSeconds = values[5];
   c.additive = values[6] == 1.0;
+  const Status valid = validateFrameCostConstants(c);
+  if (!valid.ok()) return Status(valid.code(), "frame cost file: " + valid.message());
   return c;
+}
+
+Result<FrameCostConstants> loadFrameCostFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kNotFound, path + ": cannot open frame cost file");
+  std::string text(kMaxFrameCostFileBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) return Status(ErrorCode::kIoError, path + ": read failed");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxFrameCostFileBytes)
+    return Status(ErrorCode::kResourceExhausted, path + ": frame cost file larger than " +
+                                                     std::to_string(kMaxFrameCostFileBytes) +
+                                                     " bytes");
+  Result<FrameCostConstants> parsed = parseFrameCostToml(text);
+  if (!parsed.ok()) return Status(parsed.status().code(), path + ": " + parsed.status().message());
+  const Status usable = validateCalibratedFrameCost(*parsed);
+  if (!usable.ok()) return Status(usable.code(), path + ": " + usable.message());
+  return parsed;
 }
 
 }  // namespace thinlod

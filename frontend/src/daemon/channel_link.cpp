@@ -19,7 +19,7 @@ std::string defaultPeerName() {
 Result<std::unique_ptr<ChannelLink>> ChannelLink::connect(
     const std::string& address, const std::string& name,
     const protocol::TransportOptions& transport, int wakeFd, std::uint64_t sceneFingerprint,
-    const std::string& sceneFile) {
+    const std::string& sceneFile, std::optional<FrameCostConstants> frameCost) {
   protocol::Channel::Options options;
   options.address = address;
   options.hello.role = protocol::Role::kFrontend;
@@ -27,6 +27,7 @@ Result<std::unique_ptr<ChannelLink>> ChannelLink::connect(
   options.hello.capacity = 0;
   options.hello.sceneFingerprint = sceneFingerprint;
   options.hello.sceneFile = sceneFile;
+  options.hello.frameCost = frameCost;
   std::random_device entropy;
   options.hello.instanceId = (static_cast<std::uint64_t>(entropy()) << 32) ^ entropy();
   options.transport = transport;

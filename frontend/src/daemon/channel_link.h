@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "replay_loop.h"
+#include "thinlod/common/core/frame_cost.h"
 #include "thinlod/protocol/transport.h"
 
 namespace thinlod::frontend::daemon {
@@ -20,13 +21,12 @@ class ChannelLink final : public BackboneLink {
  public:
   // `name` must be unique among the backbone's frontends (docs/protocol.md).
   // The Hello names the scene this frontend loaded (fingerprint 0: none), so
-  // a backbone with another scene refuses it.
-  static Result<std::unique_ptr<ChannelLink>> connect(const std::string& address,
-                                                      const std::string& name,
-                                                      const protocol::TransportOptions& transport,
-                                                      int wakeFd,
-                                                      std::uint64_t sceneFingerprint = 0,
-                                                      const std::string& sceneFile = {});
+  // a backbone with another scene refuses it; `frameCost` (this machine's
+  // calibrated constants) is carried in the Hello for a frame-time budget.
+  static Result<std::unique_ptr<ChannelLink>> connect(
+      const std::string& address, const std::string& name,
+      const protocol::TransportOptions& transport, int wakeFd, std::uint64_t sceneFingerprint = 0,
+      const std::string& sceneFile = {}, std::optional<FrameCostConstants> frameCost = {});
 
   bool connected() const override;
   Status send(const protocol::Message& message) override;

@@ -62,6 +62,9 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("label", &o->label, "run name written into the summary");
   runtime.addOption("connect-timeout-ms", &o->connectTimeoutMs,
                     "how long to wait for the backbone handshake before replaying anyway, ms");
+  runtime.addOption("frame-cost", &o->frameCostPath,
+                    "this machine's frame-cost constants (TOML written by bench_calibrate), sent "
+                    "to the backbone at hello for its frame-time budget (empty: none)");
   runtime.addTransportOptions(&o->transport);
 }
 

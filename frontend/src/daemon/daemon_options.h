@@ -48,6 +48,9 @@ struct DaemonOptions {
   bool completeness = false;  // coverage pass: visible / missing objects per frame
   std::string label;
   int connectTimeoutMs = 10000;
+  // This machine's frame-cost constants (TOML of bench_calibrate), sent in
+  // the Hello for the backbone's frame-time budget (empty: none sent).
+  std::string frameCostPath;
   protocol::TransportOptions transport;
 };
 

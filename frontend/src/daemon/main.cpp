@@ -155,6 +155,18 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
     return 2;
   }
   finishOptions(options);
+  std::optional<FrameCostConstants> frameCost;
+  if (!options.frameCostPath.empty()) {
+    Result<FrameCostConstants> loaded = loadFrameCostFile(options.frameCostPath);
+    if (!loaded.ok()) {
+      spdlog::error("event=bad_options error=\"--frame-cost {}\"", loaded.status().toString());
+      return 2;
+    }
+    frameCost = *loaded;
+    spdlog::info("event=frame_cost path={} triangle_ns={:.4g} pixel_ns={:.4g} additive={}",
+                 options.frameCostPath, frameCost->triangleSeconds * 1e9,
+                 frameCost->pixelSeconds * 1e9, frameCost->additive ? 1 : 0);
+  }
   // Poses: a trace loaded whole, or a live stream read as it arrives.
   SteadyClock clock;
   Trace trace;
@@ -253,7 +265,7 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
 
   Result<std::unique_ptr<ChannelLink>> link = ChannelLink::connect(
       options.backboneAddress, defaultPeerName(), options.transport, runtime.wakeFd(),
-      scene ? scene->scene->fingerprint : 0, options.scenePath);
+      scene ? scene->scene->fingerprint : 0, options.scenePath, frameCost);
   if (!link.ok()) {
     spdlog::error("event=connect_failed address={} error=\"{}\"", options.backboneAddress,
                   link.status().toString());

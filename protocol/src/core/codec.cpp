@@ -83,8 +83,12 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Hello
   fb::Offset<fb::Vector<fb::Offset<fb::String>>> caps = 0;
   if (!m.capabilities.empty()) caps = b.CreateVectorOfStrings(m.capabilities);
   auto sceneFile = stringOrNull(b, m.sceneFile);
+  fb::Offset<w::FrameCost> frameCost = 0;
+  if (const auto& c = m.frameCost)
+    frameCost = w::CreateFrameCost(b, c->initSeconds, c->finalSeconds, c->setupSeconds,
+                                   c->triangleSeconds, c->pixelSeconds, c->additive);
   auto t = w::CreateHello(b, m.minVersion, m.maxVersion, static_cast<w::Role>(m.role), name,
-                          m.instanceId, caps, m.capacity, m.sceneFingerprint, sceneFile);
+                          m.instanceId, caps, m.capacity, m.sceneFingerprint, sceneFile, frameCost);
   return {w::Body::Hello, t.Union()};
 }
 
@@ -340,6 +344,16 @@ Result<Message> fromWire(const FieldPath& path, const w::Hello* m) {
   auto sceneFile = toString(path.child("scene_file"), m->scene_file(), kMaxPathBytes);
   if (!sceneFile.ok()) return sceneFile.status();
   out.sceneFile = std::move(*sceneFile);
+  if (const w::FrameCost* c = m->frame_cost()) {
+    FrameCostConstants costs;  // the values are checked by validate.cpp's check(Hello)
+    costs.initSeconds = c->init_seconds();
+    costs.finalSeconds = c->final_seconds();
+    costs.setupSeconds = c->setup_seconds();
+    costs.triangleSeconds = c->triangle_seconds();
+    costs.pixelSeconds = c->pixel_seconds();
+    costs.additive = c->additive();
+    out.frameCost = costs;
+  }
   return Message(std::move(out));
 }
 

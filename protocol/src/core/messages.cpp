@@ -21,7 +21,6 @@ const char* roleName(Role role) {
   return "invalid-role";
 }
 
-
 const char* messageName(const Message& message) {
   static constexpr const char* kNames[] = {"Hello",           "HelloReply",      "ViewerPose",
                                            "SceneUpdate",     "SimplifyRequest", "SimplifyResult",
@@ -42,6 +41,14 @@ bool sameCurve(const std::vector<AccuracySample>& a, const std::vector<AccuracyS
   }
   return true;
 }
+bool sameFrameCost(const std::optional<FrameCostConstants>& a,
+                   const std::optional<FrameCostConstants>& b) {
+  if (a.has_value() != b.has_value()) return false;
+  if (!a) return true;
+  return a->initSeconds == b->initSeconds && a->finalSeconds == b->finalSeconds &&
+         a->setupSeconds == b->setupSeconds && a->triangleSeconds == b->triangleSeconds &&
+         a->pixelSeconds == b->pixelSeconds && a->additive == b->additive;
+}
 }  // namespace
 
 bool operator==(const ConicRange& a, const ConicRange& b) {
@@ -61,7 +68,7 @@ bool operator==(const Hello& a, const Hello& b) {
   return a.minVersion == b.minVersion && a.maxVersion == b.maxVersion && a.role == b.role &&
          a.name == b.name && a.instanceId == b.instanceId && a.capabilities == b.capabilities &&
          a.capacity == b.capacity && a.sceneFingerprint == b.sceneFingerprint &&
-         a.sceneFile == b.sceneFile;
+         a.sceneFile == b.sceneFile && sameFrameCost(a.frameCost, b.frameCost);
 }
 bool operator==(const HelloReply& a, const HelloReply& b) {
   return a.accepted == b.accepted && a.version == b.version && a.role == b.role &&

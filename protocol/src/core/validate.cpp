@@ -217,6 +217,10 @@ Status check(const FieldPath& path, const Hello& m) {
                                                 std::to_string(kMaxWorkerCapacity));
   }
   THINLOD_RETURN_IF_ERROR(checkText(path.child("scene_file"), m.sceneFile, kMaxPathBytes));
+  if (m.frameCost) {
+    const Status usable = validateCalibratedFrameCost(*m.frameCost);
+    if (!usable.ok()) return invalidField(path.child("frame_cost"), usable.message());
+  }
   return Status();
 }
 

@@ -234,6 +234,23 @@ void ProgressiveMesh::extractInto(std::size_t targetTriangles, IndexedMesh& out)
   }
 }
 
+std::size_t ProgressiveMesh::traversedVerticesAt(std::size_t targetTriangles) const {
+  if (levels_.empty()) return 0;
+  const Level& level = levels_[levelFor(targetTriangles)];
+  const std::uint32_t live = level.activeVertices;
+  const std::size_t cornerCount = std::size_t{3} * level.activeTriangles;
+  std::size_t visited = 0;
+  for (std::size_t i = 0; i < cornerCount; ++i) {
+    std::uint32_t v = indices_[i];
+    ++visited;
+    while (v >= live) {  // the same walk as extractInto
+      v = parent_[v];
+      ++visited;
+    }
+  }
+  return visited;
+}
+
 std::size_t ProgressiveMesh::memoryBytes() const {
   return positions_.capacity() * sizeof(glm::vec3) + normals_.capacity() * sizeof(glm::vec3) +
          uvs_.capacity() * sizeof(glm::vec2) + colors_.capacity() * 4 +

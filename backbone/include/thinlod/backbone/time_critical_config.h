@@ -24,8 +24,13 @@ struct TimeCriticalConfig {
   bool useAcuity = true;
   double visualDegreesPerViewDegree = 1.0;
   std::vector<double> objectImportance;  // w_s by object index; missing entries are 1
-  int maxIterations = 10000;             // optimiser iteration cap per step
-  double timeBoxSeconds = 0.005;         // optimiser time box per step (any-time)
+  // Hysteresis (not in the paper): the frontend's copy of an object is kept
+  // while it fits the object's allowance r * T_max and reaches at least
+  // 1 / (1 + share) of the accuracy the best candidate within it would; 0:
+  // always switch to the best (the paper's behaviour).
+  double keepCopyAccuracyShare = 0.15;
+  int maxIterations = 10000;      // optimiser iteration cap per step
+  double timeBoxSeconds = 0.005;  // optimiser time box per step (any-time)
 };
 Status validateTimeCriticalConfig(const TimeCriticalConfig& config);
 

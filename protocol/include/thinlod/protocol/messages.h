@@ -20,11 +20,13 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/frame_cost.h"
 #include "thinlod/common/core/representation_kind.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/core/texture_codec.h"
@@ -119,6 +121,11 @@ struct Hello {
   // backbone refuses a frontend whose non-zero fingerprint differs from its own.
   std::uint64_t sceneFingerprint = 0;
   std::string sceneFile;
+  // A frontend's calibrated frame-time constants (bench_calibrate; absent:
+  // none). Checked by validateCalibratedFrameCost (finite, >= 0, within the
+  // plausibility limits, t_tri > 0); the backbone's frame-time budget of
+  // this frontend's session uses them before its own --frame-cost.
+  std::optional<FrameCostConstants> frameCost;
 };
 
 struct HelloReply {

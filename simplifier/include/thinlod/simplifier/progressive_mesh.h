@@ -11,8 +11,8 @@
 // - Greedy by cost: QEM (Garland-Heckbert, area-weighted planes) plus a fan
 //   term (distance of the removed vertex to its new fan) that keeps thin
 //   tips, and for a border vertex a border term (its distance to the border
-//   segment that replaces it) that keeps small ears on holes. Collapses keep input vertex positions (vertex substitution, see
-//   progressive_mesh.cpp for why), keep manifold boundary vertices on the
+//   segment that replaces it) that keeps small ears on holes. Collapses keep input vertex positions
+//   (vertex substitution, see progressive_mesh.cpp for why), keep manifold boundary vertices on the
 //   boundary, never create a non-manifold edge or close a hole, never move a
 //   vertex on a non-manifold edge of the input, and (preventFlips) reject
 //   triangles that turn over or face against the input surface.
@@ -92,6 +92,11 @@ class ProgressiveMesh {
   // distances weighted by area / mean triangle area: squared mesh units.
   double quadricErrorAt(std::size_t targetTriangles) const;
   std::size_t memoryBytes() const;  // heap bytes held by this object
+  // Vertices extract(targetTriangles) visits to resolve its corners: each
+  // corner's input vertex plus every hop along its substitution chain to the
+  // first live vertex (Gobbetti-Bouvier's traversal cost; 3 per triangle at
+  // full resolution, where no chain is followed).
+  std::size_t traversedVerticesAt(std::size_t targetTriangles) const;
 
   // The input vertex TOM vertex `tomVertex` (< vertexCount()) came from: the
   // first input vertex of its weld group. Output vertex i of extract() is TOM

@@ -24,10 +24,18 @@
 // - formatFrameCostToml / parseFrameCostToml: a small versioned text file
 //   ("version = 1", one "key = number" line per constant, "additive = 0|1"). The parser takes
 //   untrusted text: bounded (64 KiB), every key known and present once, every
-//   value finite and >= 0; errors name the line.
-// - Pure functions: no I/O, no globals.
+//   value finite and >= 0; errors name the line; then validateFrameCostConstants.
+// - validateFrameCostConstants: every constant finite, >= 0 and at most its
+//   plausibility limit below (larger values are no renderer's: corrupt or
+//   hostile input, e.g. from a frontend's Hello). validateCalibratedFrameCost
+//   also needs t_tri > 0: a model in which triangles cost nothing cannot
+//   trade detail for time (what a frame-time budget needs).
+// - loadFrameCostFile: the thin file wrapper (kNotFound, kResourceExhausted
+//   above 64 KiB, the parse error, then validateCalibratedFrameCost; every
+//   message starts with the path). Everything else is pure: no I/O, no globals.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -43,7 +51,15 @@ struct FrameCostConstants {
   double pixelSeconds = 0.0;     // t_pix: per covered pixel
   bool additive = false;         // false: max(triangles, pixels); true: their sum
 };
+// Plausibility limits of validateFrameCostConstants (seconds).
+inline constexpr double kMaxFrameFixedSeconds = 1.0;   // t_init, t_final each
+inline constexpr double kMaxObjectSetupSeconds = 0.1;  // t_setup
+inline constexpr double kMaxTriangleSeconds = 1e-3;    // t_tri
+inline constexpr double kMaxPixelSeconds = 1e-3;       // t_pix
+inline constexpr std::size_t kMaxFrameCostFileBytes = 64 * 1024;
+
 Status validateFrameCostConstants(const FrameCostConstants& constants);
+Status validateCalibratedFrameCost(const FrameCostConstants& constants);
 
 // One drawn object of a measured frame.
 struct DrawnObjectLoad {
@@ -74,5 +90,6 @@ double predictFrameSeconds(const FrameCostConstants& constants,
 
 std::string formatFrameCostToml(const FrameCostConstants& constants, const std::string& comment);
 Result<FrameCostConstants> parseFrameCostToml(const std::string& text);
+Result<FrameCostConstants> loadFrameCostFile(const std::string& path);
 
 }  // namespace thinlod
