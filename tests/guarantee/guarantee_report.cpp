@@ -15,9 +15,10 @@
 // Each is checked from the pose itself and the next `--lookahead` poses (an
 // impostor only where its validity cone holds the pose), and an impostor also
 // from `--samples` random positions inside its validity cone (at most twice
-// the capture distance). Meshed impostors are asked from two services, one
-// crediting the depth mesh's silhouette loss (now) and one not (before), so
-// both credits are checked on the same geometry.
+// the capture distance). Impostors are asked from two services, one with the
+// credit and cone of the guarantee check (now: depth-mesh silhouette loss,
+// parallax share in the credit) and one without (before), so both credits
+// are checked on the same geometry, each over its own cone.
 //
 // Output: one CSV row per check on stdout (or --csv FILE), a summary per
 // kind and credit on stderr.
@@ -236,7 +237,7 @@ int main(int argc, char** argv) {
           r.kind = kind;
           r.accuracyBound = std::clamp(1.0 / A, 1e-7, 1.0);
           r.textureCodec = protocol::TextureCodec::kPng;
-          for (int service = 0; service < (meshed ? 2 : 1); ++service) {
+          for (int service = 0; service < 2; ++service) {
             protocol::ImpostorResult result = (service == 0 ? now : before)->renderImpostor(r);
             if (!result.status.ok()) {
               std::fprintf(stderr, "impostor %llu at frame %zu: %s\n",
