@@ -48,6 +48,9 @@ TEST(RelativeAccuracyImpostorProperty, BothKindsAgreeWithTheBackbone) {
     options.sceneRoot = scratchDir();
     options.defaultScenePath = s.path;
     options.impostorFromLevels = false;  // full meshes: level error 0
+    // The texture's credit alone (no parallax share, no depth-mesh loss):
+    // this test is about the reference length both sides convert with.
+    options.impostorGuaranteeCredit = false;
     simplifier::SimplifierService service(options);
     for (std::uint64_t id : {kMeshObject, kSphereObject}) {
       const backbone_daemon::ObjectRecord& record = (*view)->converted.records[id - 1];

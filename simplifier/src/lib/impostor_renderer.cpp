@@ -8,6 +8,7 @@
 #include <glm/vec4.hpp>
 #include <string>
 
+#include "thinlod/simplifier/guarantee_check.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 
@@ -292,6 +293,22 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
       const glm::vec4 world = inverse * ndc;
       return glm::vec3(world) / world.w;
     };
+    CoverageMask captured;
+    CoverageMask shown;
+    captured.width = shown.width = n;
+    captured.height = shown.height = n;
+    captured.covered.resize(depthScratch_.size());
+    shown.covered.resize(depthScratch_.size());
+    for (std::size_t i = 0; i < depthScratch_.size(); ++i) {
+      captured.covered[i] = depthScratch_[i] < 1.0f;
+      // The frontend shows a texel where the mesh is and the texture is covered.
+      shown.covered[i] = captured.covered[i] && meshDepth[i] < 1.0f;
+    }
+    Result<SilhouetteDistance> loss = silhouetteDistance(captured, shown);
+    if (!loss.ok()) return loss.status();
+    impostor.silhouetteLossTexels = std::isfinite(loss->missingPixels)
+                                        ? loss->missingPixels
+                                        : std::sqrt(2.0) * n;  // nothing shown: all of it lost
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * n + x;
@@ -309,6 +326,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   } else {
     for (float d : depthScratch_) covered += d < 1.0f;
     missed = covered;
+    impostor.silhouetteLossTexels = covered ? std::sqrt(2.0) * n : 0.0;
   }
   impostor.meshDepthError = meshError;
   impostor.uncoveredFraction = covered ? static_cast<double>(missed) / covered : 0.0;

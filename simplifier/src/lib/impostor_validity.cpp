@@ -69,6 +69,16 @@ BoundParameters parameters(const ImpostorFraming& framing, const ImpostorErrorMo
   return p;
 }
 
+// The bound the cone keeps at distance d from c: maxAngularError, and with a
+// length l > 0 also l / d (a relative accuracy's angle, which falls with the
+// viewer's distance; d >= the distance to the object's surface, so l / d is
+// at most what the credit allows there).
+struct Limit {
+  double angle;
+  double length;
+  double at(double d) const { return length > 0.0 ? std::min(angle, length / d) : angle; }
+};
+
 // Bound (2) for a viewer at distance d from c, at angle theta from the axis.
 double boundAt(const BoundParameters& p, double d, double theta) {
   if (!(d > p.reach)) return kPi;
@@ -109,18 +119,18 @@ double largestAngle(const BoundParameters& p, double d, double limit) {
 
 // Walks from `from` towards `to` on a geometric grid; returns the last distance
 // before the bound at angle `theta` first exceeds `limit`, refined by bisection.
-double lastGoodDistance(const BoundParameters& p, double theta, double limit, double from,
+double lastGoodDistance(const BoundParameters& p, double theta, const Limit& limit, double from,
                         double to) {
   constexpr int kSteps = 512;
   const double ratio = std::pow(to / from, 1.0 / kSteps);
   double good = from;
   for (int i = 1; i <= kSteps; ++i) {
     const double d = (i == kSteps) ? to : from * std::pow(ratio, i);
-    if (coneBoundAt(p, d, theta) > limit) {
+    if (coneBoundAt(p, d, theta) > limit.at(d)) {
       double bad = d;
       for (int j = 0; j < 60; ++j) {
         const double mid = 0.5 * (good + bad);
-        (coneBoundAt(p, mid, theta) <= limit ? good : bad) = mid;
+        (coneBoundAt(p, mid, theta) <= limit.at(mid) ? good : bad) = mid;
       }
       return good;
     }
@@ -146,30 +156,38 @@ double impostorErrorBound(const ImpostorFraming& framing, const ImpostorErrorMod
 
 ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
                             double maxAngularError) {
+  return impostorValidity(framing, model, maxAngularError, 0.0);
+}
+
+ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
+                            double maxAngularError, double maxErrorLength) {
   const BoundParameters p = parameters(framing, model);
   const glm::dvec3 center(framing.objectCenter);
   const double D = p.captureDistance;
+  const Limit limit{maxAngularError,
+                    std::isfinite(maxErrorLength) ? std::max(0.0, maxErrorLength) : 0.0};
   if (!(maxAngularError > 0.0) || !(D > p.reach)) {
     return ConicRange::ball(glm::dvec3(framing.viewpoint), 0.0);  // only the viewpoint itself
   }
-  const double alpha = largestAngle(p, D, 0.5 * maxAngularError);
+  const double alpha = largestAngle(p, D, 0.5 * limit.at(D));
   if (!(alpha > 0.0)) return ConicRange::ball(glm::dvec3(framing.viewpoint), 0.0);
 
   // Beyond `far`, bound (1) <= t (D + d) / (d - R)^2 and the rim term
-  // rho * 2 / (d - R) both decrease with d, so once they fit they fit forever.
+  // rho * 2 / (d - R) both decrease with d, so once they fit they fit forever
+  // (against l / d too: d times either term decreases towards t and 2 rho).
   double far = 2.0 * D;
   auto farBound = [&](double d) {
     const double gap = d - p.reach;
     return std::asin(std::min(1.0, p.deviation * (D + d) / (gap * gap))) +
            std::asin(std::min(1.0, 2.0 * p.silhouette / gap));
   };
-  while (farBound(far) > maxAngularError && far < 1e9 * D) far *= 2.0;
-  double maxDistance = lastGoodDistance(p, alpha, maxAngularError, D, far);
-  if (maxDistance >= far && farBound(far) <= maxAngularError) {
+  while (farBound(far) > limit.at(far) && far < 1e9 * D) far *= 2.0;
+  double maxDistance = lastGoodDistance(p, alpha, limit, D, far);
+  if (maxDistance >= far && farBound(far) <= limit.at(far)) {
     maxDistance = std::numeric_limits<double>::infinity();
   }
   const double nearest = p.reach * (1.0 + 1e-6);
-  const double minDistance = lastGoodDistance(p, alpha, maxAngularError, D, nearest);
+  const double minDistance = lastGoodDistance(p, alpha, limit, D, nearest);
   const glm::dvec3 direction = (glm::dvec3(framing.viewpoint) - center) / D;
   auto range = ConicRange::make(center, std::min(minDistance, D), std::max(maxDistance, D),
                                 direction, std::min(alpha, kPi));

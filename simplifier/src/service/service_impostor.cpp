@@ -24,6 +24,10 @@ namespace {
 constexpr std::size_t kMaxRenderLevelsPerMesh = 4;
 // Share of a texel that Draco may move a quad / depth-mesh vertex.
 constexpr double kImpostorQuantizationTexels = 0.25;
+// Parallax may add at least this share of the texture's own error to the
+// credited error (else an impostor whose texture already costs the whole
+// requested error would be valid at its capture point only).
+constexpr double kMinParallaxShare = 0.5;
 
 Status invalid(const std::string& message) {
   return Status(ErrorCode::kInvalidArgument, "impostor: " + message);
@@ -251,12 +255,15 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   RgbaImage image;
   IndexedMesh geometry;
   ImpostorFraming rendered;
+  ImpostorErrorModel errorModel;
+  double lossTexels = 0.0;  // meshed: the depth mesh's silhouette loss
   if (request.kind == protocol::RepresentationKind::kSimpleImpostor) {
     Result<SimpleImpostor> simple = impostors->renderSimple(impostorScene, request.eye, base);
     if (!simple.ok()) return simple.status();
     image = std::move(simple->texture);
     geometry = simple->quad.mesh();
     rendered = simple->framing;
+    errorModel = simple->errorModel;
     representation.validity = toWire(simple->validity);
   } else {
     MeshedImpostorOptions meshed;
@@ -268,7 +275,9 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
     image = std::move(result->texture);
     geometry = std::move(result->mesh);
     rendered = result->framing;
+    errorModel = result->errorModel;
     representation.validity = toWire(result->validity);
+    if (options.impostorGuaranteeCredit) lossTexels = result->silhouetteLossTexels;
   }
 
   // --- Encode. ---
@@ -289,10 +298,31 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   if (!texture.ok()) return texture.status();
   representation.texture = std::move(texture).value();
   representation.transform = glm::mat4(1.0f);
-  // Relative accuracy the texture supports: detail finer than two texels is
-  // lost, plus the error of the level it was rendered from (docs/simplifier.md),
-  // relative to the objects' world reference length (relative_accuracy.h).
-  representation.accuracy = referenceLength(enclosingSphere(spheres)) / (2.0 * texel + levelError);
+  // Error the texture carries (world metres): detail finer than two texels
+  // is lost, plus the error of the level it was rendered from
+  // (docs/simplifier.md), plus, for a meshed impostor, what its depth mesh
+  // fails to show (the texture is only drawn where the mesh is: a hole or a
+  // lost leg is that far from the nearest texel still shown).
+  const BoundingSphere reference = enclosingSphere(spheres);
+  const double length = referenceLength(reference);
+  const double textureError = (2.0 + lossTexels) * texel + levelError;
+  if (!options.impostorGuaranteeCredit) {
+    representation.accuracy = length / textureError;  // parallax not in the credit
+    return representation;
+  }
+  // The credit must hold wherever the cone lets the impostor be seen: it is
+  // the texture's error plus a parallax share, and the cone keeps the
+  // parallax within that share's angle at every distance (impostorValidity
+  // with a length). The share fills the request's error at the capture
+  // (accuracyBound x the distance the backbone converts with), and is at
+  // least kMinParallaxShare of the texture's (docs/results/guarantee.md).
+  const double captureGap = std::max(
+      0.1, glm::length(glm::dvec3(request.eye) - glm::dvec3(reference.center)) - reference.radius);
+  const double requested = request.accuracyBound * captureGap;
+  const double parallaxShare = std::max(requested - textureError, kMinParallaxShare * textureError);
+  representation.validity =
+      toWire(impostorValidity(rendered, errorModel, request.accuracyBound, parallaxShare));
+  representation.accuracy = length / (textureError + parallaxShare);
   return representation;
 }
 

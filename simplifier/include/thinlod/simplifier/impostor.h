@@ -126,6 +126,13 @@ double impostorErrorBound(const ImpostorFraming& framing, const ImpostorErrorMod
 // the viewpoint.
 ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
                             double maxAngularError);
+// As above, and with maxErrorLength > 0 (metres) the bound also stays within
+// maxErrorLength / d for a viewer d from the object centre: the angle a
+// relative accuracy credits at that distance (relative_accuracy.h), so that
+// the error a credit states holds at every viewer of the cone, not only at
+// the capture distance (docs/results/guarantee.md).
+ConicRange impostorValidity(const ImpostorFraming& framing, const ImpostorErrorModel& model,
+                            double maxAngularError, double maxErrorLength);
 
 struct SimpleImpostor {
   RgbaImage texture;  // textureSize^2, transparent background
@@ -162,6 +169,12 @@ struct MeshedImpostor {
   ImpostorErrorModel errorModel;   // depthDeviation = max(meshDepthError, depthMesh.maxDepthJump)
   double coverage = 0.0;           // fraction of texels with alpha > 0
   double uncoveredFraction = 0.0;  // covered texels the depth mesh misses (silhouette loss)
+  // Largest distance (texels) from a captured covered texel to the nearest
+  // texel the depth mesh still shows, seen from the capture viewpoint
+  // (silhouetteDistance, guarantee_check.h): holes and lost thin parts. The
+  // texture only shows where the mesh is, so this detail is lost to every
+  // viewer; the service adds it to the error it credits.
+  double silhouetteLossTexels = 0.0;
 };
 
 struct ImpostorTimings {

@@ -53,6 +53,14 @@ struct ServiceOptions {
   // Render impostors from the coarsest level within one texel
   // (impostor_level.h); false: always the full meshes (the reference capture).
   bool impostorFromLevels = true;
+  // Impostor credits the guarantee check holds (docs/simplifier.md,
+  // ImpostorRequest 7): a meshed impostor's error includes its depth mesh's
+  // silhouette loss (holes, lost thin parts), and the validity cone keeps the
+  // parallax within the share of the credited error left to it at every
+  // viewer distance. false: the credit and cone before the guarantee check
+  // (texture and level only; parallax within accuracyBound), kept for
+  // docs/results/guarantee.md's comparison.
+  bool impostorGuaranteeCredit = true;
   MeshCurveOptions curve = defaultCurveOptions();
 
   static MeshCurveOptions defaultCurveOptions();
