@@ -487,7 +487,9 @@ namespace {
 // scene is refused with a reason naming both files; one that loaded the same
 // scene is served; the simplifier's requests carry the backbone's fingerprint.
 TEST(BackboneDaemonProcess, RefusesAFrontendThatLoadedAnotherScene) {
-  BackboneProcess daemon({"--budget-polygons", "400", "--curve-timeout-s", "20"});
+  // Lockstep (--sync-wait-ms): the cow's curve request goes at startup.
+  BackboneProcess daemon(
+      {"--budget-polygons", "400", "--curve-timeout-s", "20", "--sync-wait-ms", "1000"});
   ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
   FakeWorker worker(daemon.simplifierAddress());
   ASSERT_TRUE(
