@@ -522,7 +522,9 @@ int main(int argc, char** argv) {
   const std::string scenePath = (ec || canonical.empty() ? absolute : canonical).string();
   thinlod::scene::SceneLoadOptions load;
   if (!settings.modelsDir.empty()) load.meshSearchPaths = {settings.modelsDir};
+  const auto loadStarted = Clock::now();
   thinlod::Result<thinlod::scene::Scene> scene = thinlod::scene::loadSceneFile(scenePath, load);
+  const auto loaded = Clock::now();
   if (!scene.ok()) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, scene.status().toString());
     return 1;
@@ -536,10 +538,16 @@ int main(int argc, char** argv) {
     return 1;
   }
   BackboneCore& backbone = **core;
-  spdlog::info("event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={}",
-               scenePath, protocol::fingerprintText(backbone.sceneFingerprint()),
-               backbone.objects().size(), backbone.lodNodes(),
-               backbone.schedulingScene().options.size(), backbone.curvesPending());
+  const auto msBetween = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  spdlog::info(
+      "event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={} "
+      "start_ms={:.0f} load_ms={:.0f} convert_ms={:.0f}",
+      scenePath, protocol::fingerprintText(backbone.sceneFingerprint()), backbone.objects().size(),
+      backbone.lodNodes(), backbone.schedulingScene().options.size(), backbone.curvesPending(),
+      msBetween(processStart, loadStarted), msBetween(loadStarted, loaded),
+      msBetween(loaded, Clock::now()));
 
   std::optional<std::ofstream> csv;
   if (!settings.decisionsCsv.empty()) {
