@@ -133,6 +133,31 @@ TEST(BackboneCoreColdStart, MeasuredCurveReplacesTheEstimateInTheScheduledScene)
   EXPECT_LE(outcome.frontendTriangles, 200.0);
 }
 
+TEST(BackboneCoreColdStart, TheShellMayReleaseAHeldCurveWhilePlanRequestsAreOpen) {
+  auto core = paperRoom(liveBudget(200));
+  ASSERT_NE(core, nullptr);
+  EXPECT_FALSE(core->releaseHeldCurve());  // no pose planned yet
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  std::vector<OutgoingRequest> requests = submitAll(*core);
+  (void)core->finishPose();
+  ASSERT_GT(core->awaitedResults(), 0u);  // plan requests open
+  EXPECT_FALSE(core->curveRequestOpen());
+  ASSERT_TRUE(core->releaseHeldCurve());  // the duty-cycle rule of main.cpp
+  EXPECT_TRUE(core->curveRequestOpen());
+  EXPECT_FALSE(core->releaseHeldCurve());  // one at a time (and none left)
+  const std::vector<OutgoingRequest> curve = submitAll(*core);
+  ASSERT_EQ(curve.size(), 1u);
+  EXPECT_TRUE(isCurveRequest(curve[0]));
+  FakeSimplifier fake(*core);
+  answer(*core, fake, curve);
+  EXPECT_FALSE(core->curveRequestOpen());
+  EXPECT_TRUE(core->objectsWithEstimatedCurve().empty());
+  answer(*core, fake, requests);  // the plan's answers still count
+  ASSERT_TRUE(core->beginPose(poseAt(1, 0.1, kEntrance, kCow)).ok());
+  submitAll(*core);
+  EXPECT_GT(core->finishPose().adds, 0u);
+}
+
 TEST(BackboneCoreColdStart, LockstepAsksForTheCurvesAtStartup) {
   CoreOptions options = polygonBudget(200);
   options.deferCurveRequests = false;

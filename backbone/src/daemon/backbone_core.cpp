@@ -291,17 +291,25 @@ std::vector<OutgoingRequest> BackboneCore::takeRequests() {
   // A held curve request goes when the viewer's requests are all answered
   // (none queued here, none open in the ledger) and the last released curve
   // is in: at most one measurement at a time, smallest mesh first.
-  const bool curveOpen = releasedCurve_ != 0 && ledger_.open(releasedCurve_) != nullptr;
-  if (!heldCurves_.empty() && posesPlanned_ > 0 && out.empty() && !curveOpen &&
-      ledger_.openCount(RequestPurpose::kPlan) == 0) {
-    auto smallest =
-        std::min_element(heldCurves_.begin(), heldCurves_.end(),
-                         [](const auto& a, const auto& b) { return a.first < b.first; });
-    releasedCurve_ = smallest->second.requestId;
-    out.push_back(std::move(smallest->second));
-    heldCurves_.erase(smallest);
+  if (posesPlanned_ > 0 && out.empty() && ledger_.openCount(RequestPurpose::kPlan) == 0 &&
+      releaseHeldCurve()) {
+    out.swap(queued_);
   }
   return out;
+}
+
+bool BackboneCore::curveRequestOpen() const {
+  return releasedCurve_ != 0 && ledger_.open(releasedCurve_) != nullptr;
+}
+
+bool BackboneCore::releaseHeldCurve() {
+  if (heldCurves_.empty() || posesPlanned_ == 0 || curveRequestOpen()) return false;
+  auto smallest = std::min_element(heldCurves_.begin(), heldCurves_.end(),
+                                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  releasedCurve_ = smallest->second.requestId;
+  queued_.push_back(std::move(smallest->second));
+  heldCurves_.erase(smallest);
+  return true;
 }
 
 std::vector<std::uint64_t> BackboneCore::takeCancellations() {

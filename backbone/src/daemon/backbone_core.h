@@ -21,11 +21,12 @@
 //   in takeCancellations().
 // - Startup curve requests (one per mesh object) are queued at create().
 //   With deferCurveRequests they are held back and released one at a time,
-//   smallest mesh first, only after a pose has been planned and while no
-//   plan request is open: a first measurement of a large mesh occupies a
-//   simplifier for seconds, and the representations the viewer waits for
-//   go first. A measured curve replaces the estimate in the scheduling scene
-//   (the leaf's content version is bumped; no restart).
+//   smallest mesh first, after a pose has been planned, when no plan
+//   request is open (takeRequests) or when the shell calls
+//   releaseHeldCurve() (its duty-cycle rule, main.cpp): a first measurement
+//   of a large mesh occupies a simplifier for seconds, and the
+//   representations the viewer waits for go first. A measured curve replaces the estimate in the
+//   scheduling scene (the leaf's content version is bumped; no restart).
 // - Link: the LinkShaper is the one model of the link. Every byte it lets
 //   through is settled in the scheduler's link log under the copy's id
 //   (PlannerState::settleLinkSend), and a request that will never be shipped
@@ -143,7 +144,13 @@ class BackboneCore {
   // ---- startup curves ----
   std::size_t curvesPending() const;
   std::size_t curvesWanted() const { return curvesWanted_; }
-  std::size_t curvesHeld() const { return heldCurves_.size(); }    // not released yet
+  std::size_t curvesHeld() const { return heldCurves_.size(); }  // not released yet
+  // A released curve request without its answer yet.
+  bool curveRequestOpen() const;
+  // Releases the smallest held curve request now (queued for takeRequests)
+  // unless none is held, no pose was planned yet or one is open; true when
+  // one was released.
+  bool releaseHeldCurve();
   std::vector<std::uint64_t> objectsWithoutMeasuredCurve() const;  // mesh objects
   // Mesh objects planning from the estimate (curve_estimate.h) right now.
   std::vector<std::uint64_t> objectsWithEstimatedCurve() const;

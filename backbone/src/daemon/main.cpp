@@ -287,6 +287,17 @@ class Daemon {
   }
 
   void submitRequests() {
+    // Duty cycle of the held curve requests (live serving): besides the idle
+    // moments the core uses, release one when the previous curve answer is
+    // three of its own durations old, so measurements take at most about a
+    // quarter of the simplifier's time while the viewer's requests wait (a
+    // cached curve answers in milliseconds, a cold 100k-triangle one in ~10 s).
+    const auto now = Clock::now();
+    if (core_.curvesHeld() > 0 && workers_.liveWorkers() > 0 && now >= nextCurveAt_ &&
+        core_.releaseHeldCurve()) {
+      curveReleasedAt_ = now;
+      nextCurveAt_ = Clock::time_point::max();  // until its answer
+    }
     for (std::uint64_t id : core_.takeCancellations()) workers_.cancel(id);
     // The pool sends each request under the id the core (and the scheduler) gave it.
     for (auto& request : core_.takeRequests()) {
@@ -348,6 +359,9 @@ class Daemon {
         const std::size_t pendingBefore = core_.curvesPending();
         noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId);
         if (core_.curvesPending() < pendingBefore) {
+          const auto now = Clock::now();
+          if (curveReleasedAt_) nextCurveAt_ = now + 3 * (now - *curveReleasedAt_);
+          curveReleasedAt_.reset();
           // Progress of the startup curves (each replaces an estimate).
           spdlog::info(
               "event=curve_measured object={} samples={} received={} wanted={} held={} ms={:.0f}",
@@ -479,6 +493,10 @@ class Daemon {
   std::optional<protocol::PeerId> active_;
   bool hadFrontend_ = false;
   bool curvesReported_ = false;
+  // Duty cycle of held curve requests (submitRequests): the first may go
+  // 2 s after startup, the next three answer durations after an answer.
+  std::optional<Clock::time_point> curveReleasedAt_;
+  Clock::time_point nextCurveAt_ = Clock::now() + 2s;
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;
 };
