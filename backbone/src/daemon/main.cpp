@@ -289,9 +289,11 @@ class Daemon {
   void submitRequests() {
     // Duty cycle of the held curve requests (live serving): besides the idle
     // moments the core uses, release one when the previous curve answer is
-    // three of its own durations old, so measurements take at most about a
-    // quarter of the simplifier's time while the viewer's requests wait (a
+    // three of its own service times old, so measurements take at most about
+    // a quarter of the simplifier's time while the viewer's requests wait (a
     // cached curve answers in milliseconds, a cold 100k-triangle one in ~10 s).
+    // Service time = answer - max(release, the result before it): a worker
+    // answers in order, so the queue wait before it is not counted.
     const auto now = Clock::now();
     if (core_.curvesHeld() > 0 && workers_.liveWorkers() > 0 && now >= nextCurveAt_ &&
         core_.releaseHeldCurve()) {
@@ -356,11 +358,15 @@ class Daemon {
                      workers_.liveWorkers(), workers_.pendingRequests());
         break;
       case protocol::WorkerPoolEvent::Kind::kSimplifyResult: {
+        lastResultAt_ = resultAt_;
         const std::size_t pendingBefore = core_.curvesPending();
         noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId);
         if (core_.curvesPending() < pendingBefore) {
           const auto now = Clock::now();
-          if (curveReleasedAt_) nextCurveAt_ = now + 3 * (now - *curveReleasedAt_);
+          if (curveReleasedAt_) {
+            const auto began = std::max(*curveReleasedAt_, lastResultAt_);
+            nextCurveAt_ = now + 3 * (now - began);
+          }
           curveReleasedAt_.reset();
           // Progress of the startup curves (each replaces an estimate).
           spdlog::info(
@@ -379,6 +385,7 @@ class Daemon {
   }
 
   void noteResult(const Status& status, const char* kind, std::uint64_t requestId) {
+    resultAt_ = Clock::now();
     if (status.ok()) {
       ++resultsAccepted_;
       spdlog::debug("event=result kind={} request={}", kind, requestId);
@@ -497,6 +504,8 @@ class Daemon {
   // 2 s after startup, the next three answer durations after an answer.
   std::optional<Clock::time_point> curveReleasedAt_;
   Clock::time_point nextCurveAt_ = Clock::now() + 2s;
+  Clock::time_point resultAt_;      // the latest simplifier result
+  Clock::time_point lastResultAt_;  // the one before the result being handled
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;
 };
