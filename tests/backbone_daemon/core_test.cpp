@@ -86,10 +86,12 @@ TEST(BackboneCoreScene, PrimitivesHaveAnalyticCurvesAndTheCowWaitsForItsCurve) {
   }
   EXPECT_EQ(core->curvesPending(), 1u);
   EXPECT_EQ(core->objectsWithoutMeasuredCurve(), std::vector<std::uint64_t>{4});
+  EXPECT_EQ(core->objectsWithEstimatedCurve(), std::vector<std::uint64_t>{4});
   const auto& cow = scene.options[scene.objects[3].firstOption];
-  // Until the curve arrives: one point, the full mesh (exact).
-  EXPECT_EQ(cow.relativeTriangles.minAccuracy(), cow.relativeTriangles.maxAccuracy());
-  EXPECT_EQ(cow.relativeTriangles.resourcesFor(1.0), 5804.0);
+  // Until the curve arrives: the pessimistic estimate (curve_estimate.h).
+  EXPECT_EQ(cow.relativeTriangles.resourcesFor(1.0), 40.0);
+  EXPECT_EQ(cow.relativeTriangles.resourcesFor(10.0), 400.0);
+  EXPECT_EQ(cow.relativeTriangles.resourcesFor(60.0), 5804.0);
 
   std::vector<OutgoingRequest> requests = submitAll(*core);
   ASSERT_EQ(requests.size(), 1u);
@@ -102,6 +104,7 @@ TEST(BackboneCoreScene, PrimitivesHaveAnalyticCurvesAndTheCowWaitsForItsCurve) {
 
   EXPECT_EQ(core->curvesPending(), 0u);
   EXPECT_TRUE(core->objectsWithoutMeasuredCurve().empty());
+  EXPECT_TRUE(core->objectsWithEstimatedCurve().empty());
   const auto& measured = core->schedulingScene().options[scene.objects[3].firstOption];
   EXPECT_GT(measured.relativeTriangles.segments().size(), 2u);
   EXPECT_LT(measured.relativeTriangles.minAccuracy(), measured.relativeTriangles.maxAccuracy());

@@ -270,12 +270,15 @@ TEST(BackboneDaemonProcess, ServesPosesSurvivesBadBytesAndStopsOnSigterm) {
                           "20", "--log-level", "info"});
   ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
 
-  // The worker joins while the daemon waits for the cow's curve.
+  // Lockstep (--sync-wait-ms): the worker joins while the daemon waits for
+  // the cow's curve before ready, as the deterministic mode always did.
   FakeWorker worker(daemon.simplifierAddress());
   ASSERT_TRUE(
       pumpUntil([&] { worker.poll(10ms); }, [&] { return daemon.logContains("event=ready"); }))
       << daemon.log();
   EXPECT_TRUE(daemon.logContains("event=curves_ready"));
+  EXPECT_TRUE(daemon.logContains("event=curve_measured object=4"));
+  EXPECT_TRUE(daemon.logContains("estimated_curves=0"));
   EXPECT_EQ(worker.curveRequests, 1);
 
   Channel::Options frontendOptions;
@@ -412,6 +415,69 @@ TEST(BackboneDaemonProcess, ServesWithoutASimplifierAndCatchesUpWhenOneJoins) {
   EXPECT_EQ(daemon.stopWith(SIGINT), 0) << daemon.log();
 }
 
+// Live serving (--sync-wait-ms 0): ready at once with the cow on its
+// estimated curve, every pose answered without waiting, the curve request
+// held until the pose's requests are answered, then the measured curve
+// replaces the estimate (event=curve_measured, event=curves_ready).
+TEST(BackboneDaemonProcess, LiveServingIsReadyAtOnceAndMeasuresCurvesAfterThePosesRequests) {
+  const auto launched = Clock::now();
+  BackboneProcess daemon({"--budget-polygons", "200", "--log-level", "info"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+  const auto end = Clock::now() + kDeadline;
+  while (Clock::now() < end && !daemon.logContains("event=ready"))
+    std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(daemon.logContains("event=ready")) << daemon.log();
+  // No curve was measured, no worker is connected: ready all the same (well
+  // within the old 60 s curve wait; the process start is most of it).
+  EXPECT_LT(Clock::now() - launched, 30s);
+  EXPECT_TRUE(daemon.logContains("estimated_curves=1"));
+  EXPECT_FALSE(daemon.logContains("event=curves_ready"));
+
+  FakeWorker worker(daemon.simplifierAddress());
+  Channel::Options options;
+  options.address = daemon.frontendAddress();
+  options.hello.role = Role::kFrontend;
+  options.hello.name = "frontend-live";
+  options.transport = testTransport();
+  auto frontend = Channel::connect(options);
+  ASSERT_TRUE(frontend.ok());
+  std::vector<SceneUpdate> updates;
+  auto step = [&] {
+    worker.poll(5ms);
+    for (ChannelEvent& e : (*frontend)->poll(5ms)) {
+      if (e.kind == ChannelEvent::Kind::kMessage)
+        if (auto* u = std::get_if<SceneUpdate>(&e.message)) updates.push_back(*u);
+    }
+  };
+  ASSERT_TRUE(pumpUntil(step, [&] { return (*frontend)->connected() && worker.connected(); }));
+  EXPECT_EQ(worker.curveRequests, 0);  // held: no pose planned yet
+  ASSERT_TRUE((*frontend)->send(entrancePose(0, 0.0)).ok());
+  ASSERT_TRUE(pumpUntil(step, [&] { return !updates.empty(); })) << daemon.log();
+  EXPECT_EQ(updates[0].frame, 0u);
+  // The pose's requests are answered, then the curve request goes.
+  ASSERT_TRUE(pumpUntil(step, [&] { return daemon.logContains("event=curves_ready"); }))
+      << daemon.log();
+  EXPECT_EQ(worker.curveRequests, 1);
+  EXPECT_GT(worker.simplifyRequests + worker.impostorRequests, 1);
+  EXPECT_TRUE(daemon.logContains("event=curve_measured object=4 samples="));
+  // Representations made from the estimated plan reach the frontend.
+  std::uint64_t sequence = 1;
+  auto hasOperations = [&] {
+    for (const SceneUpdate& u : updates)
+      if (!u.operations.empty()) return true;
+    return false;
+  };
+  const auto deadline = Clock::now() + kDeadline;
+  while (!hasOperations() && Clock::now() < deadline) {
+    ASSERT_TRUE((*frontend)->send(entrancePose(sequence, sequence * 0.1)).ok());
+    const std::size_t before = updates.size();
+    ASSERT_TRUE(pumpUntil(step, [&] { return updates.size() > before; })) << daemon.log();
+    ++sequence;
+  }
+  EXPECT_TRUE(hasOperations()) << daemon.log();
+  EXPECT_EQ(daemon.stopWith(SIGTERM), 0) << daemon.log();
+}
+
 }  // namespace
 }  // namespace thinlod::protocol
 
@@ -422,7 +488,9 @@ namespace {
 // scene is refused with a reason naming both files; one that loaded the same
 // scene is served; the simplifier's requests carry the backbone's fingerprint.
 TEST(BackboneDaemonProcess, RefusesAFrontendThatLoadedAnotherScene) {
-  BackboneProcess daemon({"--budget-polygons", "400", "--curve-timeout-s", "20"});
+  // Lockstep (--sync-wait-ms): the cow's curve request goes at startup.
+  BackboneProcess daemon(
+      {"--budget-polygons", "400", "--curve-timeout-s", "20", "--sync-wait-ms", "1000"});
   ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
   FakeWorker worker(daemon.simplifierAddress());
   ASSERT_TRUE(

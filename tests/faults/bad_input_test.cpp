@@ -95,7 +95,10 @@ TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePe
       {THINLOD_BACKBONE_EXE, "--scene", kScene, "--models-dir", kModels, "--frontend.address",
        "tcp://127.0.0.1:0", "--simplifier.address", "tcp://127.0.0.1:0", "--ready-file",
        (dir.path() / "ready.json").string(), "--budget-polygons", "200", "--curve-timeout-s", "30",
-       "--transport.heartbeat_ms", "100", "--transport.liveness_misses", "50"},
+       // Lockstep (a sync wait): the cow's curve request goes at startup and
+       // the backbone waits for it before ready (live serving holds it back).
+       "--sync-wait-ms", "1", "--transport.heartbeat_ms", "100", "--transport.liveness_misses",
+       "50"},
       dir.path() / "backbone.log");
   ASSERT_TRUE(backbone.waitForLog("event=listening")) << backbone.log();
   // The backbone logs "listening" before it writes the ready file (renamed

@@ -233,8 +233,14 @@ Status BackboneCore::initialize() {
         state.baseTriangles = curve->scaledAccuracy(1.0 / (1.0 + kQuantizationShare));
         state.measuredCurve = true;
       } else {
-        // Until the simplifier's curve arrives: only the full mesh, exact.
-        state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy, record.fullTriangles);
+        // Until the simplifier's curve arrives: the pessimistic estimate.
+        Result<AccuracyCurve> estimate =
+            estimatedMeshCurve(std::max(1.0, record.fullTriangles), options_.curveEstimate);
+        if (!estimate.ok())
+          return Status(estimate.status().code(),
+                        "object " + idText(record.id) + ": " + estimate.status().message());
+        state.baseTriangles = std::move(estimate).value();
+        state.estimatedCurve = true;
         queueStartupRequest(k, static_cast<std::uint32_t>(scene_.options.size()), false);
       }
       scene_.options.push_back(std::move(option));
@@ -301,7 +307,13 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
   message.targetTriangles = request.targetTriangles;
   message.curvePoints = warmup ? 0 : options_.curvePoints;
   // Fresh ids from the planner's counter are never known to the ledger.
-  if (ledger_.ask(request).ok()) queued_.push_back({request.id, std::move(message)});
+  if (!ledger_.ask(request).ok()) return;
+  if (!warmup) ++curvesWanted_;
+  if (!warmup && options_.deferCurveRequests) {
+    heldCurves_.push_back({record.fullTriangles, OutgoingRequest{request.id, std::move(message)}});
+  } else {
+    queued_.push_back({request.id, std::move(message)});
+  }
 }
 
 void BackboneCore::rebuildCurves(std::uint32_t index) {
@@ -337,7 +349,28 @@ double BackboneCore::timeoutSeconds() const {
 std::vector<OutgoingRequest> BackboneCore::takeRequests() {
   std::vector<OutgoingRequest> out;
   out.swap(queued_);
+  // A held curve request goes when the viewer's requests are all answered
+  // (none queued here, none open in the ledger) and the last released curve
+  // is in: at most one measurement at a time, smallest mesh first.
+  if (posesPlanned_ > 0 && out.empty() && ledger_.openCount(RequestPurpose::kPlan) == 0 &&
+      releaseHeldCurve()) {
+    out.swap(queued_);
+  }
   return out;
+}
+
+bool BackboneCore::curveRequestOpen() const {
+  return releasedCurve_ != 0 && ledger_.open(releasedCurve_) != nullptr;
+}
+
+bool BackboneCore::releaseHeldCurve() {
+  if (heldCurves_.empty() || posesPlanned_ == 0 || curveRequestOpen()) return false;
+  auto smallest = std::min_element(heldCurves_.begin(), heldCurves_.end(),
+                                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  releasedCurve_ = smallest->second.requestId;
+  queued_.push_back(std::move(smallest->second));
+  heldCurves_.erase(smallest);
+  return true;
 }
 
 std::vector<std::uint64_t> BackboneCore::takeCancellations() {
@@ -361,11 +394,24 @@ void BackboneCore::withdraw(const LedgerRequest& request) {
   queued_.erase(std::remove_if(queued_.begin(), queued_.end(),
                                [&](const OutgoingRequest& r) { return r.requestId == request.id; }),
                 queued_.end());
+  heldCurves_.erase(
+      std::remove_if(heldCurves_.begin(), heldCurves_.end(),
+                     [&](const auto& held) { return held.second.requestId == request.id; }),
+      heldCurves_.end());
   planner_.releaseLinkReservation(request.id);
 }
 
 std::size_t BackboneCore::curvesPending() const {
   return ledger_.openCount(RequestPurpose::kCurve) + ledger_.openCount(RequestPurpose::kWarmup);
+}
+
+std::vector<std::uint64_t> BackboneCore::objectsWithEstimatedCurve() const {
+  std::vector<std::uint64_t> ids;
+  for (const OptionState& state : optionStates_) {
+    if (state.wireKind == protocol::RepresentationKind::kMesh && state.estimatedCurve)
+      ids.push_back(converted_.records[state.object].id);
+  }
+  return ids;
 }
 
 std::vector<std::uint64_t> BackboneCore::objectsWithoutMeasuredCurve() const {
@@ -523,9 +569,12 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
     Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
     if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
     learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
+    // The measured curve replaces the estimate (and any calibration learned
+    // against the estimate) in the scheduling scene.
     state.baseTriangles = std::move(fitted).value();
     state.calibration = 1.0;
     state.measuredCurve = true;
+    state.estimatedCurve = false;
     rebuildCurves(request.option);
     return Status();
   }
@@ -641,6 +690,7 @@ Status BackboneCore::runPlan() {
   if (!planned.ok()) return planned.status();
   plan_ = std::move(planned).value();
   ++plansThisPose_;
+  ++posesPlanned_;
   requestsThisPose_ += static_cast<std::uint32_t>(plan_->requests.size());
   schedulingMicrosecondsThisPose_ += plan_->row.schedulingMicroseconds;
   const double now = viewer_.timeSeconds;

@@ -4,8 +4,8 @@
 // Contract:
 // - create() converts the scene (scene_conversion.h) and gives every object
 //   its representation options: a simplified mesh (relative triangle curve:
-//   primitives analytic, meshes measured by the simplifier, a conservative
-//   point curve "full mesh, exact" until then) and, when enabled, meshed and
+//   primitives analytic, meshes measured by the simplifier, a pessimistic
+//   estimate until then: curve_estimate.h) and, when enabled, meshed and
 //   simple impostors (point curves from the texture size, learned from
 //   results). Link bytes are estimated from the results' encoded sizes
 //   (docs/backbone.md, "Link estimates").
@@ -19,6 +19,14 @@
 //   with a Status. One plan request per option is open at a time: a newer
 //   one (the scheduler asking again) replaces it, and the older id appears
 //   in takeCancellations().
+// - Startup curve requests (one per mesh object) are queued at create().
+//   With deferCurveRequests they are held back and released one at a time,
+//   smallest mesh first, after a pose has been planned, when no plan
+//   request is open (takeRequests) or when the shell calls
+//   releaseHeldCurve() (its duty-cycle rule, main.cpp): a first measurement
+//   of a large mesh occupies a simplifier for seconds, and the
+//   representations the viewer waits for go first. A measured curve replaces the estimate in the
+//   scheduling scene (the leaf's content version is bumped; no restart).
 // - Link: the LinkShaper is the one model of the link. Every byte it lets
 //   through is settled in the scheduler's link log under the copy's id
 //   (PlannerState::settleLinkSend), and a request that will never be shipped
@@ -50,6 +58,7 @@
 #include <variant>
 #include <vector>
 
+#include "curve_estimate.h"
 #include "frontend_mirror.h"
 #include "request_ledger.h"
 #include "scene_conversion.h"
@@ -91,6 +100,11 @@ struct CoreOptions {
   double meshedImpostorTriangles = 64.0;  // estimate until the first result
   std::uint16_t curvePoints = 32;         // samples asked for per mesh curve
   std::uint32_t curveRequestTriangles = 2000;
+  MeshCurveEstimate curveEstimate;  // meshes until their measured curve arrives
+  // Hold startup curve requests back while plan requests are open (live
+  // serving); false: queue them all at create() (lockstep: the shell waits
+  // for them before the first plan, as the paper experiment always did).
+  bool deferCurveRequests = false;
   bool hardPolygonCap = true;         // never let the frontend hold more than budget.maxTriangles
   double linkBurstBytes = 0.0;        // 0: max(budget-link * plannedLifetime, 64 KiB)
   double defaultAspect = 16.0 / 9.0;  // width/height when the pose has no viewport
@@ -153,7 +167,17 @@ class BackboneCore {
 
   // ---- startup curves ----
   std::size_t curvesPending() const;
+  std::size_t curvesWanted() const { return curvesWanted_; }
+  std::size_t curvesHeld() const { return heldCurves_.size(); }  // not released yet
+  // A released curve request without its answer yet.
+  bool curveRequestOpen() const;
+  // Releases the smallest held curve request now (queued for takeRequests)
+  // unless none is held, no pose was planned yet or one is open; true when
+  // one was released.
+  bool releaseHeldCurve();
   std::vector<std::uint64_t> objectsWithoutMeasuredCurve() const;  // mesh objects
+  // Mesh objects planning from the estimate (curve_estimate.h) right now.
+  std::vector<std::uint64_t> objectsWithEstimatedCurve() const;
 
   // ---- poses ----
   Status beginPose(const protocol::ViewerPose& pose);
@@ -215,6 +239,7 @@ class BackboneCore {
     AccuracyCurve baseTriangles;
     double calibration = 1.0;
     bool measuredCurve = false;
+    bool estimatedCurve = false;  // baseTriangles is estimatedMeshCurve (until measured)
     // Impostor kinds: point-curve estimates.
     double textureAccuracy = 0.0;  // scheduler-relative, what the texture supports
     double parallaxFactor = 1.0;   // lowered when validity cones miss the reach ball
@@ -263,6 +288,12 @@ class BackboneCore {
   RequestLedger ledger_;
   std::vector<OutgoingRequest> queued_;
   std::vector<std::uint64_t> cancellations_;
+  // Startup curve requests held back (deferCurveRequests), their mesh sizes,
+  // and the one released last (its id; 0 = none).
+  std::vector<std::pair<double, OutgoingRequest>> heldCurves_;
+  std::uint64_t releasedCurve_ = 0;
+  std::size_t curvesWanted_ = 0;
+  std::uint64_t posesPlanned_ = 0;
 
   // Current pose.
   bool inPose_ = false;

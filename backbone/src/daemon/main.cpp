@@ -86,7 +86,8 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("sync-wait-ms", &s.syncWaitMs,
                     "wait this long for a plan's simplifier results, then re-plan once (0: live)");
   runtime.addOption("curve-timeout-s", &s.curveTimeoutS,
-                    "at startup, wait this long for the meshes' accuracy curves before ready");
+                    "with --sync-wait-ms > 0 (lockstep): wait up to this long for the meshes' "
+                    "measured curves before ready; live serving is ready at once");
   runtime.addOption("curve-points", &s.curvePoints, "curve samples asked for per mesh");
   runtime.addOption("texture-size", &s.textureSize, "impostor texture size (pixels per side)");
   runtime.addOption("texture-codec", &s.textureCodec, "impostor textures: png | jpeg | zstd | raw");
@@ -150,6 +151,10 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--sync-wait-ms and --curve-timeout-s must be >= 0, the simplifier attempt "
                   "timeout and attempts > 0");
+  // Live serving plans from estimated curves at once and measures curves
+  // when the simplifier is free; lockstep waits for them before ready
+  // (deterministic, as before), so it asks for all of them at startup.
+  o.deferCurveRequests = s.syncWaitMs == 0;
   THINLOD_RETURN_IF_ERROR(thinlod::backbone_daemon::validateCoreOptions(o));
   return o;
 }
@@ -174,8 +179,10 @@ Status writeReadyFile(const std::string& path, const std::string& frontend,
 class Daemon {
  public:
   Daemon(protocol::DaemonRuntime& runtime, const Settings& settings, BackboneCore& core,
-         protocol::Endpoint& frontends, protocol::WorkerPool& workers, std::ofstream* csv)
-      : runtime_(runtime),
+         protocol::Endpoint& frontends, protocol::WorkerPool& workers, std::ofstream* csv,
+         Clock::time_point processStart)
+      : started_(processStart),
+        runtime_(runtime),
         settings_(settings),
         core_(core),
         frontends_(frontends),
@@ -188,12 +195,21 @@ class Daemon {
 
   int run() {
     submitRequests();
-    waitForCurves();
+    // Live serving is ready at once: meshes without a measured curve plan
+    // from the estimate (curve_estimate.h) and measured curves replace it as
+    // they arrive. Lockstep (a sync wait) is the deterministic mode: it waits
+    // for the curves first, as it always did.
+    if (settings_.syncWaitMs > 0) waitForCurves();
     if (runtime_.shutdownRequested()) return 0;
-    spdlog::info("event=ready frontend={} simplifier={} objects={} scheduler={} workers={}",
-                 frontends_.address(), workers_.endpoint().address(), core_.objects().size(),
-                 core_.schedulerName(), workers_.liveWorkers());
+    const auto estimated = core_.objectsWithEstimatedCurve();
+    spdlog::info(
+        "event=ready frontend={} simplifier={} objects={} scheduler={} workers={} "
+        "curves_wanted={} estimated_curves={} ms={:.0f}",
+        frontends_.address(), workers_.endpoint().address(), core_.objects().size(),
+        core_.schedulerName(), workers_.liveWorkers(), core_.curvesWanted(), estimated.size(),
+        msSinceStart());
     spdlog::default_logger()->flush();
+    if (core_.curvesPending() == 0) curvesReported_ = true;
     while (!runtime_.shutdownRequested()) {
       pump(100ms);
       servePoses();
@@ -204,31 +220,48 @@ class Daemon {
   }
 
  private:
+  double msSinceStart() const {
+    return std::chrono::duration<double, std::milli>(Clock::now() - started_).count();
+  }
+
+  // Lockstep only: before ready, wait up to --curve-timeout-s for the
+  // startup curves, so a deterministic run plans from measured curves as the
+  // paper experiment always did.
   void waitForCurves() {
     const auto deadline =
         Clock::now() + std::chrono::duration_cast<Clock::duration>(
                            std::chrono::duration<double>(settings_.curveTimeoutS));
     auto nextReport = Clock::now();
-    const std::size_t wanted = core_.curvesPending();
     while (!runtime_.shutdownRequested() && core_.curvesPending() > 0 && Clock::now() < deadline) {
       if (Clock::now() >= nextReport) {
-        spdlog::info("event=curves_waiting received={} wanted={} workers={}",
-                     wanted - core_.curvesPending(), wanted, workers_.liveWorkers());
+        spdlog::info("event=curves_waiting received={} wanted={} workers={} ms={:.0f}",
+                     core_.curvesWanted() - core_.curvesPending(), core_.curvesWanted(),
+                     workers_.liveWorkers(), msSinceStart());
         nextReport = Clock::now() + 2s;
       }
       pump(100ms);
       servePoses();
     }
-    const auto missing = core_.objectsWithoutMeasuredCurve();
-    if (!missing.empty()) {
-      std::string ids;
-      for (std::uint64_t id : missing) ids += (ids.empty() ? "" : ",") + std::to_string(id);
-      spdlog::warn(
-          "event=curves_missing objects={} note=\"full mesh (exact) until the curve arrives\"",
-          ids);
-    } else {
-      spdlog::info("event=curves_ready objects={}", wanted);
+    reportCurves(true);
+  }
+
+  // event=curves_ready once every curve is in; with `final` (the lockstep
+  // wait ended) event=curves_missing names the meshes still estimated.
+  void reportCurves(bool final) {
+    if (curvesReported_) return;
+    if (core_.curvesPending() == 0) {
+      spdlog::info("event=curves_ready objects={} ms={:.0f}", core_.curvesWanted(), msSinceStart());
+      curvesReported_ = true;
+      return;
     }
+    if (!final) return;
+    std::string ids;
+    for (std::uint64_t id : core_.objectsWithEstimatedCurve())
+      ids += (ids.empty() ? "" : ",") + std::to_string(id);
+    spdlog::warn(
+        "event=curves_missing objects={} ms={:.0f} note=\"estimated curves until they arrive\"",
+        ids, msSinceStart());
+    curvesReported_ = true;  // later arrivals are logged as event=curve_measured
   }
 
   // Waits up to `timeout` for input, then handles every socket's events.
@@ -240,6 +273,19 @@ class Daemon {
   }
 
   void submitRequests() {
+    // Duty cycle of the held curve requests (live serving): besides the idle
+    // moments the core uses, release one when the previous curve answer is
+    // three of its own service times old, so measurements take at most about
+    // a quarter of the simplifier's time while the viewer's requests wait (a
+    // cached curve answers in milliseconds, a cold 100k-triangle one in ~10 s).
+    // Service time = answer - max(release, the result before it): a worker
+    // answers in order, so the queue wait before it is not counted.
+    const auto now = Clock::now();
+    if (core_.curvesHeld() > 0 && workers_.liveWorkers() > 0 && now >= nextCurveAt_ &&
+        core_.releaseHeldCurve()) {
+      curveReleasedAt_ = now;
+      nextCurveAt_ = Clock::time_point::max();  // until its answer
+    }
     for (std::uint64_t id : core_.takeCancellations()) workers_.cancel(id);
     // The pool sends each request under the id the core (and the scheduler) gave it.
     for (auto& request : core_.takeRequests()) {
@@ -301,9 +347,27 @@ class Daemon {
         spdlog::info("event=worker_left worker={} workers={} pending={}", event.worker.value,
                      workers_.liveWorkers(), workers_.pendingRequests());
         break;
-      case protocol::WorkerPoolEvent::Kind::kSimplifyResult:
+      case protocol::WorkerPoolEvent::Kind::kSimplifyResult: {
+        lastResultAt_ = resultAt_;
+        const std::size_t pendingBefore = core_.curvesPending();
         noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId);
+        if (core_.curvesPending() < pendingBefore) {
+          const auto now = Clock::now();
+          if (curveReleasedAt_) {
+            const auto began = std::max(*curveReleasedAt_, lastResultAt_);
+            nextCurveAt_ = now + 3 * (now - began);
+          }
+          curveReleasedAt_.reset();
+          // Progress of the startup curves (each replaces an estimate).
+          spdlog::info(
+              "event=curve_measured object={} samples={} received={} wanted={} held={} ms={:.0f}",
+              event.simplify.objectId, event.simplify.curve.size(),
+              core_.curvesWanted() - core_.curvesPending(), core_.curvesWanted(),
+              core_.curvesHeld(), msSinceStart());
+          reportCurves(false);
+        }
         break;
+      }
       case protocol::WorkerPoolEvent::Kind::kImpostorResult:
         noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId);
         break;
@@ -311,6 +375,7 @@ class Daemon {
   }
 
   void noteResult(const Status& status, const char* kind, std::uint64_t requestId) {
+    resultAt_ = Clock::now();
     if (status.ok()) {
       ++resultsAccepted_;
       spdlog::debug("event=result kind={} request={}", kind, requestId);
@@ -431,6 +496,7 @@ class Daemon {
     }
   }
 
+  Clock::time_point started_;  // process start: ms= in the logs counts from it
   protocol::DaemonRuntime& runtime_;
   const Settings& settings_;
   BackboneCore& core_;
@@ -442,6 +508,13 @@ class Daemon {
   std::optional<protocol::PeerId> active_;
   std::map<std::uint64_t, protocol::Hello> hellos_;  // joined frontends by peer id
   bool hadFrontend_ = false;
+  bool curvesReported_ = false;
+  // Duty cycle of held curve requests (submitRequests): the first may go
+  // 2 s after startup, the next three answer durations after an answer.
+  std::optional<Clock::time_point> curveReleasedAt_;
+  Clock::time_point nextCurveAt_ = Clock::now() + 2s;
+  Clock::time_point resultAt_;      // the latest simplifier result
+  Clock::time_point lastResultAt_;  // the one before the result being handled
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;
 };
@@ -449,6 +522,7 @@ class Daemon {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const Clock::time_point processStart = Clock::now();
   protocol::DaemonRuntime runtime("thinlod-backbone",
                                   "thinlod backbone: schedules level of detail for frontends "
                                   "with accuracy curves and asks simplifiers for representations");
@@ -484,7 +558,9 @@ int main(int argc, char** argv) {
   const std::string scenePath = (ec || canonical.empty() ? absolute : canonical).string();
   thinlod::scene::SceneLoadOptions load;
   if (!settings.modelsDir.empty()) load.meshSearchPaths = {settings.modelsDir};
+  const auto loadStarted = Clock::now();
   thinlod::Result<thinlod::scene::Scene> scene = thinlod::scene::loadSceneFile(scenePath, load);
+  const auto loaded = Clock::now();
   if (!scene.ok()) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, scene.status().toString());
     return 1;
@@ -498,10 +574,16 @@ int main(int argc, char** argv) {
     return 1;
   }
   BackboneCore& backbone = **core;
-  spdlog::info("event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={}",
-               scenePath, protocol::fingerprintText(backbone.sceneFingerprint()),
-               backbone.objects().size(), backbone.lodNodes(),
-               backbone.schedulingScene().options.size(), backbone.curvesPending());
+  const auto msBetween = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  spdlog::info(
+      "event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={} "
+      "start_ms={:.0f} load_ms={:.0f} convert_ms={:.0f}",
+      scenePath, protocol::fingerprintText(backbone.sceneFingerprint()), backbone.objects().size(),
+      backbone.lodNodes(), backbone.schedulingScene().options.size(), backbone.curvesPending(),
+      msBetween(processStart, loadStarted), msBetween(loadStarted, loaded),
+      msBetween(loaded, Clock::now()));
 
   std::optional<std::ofstream> csv;
   if (!settings.decisionsCsv.empty()) {
@@ -549,6 +631,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  Daemon daemon(runtime, settings, backbone, **frontends, **workers, csv ? &*csv : nullptr);
+  Daemon daemon(runtime, settings, backbone, **frontends, **workers, csv ? &*csv : nullptr,
+                processStart);
   return daemon.run();
 }

@@ -1,5 +1,6 @@
 #include "thinlod/frontend/frontend_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
@@ -134,6 +135,7 @@ Status FrontendScene::enqueue(SceneBatch batch) {
       object.uploadBytes = uploadBytesOf(*rep.mesh, rep.texture.get());
     }
     queued.uploaded.push_back(op.type == SceneOperation::Type::kRemove);
+    queued.shownEarly.push_back(false);
     queued.objects.push_back(std::move(object));
   }
   pending_.push_back(std::move(queued));
@@ -182,7 +184,9 @@ std::vector<RepresentationKey> FrontendScene::dropBatch(std::uint64_t batchSeque
   for (auto it = pending_.begin(); it != pending_.end(); ++it) {
     if (it->sequence != batchSequence) continue;
     for (std::size_t i = 0; i < it->objects.size(); ++i) {
-      if (it->types[i] == SceneOperation::Type::kAddOrReplace) keys.push_back(it->objects[i].key);
+      // A first representation shown early is held now: its GPU copy stays.
+      if (it->types[i] == SceneOperation::Type::kAddOrReplace && !it->shownEarly[i])
+        keys.push_back(it->objects[i].key);
     }
     pending_.erase(it);
     break;
@@ -198,6 +202,7 @@ CommitResult FrontendScene::commitReady() {
     for (bool done : batch.uploaded) complete = complete && done;
     if (!complete) break;
     for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (batch.shownEarly[i]) continue;  // applied already (showFirstRepresentationsEarly)
       SceneObject& incoming = batch.objects[i];
       auto held = objects_.find(incoming.id);
       if (held != objects_.end()) {
@@ -220,7 +225,48 @@ CommitResult FrontendScene::commitReady() {
     lastPlan_ = batch.plan;
     pending_.pop_front();
   }
+  showFirstRepresentationsEarly(result);
   return result;
+}
+
+void FrontendScene::showFirstRepresentationsEarly(CommitResult& result) {
+  // Walk the queued operations in order with the triangle change of the
+  // prefix so far (relative to what is held now) and its running maximum.
+  // An operation shown early contributes nothing afterwards: the held state
+  // already includes it, so the prefix sums stay relative to the new state.
+  std::map<ObjectId, std::size_t> simulated;  // id -> triangles after the prefix
+  auto trianglesOf = [&](ObjectId id) -> std::size_t {
+    auto s = simulated.find(id);
+    if (s != simulated.end()) return s->second;
+    auto held = objects_.find(id);
+    return held == objects_.end() ? 0 : held->second.triangleCount;
+  };
+  std::unordered_set<ObjectId> touched;  // ids with an earlier queued operation
+  long long prefix = 0;
+  long long highest = 0;
+  for (QueuedBatch& batch : pending_) {
+    for (std::size_t i = 0; i < batch.objects.size(); ++i) {
+      if (batch.shownEarly[i]) continue;
+      SceneObject& incoming = batch.objects[i];
+      const bool add = batch.types[i] == SceneOperation::Type::kAddOrReplace;
+      const bool first = add && objects_.count(incoming.id) == 0 && touched.count(incoming.id) == 0;
+      if (first && batch.uploaded[i] && prefix >= highest) {
+        batch.shownEarly[i] = true;
+        result.activated.push_back(incoming.key);
+        ++result.shownEarly;
+        polygons_ += incoming.triangleCount;
+        objects_[incoming.id] = incoming;  // the batch keeps its entry (skipped at commit)
+        touched.insert(incoming.id);
+        continue;
+      }
+      const std::size_t before = trianglesOf(incoming.id);
+      const std::size_t after = add ? incoming.triangleCount : 0;
+      prefix += static_cast<long long>(after) - static_cast<long long>(before);
+      highest = std::max(highest, prefix);
+      simulated[incoming.id] = after;
+      touched.insert(incoming.id);
+    }
+  }
 }
 
 const SceneObject* FrontendScene::find(ObjectId id) const {

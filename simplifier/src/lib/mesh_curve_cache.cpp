@@ -273,19 +273,15 @@ Result<MeshCurves> MeshCurveCache::getOrMeasure(const IndexedMesh& original,
   const std::string key =
       meshCurveCacheKey(original, producer, minTriangles, maxTriangles, options);
   const std::filesystem::path path = fileFor(key);
-  std::error_code ec;
-  if (std::filesystem::exists(path, ec)) {
-    Result<std::string> text = readSmallFile(path);
-    if (text.ok()) {
-      Result<MeshCurves> cached = parseMeshCurves(*text, key);
-      if (cached.ok()) {
-        ++stats_.hits;
-        return cached;
-      }
-    }
-    ++stats_.rejected;
-  } else {
+  Result<MeshCurves> stored = readStored(key);
+  if (stored.ok()) {
+    ++stats_.hits;
+    return stored;
+  }
+  if (stored.status().code() == ErrorCode::kNotFound) {
     ++stats_.misses;
+  } else {
+    ++stats_.rejected;
   }
   Result<MeshCurves> measured =
       measureMeshCurves(original, minTriangles, maxTriangles, extract, options);
@@ -294,6 +290,30 @@ Result<MeshCurves> MeshCurveCache::getOrMeasure(const IndexedMesh& original,
     ++stats_.writeFailures;
   }
   return measured;
+}
+
+Result<MeshCurves> MeshCurveCache::readStored(const std::string& key) {
+  const std::filesystem::path path = fileFor(key);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    return Status(ErrorCode::kNotFound, "mesh curve cache: no " + path.string());
+  Result<std::string> text = readSmallFile(path);
+  if (!text.ok()) return text.status();
+  return parseMeshCurves(*text, key);
+}
+
+Result<MeshCurves> MeshCurveCache::find(const IndexedMesh& original, const std::string& producer,
+                                        const ProgressiveMesh& pm,
+                                        const MeshCurveOptions& options) {
+  const std::string key = meshCurveCacheKey(
+      original, producer, std::max<std::size_t>(1, pm.minTriangles()), pm.maxTriangles(), options);
+  Result<MeshCurves> stored = readStored(key);
+  if (stored.ok()) {
+    ++stats_.hits;
+  } else if (stored.status().code() != ErrorCode::kNotFound) {
+    ++stats_.rejected;
+  }
+  return stored;
 }
 
 Result<MeshCurves> MeshCurveCache::getOrMeasure(const IndexedMesh& original,

@@ -4,6 +4,7 @@
 #include "thinlod/simplifier/service.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -155,9 +156,21 @@ void SimplifierService::Impl::dropUnusedModels() {
 Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const IndexedMesh> mesh,
                                                        const std::string& what) {
   auto model = std::make_unique<MeshModel>();
+  // Builds of large meshes take a second or more: say so in the log.
+  constexpr std::size_t kReportBuildsFrom = 20000;
+  const bool report = mesh->triangleCount() >= kReportBuildsFrom;
+  const auto started = std::chrono::steady_clock::now();
+  if (report)
+    progress("event=pm_build_started what=\"" + what +
+             "\" triangles=" + std::to_string(mesh->triangleCount()));
   Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh);
   if (!pm.ok()) return Status(pm.status().code(), what + ": " + pm.status().message());
   ++stats.progressiveMeshBuilds;
+  if (report)
+    progress("event=pm_build_done what=\"" + what + "\" ms=" +
+             std::to_string(std::llround(std::chrono::duration<double, std::milli>(
+                                             std::chrono::steady_clock::now() - started)
+                                             .count())));
   model->pm = std::move(pm).value();
   model->diameter = referenceLength(referenceSphere(*mesh));
   model->original = std::move(mesh);
@@ -197,12 +210,41 @@ Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::B
   return raw;
 }
 
+bool SimplifierService::Impl::curveWithoutMeasuring(MeshModel& model) {
+  if (model.curveReady) return true;
+  if (!curveCache || model.cacheLookedUp) return false;
+  model.cacheLookedUp = true;
+  Result<MeshCurves> curves =
+      curveCache->find(*model.original, kCurveProducer, model.pm, options.curve);
+  if (!curves.ok() || curves->levels.empty()) return false;
+  ++stats.curvesFromDisk;
+  model.ladder = creditLevels(curves->levels, options.curve.minRelativeError);
+  model.curveReady = true;
+  return true;
+}
+
 Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   if (model.curveReady) return Status();
   Result<MeshCurves> curves = Status(ErrorCode::kInternal, "not measured");
+  // A measurement takes seconds for a large mesh: one progress line per level.
+  const std::size_t minTriangles = std::max<std::size_t>(1, model.pm.minTriangles());
+  const std::size_t levels =
+      geometricLadder(minTriangles, model.pm.maxTriangles(), options.curve.levels).size();
+  std::size_t level = 0;
+  const auto started = std::chrono::steady_clock::now();
+  const ExtractTriangles extract = [&](std::size_t n) {
+    progress("event=curve_progress mesh_triangles=" + std::to_string(model.pm.maxTriangles()) +
+             " level=" + std::to_string(++level) + "/" + std::to_string(levels) +
+             " triangles=" + std::to_string(n) + " ms=" +
+             std::to_string(std::llround(std::chrono::duration<double, std::milli>(
+                                             std::chrono::steady_clock::now() - started)
+                                             .count())));
+    return model.pm.extract(n);
+  };
   if (curveCache) {
     const int hitsBefore = curveCache->stats().hits;
-    curves = curveCache->getOrMeasure(*model.original, kCurveProducer, model.pm, options.curve);
+    curves = curveCache->getOrMeasure(*model.original, kCurveProducer, minTriangles,
+                                      model.pm.maxTriangles(), extract, options.curve);
     if (curves.ok()) {
       if (curveCache->stats().hits > hitsBefore) {
         ++stats.curvesFromDisk;
@@ -211,7 +253,8 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
       }
     }
   } else {
-    curves = measureMeshCurves(*model.original, model.pm, options.curve);
+    curves = measureMeshCurves(*model.original, minTriangles, model.pm.maxTriangles(), extract,
+                               options.curve);
     if (curves.ok()) ++stats.curvesMeasured;
   }
   if (!curves.ok()) return curves.status();
@@ -223,6 +266,28 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
 
 Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     const protocol::SimplifyRequest& request, MeshModel& model) {
+  if (options.answerBeforeCurve &&
+      request.target == protocol::SimplifyRequest::Target::kTriangles && request.curvePoints == 0 &&
+      !curveWithoutMeasuring(model)) {
+    // Cold start: measure the one level asked for, not the whole ladder.
+    const IndexedMesh mesh =
+        model.pm.extract(std::min<std::size_t>(request.targetTriangles, model.pm.maxTriangles()));
+    Result<SurfaceError> error = measureSurfaceError(*model.original, mesh, options.curve.error);
+    if (!error.ok()) return error.status();
+    ++stats.levelsMeasuredAlone;
+    const double d =
+        std::max(relativeError(error->max(), model.diameter), options.curve.minRelativeError);
+    const DeliveredLevel delivered = deliveredLevel(d);
+    MeshEncodeOptions encode;
+    encode.positionBits = delivered.positionBits;
+    Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
+    if (!frame.ok()) return frame.status();
+    protocol::SimplifyResult result;
+    result.mesh = std::move(frame).value();
+    result.triangleCount = frameTriangles(result.mesh);
+    result.accuracy = delivered.accuracy;
+    return result;
+  }
   THINLOD_RETURN_IF_ERROR(ensureCurve(model));
   const ProgressiveMesh& pm = model.pm;
   std::size_t target = pm.maxTriangles();

@@ -216,6 +216,16 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
       mesh = cached->second;
       levelError = std::max(levelError, tessellationError(shape, params) * scale);
     } else {
+      // Cold start: without a known curve (memory or cache file) the full
+      // mesh is rendered (error 0) rather than measuring the curve first.
+      if (options.answerBeforeCurve && object->fullMesh) {
+        auto built = meshModels.find(object->fullMesh.get());
+        if (built == meshModels.end() || !curveWithoutMeasuring(*built->second)) {
+          impostorScene.parts.push_back(ImpostorPart{object->fullMesh, object->objectToWorld,
+                                                     scene::shapeMaterial(*object->shape)});
+          continue;
+        }
+      }
       Result<MeshModel*> model = meshModelFor(*object);
       if (!model.ok()) return model.status();
       THINLOD_RETURN_IF_ERROR(ensureCurve(**model));

@@ -70,6 +70,7 @@ struct MeshModel {
   double diameter = 0.0;  // L of `original` (referenceLength(referenceSphere(original)))
   ProgressiveMesh pm;
   bool curveReady = false;
+  bool cacheLookedUp = false;  // curveWithoutMeasuring found no file once: do not ask again
   std::vector<LevelCredit> ladder;
   // Levels kept for impostor rendering (their GPU copies live as long as these).
   std::map<std::size_t, std::shared_ptr<const IndexedMesh>> renderLevels;
@@ -123,6 +124,12 @@ struct SimplifierService::Impl {
   Result<service_detail::MeshModel*> buildModel(std::shared_ptr<const IndexedMesh> mesh,
                                                 const std::string& what);
   Status ensureCurve(service_detail::MeshModel& model);
+  // The curve from memory or the cache file only (never measured): true when
+  // model.ladder is ready afterwards.
+  bool curveWithoutMeasuring(service_detail::MeshModel& model);
+  void progress(const std::string& line) const {
+    if (options.progress) options.progress(line);
+  }
   Status ensureRendering();
   void dropUnusedModels();
 

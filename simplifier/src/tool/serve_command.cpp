@@ -146,13 +146,14 @@ Answer handle(SimplifierService& service, const Request& request) {
     if (result.status.ok()) {
       spdlog::info(
           "event=simplify_done request={} object={} target={} asked={} triangles={} "
-          "accuracy={:.4g} curve_points={} mesh_bytes={} ms={:.1f} pm_builds={}",
+          "accuracy={:.4g} curve_points={} mesh_bytes={} ms={:.1f} pm_builds={} "
+          "levels_alone={}",
           simplify->requestId, simplify->objectId, targetName(*simplify),
           simplify->target == SimplifyRequest::Target::kTriangles
               ? static_cast<double>(simplify->targetTriangles)
               : simplify->targetAccuracy,
           result.triangleCount, result.accuracy, result.curve.size(), result.mesh.size(), ms,
-          service.stats().progressiveMeshBuilds);
+          service.stats().progressiveMeshBuilds, service.stats().levelsMeasuredAlone);
     } else {
       spdlog::warn("event=simplify_failed request={} object={} ms={:.1f} error=\"{}\"",
                    simplify->requestId, simplify->objectId, ms, result.status.toString());
@@ -199,6 +200,7 @@ struct ServeConfig {
   static ServiceOptions daemonServiceDefaults() {
     ServiceOptions options;
     options.sceneRoot = ".";
+    options.answerBeforeCurve = true;  // cold start: answer before measuring whole curves
     return options;
   }
 };
@@ -238,6 +240,9 @@ int runServe(const std::vector<std::string>& args) {
   runtime.addOption("cache-dir", &config.service.curveCacheDir,
                     "measured-curve cache directory (default $THINLOD_CACHE_DIR or "
                     "build/cache/curves)");
+  runtime.addOption("answer-before-curve", &config.service.answerBeforeCurve,
+                    "answer a mesh without a known curve from its one measured level (curve "
+                    "requests still measure the whole curve); =false: measure the curve first");
   runtime.addOption("backend", &config.backend, "offscreen rendering: auto|egl|osmesa");
   runtime.addOption("capacity", &config.capacity,
                     "requests the backbone may queue here at once (run one at a time)");
@@ -296,6 +301,8 @@ int runServe(const std::vector<std::string>& args) {
   options.defaultTextureSize = static_cast<std::uint32_t>(config.textureSize);
   options.maxTextureSize = static_cast<std::uint32_t>(config.maxTextureSize);
   options.meshedImpostorTriangles = static_cast<std::size_t>(config.meshedTriangles);
+  // Long work (curve measurements, builds of large meshes) in the log.
+  options.progress = [](const std::string& line) { spdlog::info("{}", line); };
 
   WorkQueue queue;
   if (!queue.valid()) {

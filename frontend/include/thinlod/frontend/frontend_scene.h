@@ -1,6 +1,8 @@
 // FrontendScene: what the thin client holds (Pasman & Jansen 2002, section 4):
 // one representation per object id, replaced by atomic update batches that
-// become visible only once every new representation in them is on the GPU.
+// become visible only once every new representation in them is on the GPU
+// (an object's FIRST representation is shown as soon as its own upload is
+// done, see commitReady).
 //
 // Contract:
 // - Representations are already decoded (IndexedMesh + RgbaImage); the wire
@@ -15,7 +17,20 @@
 //   within a byte bound (one oversized item may go alone so nothing stalls);
 //   markUploaded()/dropBatch() report back. commitReady() applies every fully
 //   uploaded batch at the head of the queue, in arrival order, all operations
-//   of a batch in one step; until then the previous representations stay.
+//   of a batch in one step; until then the previous representations stay
+//   (old until complete: replacements and removals wait for their batch).
+// - First representations early: an uploaded AddOrReplace of an object the
+//   scene does not hold, with no earlier queued operation on that id, is
+//   shown at once (before its batch completes) when the operations queued
+//   before it do not free triangles on any prefix: with P_j the triangle
+//   change of the first j queued operations and k operations queued before
+//   it, it goes early only if P_k >= P_j for every j <= k (P_0 = 0; checked
+//   per operation, so conservative inside a batch). Then every triangle count the
+//   scene passes through is at most one the operation stream passes through
+//   in order (the backbone checked those against its polygon cap), so early
+//   display never exceeds the budget (FrontendSceneEarly.* tests it). Its
+//   batch still commits (and reports its plan) as a whole later; dropBatch()
+//   does not return the key of a representation already shown.
 // - Removing an id that is not held is not an error (counted, see CommitResult).
 // - Keys: every queued representation gets a unique RepresentationKey, never
 //   reused, so GPU resources can be tracked by key across replacements.
@@ -90,6 +105,7 @@ struct CommitResult {
   std::vector<RepresentationKey> activated;  // now drawn
   std::vector<RepresentationKey> released;   // replaced or removed: free their GPU resources
   std::size_t missingRemovals = 0;           // removals of ids not held
+  std::size_t shownEarly = 0;  // first representations activated before their batch completed
   bool changed() const { return !activated.empty() || !released.empty(); }
 };
 
@@ -140,7 +156,10 @@ class FrontendScene {
     std::vector<SceneOperation::Type> types;
     std::vector<SceneObject> objects;  // one per operation (removals: id only)
     std::vector<bool> uploaded;        // per operation; removals start true
+    std::vector<bool> shownEarly;      // per operation: a first representation already held
   };
+  // Activates first representations early (see the contract); appends to `result`.
+  void showFirstRepresentationsEarly(CommitResult& result);
 
   SceneLimits limits_;
   std::map<ObjectId, SceneObject> objects_;

@@ -119,12 +119,19 @@ class MeshCurveCache {
                                   const MeshCurveOptions& options = {});
   Result<MeshCurves> getOrMeasure(const IndexedMesh& original, const std::string& producer,
                                   const ProgressiveMesh& pm, const MeshCurveOptions& options = {});
+  // The stored curves only, never measuring: kNotFound when there is no
+  // valid file (a corrupt or stale one counts as rejected). Ladder = pm's.
+  Result<MeshCurves> find(const IndexedMesh& original, const std::string& producer,
+                          const ProgressiveMesh& pm, const MeshCurveOptions& options = {});
 
   std::filesystem::path fileFor(const std::string& key) const;
   const std::filesystem::path& directory() const { return directory_; }
   const Stats& stats() const { return stats_; }
 
  private:
+  // The parsed file for `key`; kNotFound (no file) or its parse error.
+  Result<MeshCurves> readStored(const std::string& key);
+
   std::filesystem::path directory_;
   Stats stats_;
 };

@@ -12,6 +12,17 @@
 //   a level is credited with the worst error measured at its ladder rung or
 //   any finer one, plus the Draco quantization bound (docs/simplifier.md).
 //   Primitives use the analytic tessellation error instead.
+// - Cold start (options.answerBeforeCurve; the daemon's default): a
+//   kTriangles SimplifyRequest without curvePoints for a mesh whose curve is
+//   neither in memory nor in the curve cache does not wait for the whole
+//   ladder: the extracted level's own error is measured (one
+//   measureSurfaceError, about 1/12 of a curve) and credited (plus the
+//   quantization bound); such credits are not monotone across levels.
+//   Requests with curvePoints > 0 (the backbone's curve requests) and
+//   kAccuracy targets measure the full curve. Impostors of such a mesh render
+//   the full mesh (error 0) until its curve is known.
+// - options.progress (optional) hears long work: progressive-mesh builds of
+//   large meshes and each level of a curve measurement (one line each).
 // - Mesh bytes are codec frames (encodeMesh: Draco inside); textures are
 //   raw RGBA8 for kRawRgba8, else encodeTextureWith frames. JPEG needs an
 //   opaque texture: impostors have alpha, so a JPEG request gets PNG (the
@@ -28,6 +39,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,7 +73,12 @@ struct ServiceOptions {
   // (texture and level only; parallax within accuracyBound), kept for
   // docs/results/guarantee.md's comparison.
   bool impostorGuaranteeCredit = true;
+  // Answer meshes without a known curve from one measured level (see above);
+  // false: measure the curve first (every credit from the ladder).
+  bool answerBeforeCurve = false;
   MeshCurveOptions curve = defaultCurveOptions();
+  // Called (on the service's thread) with one log line per step of long work.
+  std::function<void(const std::string&)> progress;
 
   static MeshCurveOptions defaultCurveOptions();
 };
@@ -70,8 +87,9 @@ struct ServiceOptions {
 struct ServiceStats {
   std::uint64_t sceneLoads = 0;
   std::uint64_t progressiveMeshBuilds = 0;
-  std::uint64_t curvesMeasured = 0;  // computed (disk cache miss or no cache)
-  std::uint64_t curvesFromDisk = 0;  // read from the curve cache directory
+  std::uint64_t curvesMeasured = 0;       // computed (disk cache miss or no cache)
+  std::uint64_t curvesFromDisk = 0;       // read from the curve cache directory
+  std::uint64_t levelsMeasuredAlone = 0;  // cold-start answers: one level measured, no curve
   std::uint64_t simplifyRequests = 0;
   std::uint64_t impostorRequests = 0;
   std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
