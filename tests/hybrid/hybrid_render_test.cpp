@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <glm/gtc/matrix_transform.hpp>
 #include <memory>
+#include <tuple>
 
 #include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/mesh/mesh_io.h"
@@ -36,7 +37,8 @@ struct Rig {
   }
 };
 
-::testing::AssertionResult makeRig(render::Backend backend, int size, Rig& rig) {
+::testing::AssertionResult makeRig(render::Backend backend, int size, Rig& rig,
+                                   render::DiscStyle style = render::DiscStyle::kInstancedQuads) {
   auto context = render::createOffscreenContext(backend, size, size);
   if (!context.ok()) return ::testing::AssertionFailure() << context.status().toString();
   rig.context = std::move(context).value();
@@ -46,7 +48,7 @@ struct Rig {
   auto meshes = render::MeshRenderer::create(*rig.context);
   if (!meshes.ok()) return ::testing::AssertionFailure() << meshes.status().toString();
   rig.meshes = std::move(meshes).value();
-  auto discs = render::DiscRenderer::create(*rig.context);
+  auto discs = render::DiscRenderer::create(*rig.context, style);
   if (!discs.ok()) return ::testing::AssertionFailure() << discs.status().toString();
   rig.discs = std::move(discs).value();
   return ::testing::AssertionSuccess();
@@ -67,11 +69,17 @@ DiscPoints oneDisc(glm::vec3 centre, float radius, std::array<std::uint8_t, 4> c
   return p;
 }
 
-class DiscRendererTest : public ::testing::TestWithParam<render::Backend> {};
+class DiscRendererTest
+    : public ::testing::TestWithParam<std::tuple<render::Backend, render::DiscStyle>> {
+ protected:
+  ::testing::AssertionResult rig(int size, Rig& out) {
+    return makeRig(std::get<0>(GetParam()), size, out, std::get<1>(GetParam()));
+  }
+};
 
 TEST_P(DiscRendererTest, DrawsARoundDiscOfTheWorldRadius) {
   Rig rig;
-  ASSERT_TRUE(makeRig(GetParam(), 64, rig));
+  ASSERT_TRUE(this->rig(64, rig));
   auto handle = rig.discs->upload(oneDisc(glm::vec3(0.0f), 0.5f, {255, 0, 0, 255}));
   ASSERT_TRUE(handle.ok()) << handle.status().toString();
   ASSERT_TRUE(rig.meshes->beginFrame(*rig.target, glm::vec4(0, 0, 0, 1)).ok());
@@ -96,7 +104,7 @@ TEST_P(DiscRendererTest, DrawsARoundDiscOfTheWorldRadius) {
 
 TEST_P(DiscRendererTest, DiscsLandWhereTheCameraProjectsThem) {
   Rig rig;
-  ASSERT_TRUE(makeRig(GetParam(), 64, rig));
+  ASSERT_TRUE(this->rig(64, rig));
   // Up-left of the centre, under a perspective camera (rows top-down).
   Camera camera;
   camera.view = glm::lookAt(glm::vec3(0.0f, 0.0f, 5.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0));
@@ -117,7 +125,7 @@ TEST_P(DiscRendererTest, DiscsLandWhereTheCameraProjectsThem) {
 
 TEST_P(DiscRendererTest, DiscsAreDepthTestedAgainstTriangles) {
   Rig rig;
-  ASSERT_TRUE(makeRig(GetParam(), 32, rig));
+  ASSERT_TRUE(this->rig(32, rig));
   IndexedMesh quad;
   quad.positions = {{-1, -1, 0}, {0, -1, 0}, {0, 1, 0}, {-1, 1, 0}};  // the left half, z = 0
   quad.indices = {0, 1, 2, 0, 2, 3};
@@ -147,7 +155,7 @@ TEST_P(DiscRendererTest, DiscsAreDepthTestedAgainstTriangles) {
 
 TEST_P(DiscRendererTest, TinyDiscsStillCoverAPixel) {
   Rig rig;
-  ASSERT_TRUE(makeRig(GetParam(), 32, rig));
+  ASSERT_TRUE(this->rig(32, rig));
   auto discs =
       rig.discs->upload(oneDisc(glm::vec3(0.03125f, 0.03125f, 0.0f), 1e-6f, {255, 255, 255, 255}));
   ASSERT_TRUE(discs.ok());
@@ -165,7 +173,7 @@ TEST_P(DiscRendererTest, TinyDiscsStillCoverAPixel) {
 
 TEST_P(DiscRendererTest, RejectsBadInputAndUnknownHandles) {
   Rig rig;
-  ASSERT_TRUE(makeRig(GetParam(), 16, rig));
+  ASSERT_TRUE(this->rig(16, rig));
   DiscPoints bad = oneDisc(glm::vec3(0.0f), -1.0f, {1, 2, 3, 4});
   EXPECT_EQ(rig.discs->upload(bad).status().code(), ErrorCode::kInvalidArgument);
   const render::DiscDrawItem unknown{render::DiscHandle{99}, glm::mat4(1.0f)};
@@ -180,11 +188,15 @@ TEST_P(DiscRendererTest, RejectsBadInputAndUnknownHandles) {
   EXPECT_EQ(rig.discs->draw(&removed, 1, orthoCamera()).code(), ErrorCode::kNotFound);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, DiscRendererTest,
-                         ::testing::Values(render::Backend::kEgl, render::Backend::kOsMesa),
-                         [](const ::testing::TestParamInfo<render::Backend>& info) {
-                           return std::string(render::backendName(info.param));
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    BackendsAndStyles, DiscRendererTest,
+    ::testing::Combine(::testing::Values(render::Backend::kEgl, render::Backend::kOsMesa),
+                       ::testing::Values(render::DiscStyle::kInstancedQuads,
+                                         render::DiscStyle::kPointSprites)),
+    [](const ::testing::TestParamInfo<DiscRendererTest::ParamType>& info) {
+      return std::string(render::backendName(std::get<0>(info.param))) +
+             (std::get<1>(info.param) == render::DiscStyle::kPointSprites ? "_sprites" : "_quads");
+    });
 
 TEST(DiscRendering, PreLightingMatchesTheLambertTerm) {
   DiscPoints p = oneDisc(glm::vec3(0.0f), 1.0f, {200, 100, 50, 255});
@@ -313,7 +325,9 @@ std::size_t holes(const RgbaImage& full, const RgbaImage& other) {
 // pixels (43 without the discs); the floor, 16 dB, is below that by the
 // margin llvmpipe vs a GPU rasterisation may move it. A vertically mirrored
 // disc pass (the first version) measured 14.0 dB.
-TEST(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
+class HybridRendering : public ::testing::TestWithParam<render::DiscStyle> {};
+
+TEST_P(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
   Result<LoadedMesh> cow = loadMeshFile(std::string(THINLOD_SHARED_DIR) + "/models/cow.obj");
   ASSERT_TRUE(cow.ok()) << cow.status().toString();
   simplifier::HybridOptions options;
@@ -324,7 +338,7 @@ TEST(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
 
   constexpr int kSize = 256;
   Rig rig;
-  ASSERT_TRUE(makeRig(render::Backend::kAuto, kSize, rig));
+  ASSERT_TRUE(makeRig(render::Backend::kAuto, kSize, rig, GetParam()));
   const View view = viewOf(cow->mesh, kSize, 3.0f);
   simplifier::HybridView hybridView;
   hybridView.eye = glm::dvec3(view.eye);
@@ -356,11 +370,12 @@ TEST(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
   const std::size_t hybridHoles = holes(full.image, hybrid.image);
   const std::size_t holesWithoutDiscs = holes(full.image, trianglesOnly.image);
   std::printf(
-      "cow hybrid cut at 2 px: %zu triangles + %zu points = %.1f units (full %zu); "
+      "%s: cow hybrid cut at 2 px: %zu triangles + %zu points = %.1f units (full %zu); "
       "SNR %.2f dB (discs dropped: %.2f dB); holes %zu of %zu covered pixels "
       "(discs dropped: %zu)\n",
-      cut.triangleCount(), cut.pointCount(), cut.units(), cow->mesh.triangleCount(), *snr,
-      *snrWithoutDiscs, hybridHoles, full.covered, holesWithoutDiscs);
+      GetParam() == render::DiscStyle::kPointSprites ? "sprites" : "quads", cut.triangleCount(),
+      cut.pointCount(), cut.units(), cow->mesh.triangleCount(), *snr, *snrWithoutDiscs, hybridHoles,
+      full.covered, holesWithoutDiscs);
   EXPECT_GT(*snr, 16.0);
   // The discs' job: fill what the replaced triangles left open. (They need
   // not raise the SNR: flat pre-lit discs vs smooth-shaded triangles.)
@@ -368,6 +383,13 @@ TEST(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
   EXPECT_LT(static_cast<double>(hybridHoles), 0.01 * static_cast<double>(full.covered));
   EXPECT_LT(cut.units(), 0.5 * static_cast<double>(cow->mesh.triangleCount()));
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Styles, HybridRendering,
+    ::testing::Values(render::DiscStyle::kInstancedQuads, render::DiscStyle::kPointSprites),
+    [](const ::testing::TestParamInfo<render::DiscStyle>& info) {
+      return std::string(info.param == render::DiscStyle::kPointSprites ? "sprites" : "quads");
+    });
 
 }  // namespace
 }  // namespace thinlod

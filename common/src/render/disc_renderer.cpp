@@ -45,6 +45,40 @@ void main() {
 }
 )GLSL";
 
+// Point-sprite variant: one vertex per disc, gl_PointSize = the diameter in
+// pixels (capped by the implementation's largest point size).
+constexpr const char* kSpriteVertexShader = R"GLSL(#version 330 core
+layout(location = 1) in vec4 aCentreRadius;
+layout(location = 2) in vec4 aColor;
+
+uniform mat4 uModelView;
+uniform mat4 uProjection;
+uniform float uRadiusScale;
+uniform float uPixelsPerClipW;
+uniform float uMinRadiusPixels;
+uniform float uMaxPointSize;
+
+flat out vec4 vColor;
+
+void main() {
+  vec4 eye = uModelView * vec4(aCentreRadius.xyz, 1.0);
+  gl_Position = uProjection * eye;
+  float radiusPixels = aCentreRadius.w * uRadiusScale * uPixelsPerClipW / abs(gl_Position.w);
+  gl_PointSize = min(2.0 * max(radiusPixels, uMinRadiusPixels), uMaxPointSize);
+  vColor = aColor;
+}
+)GLSL";
+
+constexpr const char* kSpriteFragmentShader = R"GLSL(#version 330 core
+flat in vec4 vColor;
+out vec4 fragColor;
+void main() {
+  vec2 corner = 2.0 * gl_PointCoord - 1.0;
+  if (dot(corner, corner) > 1.0) discard;
+  fragColor = vec4(vColor.rgb, 1.0);
+}
+)GLSL";
+
 constexpr const char* kDiscFragmentShader = R"GLSL(#version 330 core
 in vec2 vCorner;
 flat in vec4 vColor;
@@ -104,6 +138,9 @@ void buildInstances(const DiscPoints& points, std::vector<GpuDisc>& out) {
 }  // namespace
 
 struct DiscRenderer::Impl {
+  DiscStyle style = DiscStyle::kInstancedQuads;
+  float maxPointSize = 1.0f;
+  GLint maxPointSizeUniform = -1;
   GLuint program = 0;
   GLuint quadBuffer = 0;
   GLint modelView = -1, projection = -1, radiusScale = -1, pixelsPerClipW = -1, minRadius = -1;
@@ -114,20 +151,23 @@ struct DiscRenderer::Impl {
   void fill(const GlFunctions& gl, DiscRecord& record, const DiscPoints& points) {
     buildInstances(points, scratch);
     gl.glBindVertexArray(record.vertexArray);
-    gl.glBindBuffer(GL_ARRAY_BUFFER, quadBuffer);
-    gl.glEnableVertexAttribArray(0);
-    gl.glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
-    gl.glVertexAttribDivisor(0, 0);
+    const GLuint perDisc = style == DiscStyle::kInstancedQuads ? 1 : 0;
+    if (style == DiscStyle::kInstancedQuads) {
+      gl.glBindBuffer(GL_ARRAY_BUFFER, quadBuffer);
+      gl.glEnableVertexAttribArray(0);
+      gl.glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+      gl.glVertexAttribDivisor(0, 0);
+    }
     gl.glBindBuffer(GL_ARRAY_BUFFER, record.instanceBuffer);
     gl.glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(scratch.size() * sizeof(GpuDisc)),
                     scratch.empty() ? nullptr : scratch.data(), GL_STATIC_DRAW);
     gl.glEnableVertexAttribArray(1);
     gl.glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(GpuDisc), nullptr);
-    gl.glVertexAttribDivisor(1, 1);
+    gl.glVertexAttribDivisor(1, perDisc);
     gl.glEnableVertexAttribArray(2);
     gl.glVertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(GpuDisc),
                              reinterpret_cast<const void*>(4 * sizeof(float)));
-    gl.glVertexAttribDivisor(2, 1);
+    gl.glVertexAttribDivisor(2, perDisc);
     gl.glBindVertexArray(0);
     gl.glBindBuffer(GL_ARRAY_BUFFER, 0);
     record.count = static_cast<GLsizei>(points.size());
@@ -148,14 +188,19 @@ DiscRenderer::~DiscRenderer() {
   if (impl_->program != 0) gl.glDeleteProgram(impl_->program);
 }
 
-Result<std::unique_ptr<DiscRenderer>> DiscRenderer::create(OffscreenContext& context) {
+Result<std::unique_ptr<DiscRenderer>> DiscRenderer::create(OffscreenContext& context,
+                                                           DiscStyle style) {
   if (!context.isCurrent()) return notCurrent("DiscRenderer::create");
   std::unique_ptr<DiscRenderer> renderer(new DiscRenderer(context));
+  renderer->impl_->style = style;
   const GlFunctions& gl = context.gl();
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "before DiscRenderer::create"));
-  Result<GLuint> vs = compile(gl, GL_VERTEX_SHADER, kDiscVertexShader);
+  const bool sprites = style == DiscStyle::kPointSprites;
+  Result<GLuint> vs =
+      compile(gl, GL_VERTEX_SHADER, sprites ? kSpriteVertexShader : kDiscVertexShader);
   if (!vs.ok()) return vs.status();
-  Result<GLuint> fs = compile(gl, GL_FRAGMENT_SHADER, kDiscFragmentShader);
+  Result<GLuint> fs =
+      compile(gl, GL_FRAGMENT_SHADER, sprites ? kSpriteFragmentShader : kDiscFragmentShader);
   if (!fs.ok()) {
     gl.glDeleteShader(*vs);
     return fs.status();
@@ -179,6 +224,12 @@ Result<std::unique_ptr<DiscRenderer>> DiscRenderer::create(OffscreenContext& con
   impl.radiusScale = gl.glGetUniformLocation(impl.program, "uRadiusScale");
   impl.pixelsPerClipW = gl.glGetUniformLocation(impl.program, "uPixelsPerClipW");
   impl.minRadius = gl.glGetUniformLocation(impl.program, "uMinRadiusPixels");
+  impl.maxPointSizeUniform = gl.glGetUniformLocation(impl.program, "uMaxPointSize");
+  if (sprites) {
+    GLint range[2] = {1, 1};
+    gl.glGetIntegerv(GL_POINT_SIZE_RANGE, range);
+    impl.maxPointSize = static_cast<float>(std::max(range[1], 1));
+  }
   const float quad[8] = {-1.0f, -1.0f, 1.0f, -1.0f, -1.0f, 1.0f, 1.0f, 1.0f};  // a strip
   gl.glGenBuffers(1, &impl.quadBuffer);
   gl.glBindBuffer(GL_ARRAY_BUFFER, impl.quadBuffer);
@@ -259,6 +310,11 @@ Status DiscRenderer::draw(const DiscDrawItem* items, std::size_t count, const Ca
   gl.glUniformMatrix4fv(impl_->projection, 1, GL_FALSE, glm::value_ptr(projection));
   gl.glUniform1f(impl_->pixelsPerClipW, pixelsPerClipW);
   gl.glUniform1f(impl_->minRadius, kMinDiscRadiusPixels);
+  const bool sprites = impl_->style == DiscStyle::kPointSprites;
+  if (sprites) {
+    gl.glUniform1f(impl_->maxPointSizeUniform, impl_->maxPointSize);
+    gl.glEnable(GL_PROGRAM_POINT_SIZE);
+  }
   for (std::size_t i = 0; i < count; ++i) {
     const DiscRecord& record = impl_->records.at(items[i].discs.id);
     if (record.count == 0) continue;
@@ -266,12 +322,17 @@ Status DiscRenderer::draw(const DiscDrawItem* items, std::size_t count, const Ca
     gl.glUniformMatrix4fv(impl_->modelView, 1, GL_FALSE, glm::value_ptr(modelView));
     gl.glUniform1f(impl_->radiusScale, largestAxisScale(items[i].model));
     gl.glBindVertexArray(record.vertexArray);
-    gl.glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, record.count);
+    if (sprites) {
+      gl.glDrawArraysInstanced(GL_POINTS, 0, record.count, 1);
+    } else {
+      gl.glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, record.count);
+    }
     ++stats_.drawCalls;
     stats_.discs += static_cast<std::size_t>(record.count);
   }
   gl.glBindVertexArray(0);
   gl.glUseProgram(0);
+  if (sprites) gl.glDisable(GL_PROGRAM_POINT_SIZE);
   return checkGlErrors(gl, "DiscRenderer::draw");
 }
 

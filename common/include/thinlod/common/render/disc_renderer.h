@@ -53,9 +53,15 @@ struct DiscStats {
   std::size_t discs = 0;
 };
 
+// kInstancedQuads: 4 vertices per disc, any size. kPointSprites: 1 vertex
+// per disc (GL_POINTS, gl_PointSize); a disc is capped at the implementation's
+// largest point size and vanishes when its centre leaves the view volume.
+enum class DiscStyle : std::uint8_t { kInstancedQuads, kPointSprites };
+
 class DiscRenderer {
  public:
-  static Result<std::unique_ptr<DiscRenderer>> create(OffscreenContext& context);
+  static Result<std::unique_ptr<DiscRenderer>> create(OffscreenContext& context,
+                                                      DiscStyle style = DiscStyle::kInstancedQuads);
   ~DiscRenderer();
   DiscRenderer(const DiscRenderer&) = delete;
   DiscRenderer& operator=(const DiscRenderer&) = delete;
