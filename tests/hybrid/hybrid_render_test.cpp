@@ -16,6 +16,7 @@
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/common/render/render_target.h"
 #include "thinlod/frontend/frame_metrics.h"
+#include "thinlod/frontend/frontend_renderer.h"
 #include "thinlod/simplifier/hybrid_graph.h"
 
 namespace thinlod {
@@ -382,6 +383,107 @@ TEST_P(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
   EXPECT_LT(hybridHoles, holesWithoutDiscs);
   EXPECT_LT(static_cast<double>(hybridHoles), 0.01 * static_cast<double>(full.covered));
   EXPECT_LT(cut.units(), 0.5 * static_cast<double>(cow->mesh.triangleCount()));
+}
+
+// The frontend's renderer holds a Hybrid representation (triangles in the lit
+// batch, discs pre-lit in one disc draw) and renders it close to the full
+// mesh held as a Mesh; a points-only hybrid draws only discs.
+TEST(FrontendHybridRendering, FrontendRendererDrawsHybridRepresentations) {
+  Result<LoadedMesh> cow = loadMeshFile(std::string(THINLOD_SHARED_DIR) + "/models/cow.obj");
+  ASSERT_TRUE(cow.ok()) << cow.status().toString();
+  simplifier::HybridOptions options;
+  options.kappa = 10.0;
+  options.tau = 5.0;
+  Result<simplifier::HybridGraph> graph = simplifier::buildHybridGraph(cow->mesh, options);
+  ASSERT_TRUE(graph.ok()) << graph.status().toString();
+  constexpr int kSize = 256;
+  auto context = render::createOffscreenContext(render::Backend::kAuto, kSize, kSize);
+  ASSERT_TRUE(context.ok()) << context.status().toString();
+  frontend::FrontendRendererOptions rendererOptions;
+  rendererOptions.width = rendererOptions.height = kSize;
+  rendererOptions.uploadBytesPerFrame = 64u << 20;
+  auto renderer = frontend::FrontendRenderer::create(**context, rendererOptions);
+  ASSERT_TRUE(renderer.ok()) << renderer.status().toString();
+
+  const View view = viewOf(cow->mesh, kSize, 3.0f);
+  simplifier::HybridView hybridView;
+  hybridView.eye = glm::dvec3(view.eye);
+  hybridView.pixelsPerRadian = kSize / (2.0 * std::tan(0.4));
+  simplifier::HybridCut cut(*graph);
+  cut.adaptToScreen(hybridView, 2.0);
+  const HybridGeometry geometry = simplifier::hybridGeometry(cut);
+  ASSERT_GT(geometry.points.size(), 0u);
+
+  auto show = [&](std::uint64_t plan, frontend::Representation rep, RgbaImage& image) {
+    frontend::SceneBatch batch;
+    batch.plan = plan;
+    frontend::SceneOperation op;
+    op.id = 1;
+    op.representation = std::move(rep);
+    batch.operations.push_back(std::move(op));
+    const Status submitted = (*renderer)->submit(std::move(batch));
+    EXPECT_TRUE(submitted.ok()) << submitted.toString();
+    auto report = (*renderer)->renderFrame(view.camera, sceneLighting(), image);
+    EXPECT_TRUE(report.ok()) << report.status().toString();
+    return report.ok() ? *report : frontend::FrameReport{};
+  };
+  const glm::vec4 colour(0.9f, 0.75f, 0.6f, 1.0f);
+  frontend::Representation full;
+  full.mesh = std::make_shared<const IndexedMesh>(cow->mesh);
+  full.color = colour;
+  RgbaImage fullFrame, hybridFrame, pointsFrame;
+  const frontend::FrameReport fullReport = show(1, full, fullFrame);
+  EXPECT_EQ(fullReport.discs, 0u);
+
+  frontend::Representation hybrid;
+  hybrid.kind = RepresentationKind::kHybrid;
+  hybrid.mesh = std::make_shared<const IndexedMesh>(geometry.triangles);
+  hybrid.points = std::make_shared<const DiscPoints>(geometry.points);
+  hybrid.color = colour;
+  const frontend::FrameReport hybridReport = show(2, hybrid, hybridFrame);
+  EXPECT_EQ(hybridReport.discs, geometry.points.size());
+  EXPECT_EQ(hybridReport.triangles, geometry.triangles.triangleCount());
+  Result<double> snr = frontend::frameSnr(hybridFrame, fullFrame);
+  ASSERT_TRUE(snr.ok());
+  std::printf(
+      "frontend renderer: hybrid cow %zu triangles + %zu discs, SNR %.2f dB vs the full "
+      "mesh\n",
+      geometry.triangles.triangleCount(), geometry.points.size(), *snr);
+  EXPECT_GT(*snr, 16.0);
+
+  // A coarse cut of points only (all triangles replaced): discs only.
+  simplifier::HybridCut coarse(*graph);
+  coarse.adaptToError(0.05 * graph->diagonal());
+  const HybridGeometry coarseGeometry = simplifier::hybridGeometry(coarse);
+  ASSERT_GT(coarseGeometry.points.size(), 0u);
+  frontend::Representation pointsOnly;
+  pointsOnly.kind = RepresentationKind::kHybrid;
+  pointsOnly.points = std::make_shared<const DiscPoints>(coarseGeometry.points);
+  pointsOnly.color = colour;
+  const frontend::FrameReport pointsReport = show(3, pointsOnly, pointsFrame);
+  EXPECT_EQ(pointsReport.triangles, 0u);
+  EXPECT_EQ(pointsReport.discs, coarseGeometry.points.size());
+  std::size_t covered = 0;
+  const std::uint8_t* background = pointsFrame.at(0, 0);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const std::uint8_t* p = pointsFrame.at(x, y);
+      covered += p[0] != background[0] || p[1] != background[1] || p[2] != background[2];
+    }
+  }
+  EXPECT_GT(covered, 1000u) << "the discs of a points-only hybrid are drawn";
+
+  // Points on a non-hybrid are refused by the scene.
+  frontend::Representation wrong = full;
+  wrong.points = hybrid.points;
+  frontend::SceneBatch batch;
+  frontend::SceneOperation op;
+  op.id = 2;
+  op.representation = wrong;
+  batch.operations.push_back(op);
+  EXPECT_EQ((*renderer)->submit(std::move(batch)).code(), ErrorCode::kInvalidArgument);
+  (void)(*context)->makeCurrent();
+  renderer->reset();
 }
 
 INSTANTIATE_TEST_SUITE_P(
