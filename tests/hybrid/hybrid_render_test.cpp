@@ -354,11 +354,13 @@ TEST_P(HybridRendering, ACowCutAtTwoPixelsRendersCloseToTheFullMesh) {
   // The same cut with its discs dropped: what the points contribute.
   const Frame trianglesOnly = renderGeometry(rig, geometry.triangles, DiscPoints(), view);
 
+  // THINLOD_HYBRID_DUMP=<dir>: the three frames as PPM files, to look at.
   if (const char* dump = std::getenv("THINLOD_HYBRID_DUMP")) {
     for (auto [name, image] : {std::pair<const char*, const RgbaImage*>{"full", &full.image},
                                {"hybrid", &hybrid.image},
                                {"triangles", &trianglesOnly.image}}) {
       std::FILE* f = std::fopen((std::string(dump) + "/" + name + ".ppm").c_str(), "wb");
+      if (f == nullptr) continue;
       std::fprintf(f, "P6 %d %d 255\n", image->width, image->height);
       for (int i = 0; i < image->width * image->height; ++i)
         std::fwrite(&image->pixels[4 * i], 1, 3, f);
