@@ -63,13 +63,16 @@ bool write(const std::filesystem::path& path, const std::vector<std::uint8_t>& b
 
 int main(int argc, char** argv) {
   if (argc != 2) {
-    std::fprintf(stderr, "usage: %s CORPUS_DIR (writes CORPUS_DIR/codec_mesh, codec_texture)\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s CORPUS_DIR (writes CORPUS_DIR/codec_mesh, codec_texture, codec_hybrid)\n",
+        argv[0]);
     return 2;
   }
   const std::filesystem::path root = argv[1];
   std::filesystem::create_directories(root / "codec_mesh");
   std::filesystem::create_directories(root / "codec_texture");
+  std::filesystem::create_directories(root / "codec_hybrid");
   bool ok = true;
   struct MeshSeed {
     const char* name;
@@ -96,6 +99,37 @@ int main(int argc, char** argv) {
       return 1;
     }
     ok &= write(root / "codec_mesh" / (std::string(seed.name) + ".bin"), *frame);
+  }
+  // Hybrid frames: points only, triangles and points, with and without
+  // normals, at each Draco point-cloud method (speed 10: sequential; below:
+  // kd-tree).
+  struct HybridSeed {
+    const char* name;
+    bool triangles, normals;
+    int speed, points;
+  };
+  const HybridSeed hybrids[] = {
+      {"points_speed5", false, false, 5, 24},  {"points_normals_speed10", false, true, 10, 17},
+      {"both_speed0", true, true, 0, 30},      {"both_speed10", true, false, 10, 9},
+      {"one_point_speed5", false, true, 5, 1},
+  };
+  for (const HybridSeed& seed : hybrids) {
+    thinlod::HybridGeometry g;
+    if (seed.triangles) g.triangles = grid(3, false, false, false);
+    for (int i = 0; i < seed.points; ++i) {
+      g.points.centres.emplace_back(0.1f * i, 0.05f * (i % 7), 0.02f * (i % 3));
+      if (seed.normals) g.points.normals.emplace_back(0.0f, 0.0f, 1.0f);
+      g.points.radii.push_back(0.01f * (1 + i % 4));
+      g.points.colors.push_back({static_cast<std::uint8_t>(i * 9), 100, 200, 255});
+    }
+    codec::MeshEncodeOptions options;
+    options.encodeSpeed = options.decodeSpeed = seed.speed;
+    const auto frame = codec::encodeHybrid(g, options);
+    if (!frame.ok()) {
+      std::fprintf(stderr, "%s: %s\n", seed.name, frame.status().toString().c_str());
+      return 1;
+    }
+    ok &= write(root / "codec_hybrid" / (std::string(seed.name) + ".bin"), *frame);
   }
   struct TextureSeed {
     const char* name;

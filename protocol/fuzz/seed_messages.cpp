@@ -22,7 +22,7 @@ Representation sampleRepresentation(RepresentationKind kind, std::size_t meshByt
   rep.generation = 3;
   rep.kind = kind;
   if (kind != RepresentationKind::kSimpleImpostor) rep.mesh = patternBytes(meshBytes, 11);
-  if (kind != RepresentationKind::kMesh) {
+  if (kind != RepresentationKind::kMesh && kind != RepresentationKind::kHybrid) {
     rep.texture.codec = TextureCodec::kPng;
     rep.texture.width = textureSide;
     rep.texture.height = textureSide;
@@ -190,8 +190,8 @@ std::vector<NamedMessage> seedMessages() {
   out.push_back({"heartbeat", Heartbeat{1'700'000'000'300'000'000, 9}});
   out.push_back({"shutdown", Shutdown{"SIGTERM"}});
 
-  // A frontend's Hello with its calibrated frame-cost constants (appended
-  // last: tests index the seeds above by position).
+  // A frontend's Hello with its calibrated frame-cost constants, then the
+  // hybrid seeds (appended last: tests index the seeds above by position).
   Hello frontend;
   frontend.role = Role::kFrontend;
   frontend.name = "frontend@host-2#77";
@@ -208,6 +208,34 @@ std::vector<NamedMessage> seedMessages() {
   costs.additive = true;
   frontend.frameCost = costs;
   out.push_back({"hello_frontend_frame_cost", frontend});
+
+  // Hybrid triangles + points.
+  SimplifyRequest hybridRequest = byPath;
+  hybridRequest.requestId = 8;
+  hybridRequest.representation = RepresentationKind::kHybrid;
+  hybridRequest.kappa = 3.0;
+  out.push_back({"simplify_request_hybrid", hybridRequest});
+  SimplifyResult hybridResult;
+  hybridResult.requestId = 8;
+  hybridResult.objectId = 100;
+  hybridResult.mesh = patternBytes(240, 17);
+  hybridResult.triangleCount = 180;
+  hybridResult.pointCount = 75;
+  hybridResult.kind = RepresentationKind::kHybrid;
+  hybridResult.kappa = 3.0;
+  hybridResult.accuracy = 25.0;
+  hybridResult.curve = {{4.0, 20.0}, {25.0, 205.0}, {90.0, 1400.0}};
+  out.push_back({"simplify_result_hybrid", hybridResult});
+  SceneUpdate hybridUpdate;
+  hybridUpdate.plan = 19;
+  hybridUpdate.frame = 342;
+  hybridUpdate.targetAccuracy = 12.5;
+  SceneOperation hybridOp;
+  hybridOp.objectId = 104;
+  hybridOp.representation = sampleRepresentation(RepresentationKind::kHybrid, 260, 0);
+  hybridOp.representation.pointCount = 90;
+  hybridUpdate.operations.push_back(std::move(hybridOp));
+  out.push_back({"scene_update_hybrid", hybridUpdate});
   return out;
 }
 

@@ -30,7 +30,8 @@ constexpr double kMinTrianglesToLearnBytes = 64.0;
 Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
 
 bool isMeshKind(OptionKind kind) {
-  return kind == OptionKind::kOriginalMesh || kind == OptionKind::kSimplifiedMesh;
+  return kind == OptionKind::kOriginalMesh || kind == OptionKind::kSimplifiedMesh ||
+         kind == OptionKind::kHybrid;
 }
 
 protocol::ConicRange everywhereOnWire() {
@@ -70,6 +71,9 @@ backbone::SchedulerOptions schedulerOptions(const CoreOptions& o) {
 }  // namespace
 
 Status validateCoreOptions(const CoreOptions& o) {
+  if (!(o.hybridKappa == 0.0 || (o.hybridKappa > 1.0 && o.hybridKappa <= protocol::kMaxKappa)))
+    return invalid("hybrid kappa " + std::to_string(o.hybridKappa) + ": 0 (off) or in (1, " +
+                   std::to_string(protocol::kMaxKappa) + "]");
   THINLOD_RETURN_IF_ERROR(backbone::validateConfig(o.config));
   THINLOD_RETURN_IF_ERROR(backbone::validateBudget(o.budget));
   Result<std::unique_ptr<backbone::Scheduler>> scheduler =
@@ -248,6 +252,22 @@ Status BackboneCore::initialize() {
       rebuildCurves(static_cast<std::uint32_t>(scene_.options.size() - 1));
     }
 
+    // Hybrid (behind CoreOptions::hybridKappa): like the simplified mesh, in
+    // primitive units, exact full mesh until its own curve arrives.
+    if (options_.hybridKappa > 0.0 && !record.primitive) {
+      OptionState state;
+      state.object = k;
+      state.wireKind = protocol::RepresentationKind::kHybrid;
+      state.baseTriangles = AccuracyCurve::point(kExactRelativeAccuracy, record.fullTriangles);
+      backbone::RepresentationOption option;
+      option.kind = OptionKind::kHybrid;
+      scene_.options.push_back(std::move(option));
+      optionStates_.push_back(std::move(state));
+      const auto index = static_cast<std::uint32_t>(scene_.options.size() - 1);
+      rebuildCurves(index);
+      queueStartupRequest(k, index, false);
+    }
+
     // Impostors: usable from `radii` bounding radii on, every direction.
     auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind, double radii,
                            double triangles) -> Status {
@@ -306,6 +326,12 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
   message.target = protocol::SimplifyRequest::Target::kTriangles;
   message.targetTriangles = request.targetTriangles;
   message.curvePoints = warmup ? 0 : options_.curvePoints;
+  // (The mesh option queues its request before its state exists: index == size.)
+  if (!warmup && option < optionStates_.size() &&
+      optionStates_[option].wireKind == protocol::RepresentationKind::kHybrid) {
+    message.representation = protocol::RepresentationKind::kHybrid;
+    message.kappa = options_.hybridKappa;
+  }
   // Fresh ids from the planner's counter are never known to the ledger.
   if (!ledger_.ask(request).ok()) return;
   if (!warmup) ++curvesWanted_;
@@ -456,6 +482,10 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     simplify.sceneFingerprint = sceneGraph_.fingerprint;
     simplify.target = protocol::SimplifyRequest::Target::kTriangles;
     simplify.targetTriangles = request.targetTriangles;
+    if (state.wireKind == protocol::RepresentationKind::kHybrid) {
+      simplify.representation = protocol::RepresentationKind::kHybrid;
+      simplify.kappa = options_.hybridKappa;
+    }
     message = std::move(simplify);
   } else {
     request.impostor = true;
@@ -548,7 +578,21 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   if (!result.status.ok())
     return Status(result.status.code(), where + ": simplifier error: " + result.status.message());
   if (result.mesh.empty()) return invalid(where + ": no mesh");
-  if (result.triangleCount == 0 || result.triangleCount > protocol::kMaxTriangleCount)
+  const protocol::RepresentationKind wanted = request.purpose == RequestPurpose::kWarmup
+                                                  ? protocol::RepresentationKind::kMesh
+                                                  : optionStates_[request.option].wireKind;
+  if (result.kind != wanted)
+    return invalid(where + std::string(": kind ") + protocol::representationKindName(result.kind) +
+                   ", requested " + protocol::representationKindName(wanted));
+  const bool hybrid = wanted == protocol::RepresentationKind::kHybrid;
+  if (hybrid && std::fabs(result.kappa - options_.hybridKappa) > 1e-9 * options_.hybridKappa)
+    return invalid(where + ": kappa " + std::to_string(result.kappa) + ", requested " +
+                   std::to_string(options_.hybridKappa));
+  // Primitive units: triangles, or triangles + points / kappa for a hybrid.
+  const double units =
+      hybrid ? double(result.triangleCount) + double(result.pointCount) / options_.hybridKappa
+             : double(result.triangleCount);
+  if (!(units > 0.0) || result.triangleCount > protocol::kMaxTriangleCount)
     return invalid(where + ": triangle count " + std::to_string(result.triangleCount));
   if (!std::isfinite(result.accuracy) || result.accuracy <= 0.0)
     return invalid(where + ": accuracy must be finite and > 0");
@@ -568,7 +612,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
     }
     Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
     if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
-    learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
+    learnMeshBytes(request.object, double(result.mesh.size()), units);
     // The measured curve replaces the estimate (and any calibration learned
     // against the estimate) in the scheduling scene.
     state.baseTriangles = std::move(fitted).value();
@@ -579,7 +623,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
     return Status();
   }
 
-  learnMeshBytes(request.object, double(result.mesh.size()), double(result.triangleCount));
+  learnMeshBytes(request.object, double(result.mesh.size()), units);
   const double relative = result.accuracy;
   if (request.requestedAccuracy > 0.0 && relative < request.requestedAccuracy * 0.99) {
     // Delivered less than the curve promised: shift the curve so the same
@@ -589,7 +633,8 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   }
   protocol::Representation rep;
   rep.representationId = request.id;
-  rep.kind = protocol::RepresentationKind::kMesh;
+  rep.kind = wanted;
+  rep.pointCount = hybrid ? result.pointCount : 0;
   rep.mesh = result.mesh;
   rep.transform = record.object->objectToWorld;
   rep.validity = everywhereOnWire();
@@ -599,7 +644,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   copy.present = true;
   copy.id = request.id;
   copy.relativeAccuracy = relative;
-  copy.triangles = result.triangleCount;
+  copy.triangles = units;
   copy.encodedBytes = payloadBytes(rep);
   storeBackboneCopy(request.option, copy, std::move(rep));
   return Status();

@@ -111,6 +111,11 @@ struct CoreOptions {
   // The first request id (> 0, < 2^62). The shell draws a random one per
   // process, so a reply computed for an earlier backbone never matches.
   std::uint64_t firstRequestId = 1;
+  // > 1: every mesh object gets one more option, a Hybrid (triangles + disc
+  // points, docs/hybrid.md) whose graph the simplifier builds with this
+  // kappa, the frontend renderer's measured point rate / triangle rate; its
+  // primitive units count against the polygon budget. 0: off (the default).
+  double hybridKappa = 0.0;
 };
 Status validateCoreOptions(const CoreOptions& options);
 

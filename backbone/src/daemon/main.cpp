@@ -95,6 +95,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "simple impostors from this many bounding radii away (0: none)");
   runtime.addOption("meshed-impostor-radii", &s.core.meshedImpostorRadii,
                     "meshed impostors from this many bounding radii away (0: none)");
+  runtime.addOption("hybrid-kappa", &s.core.hybridKappa,
+                    "offer hybrid triangle + point options built with this kappa, the frontend's "
+                    "measured point rate / triangle rate (0: off; docs/hybrid.md)");
   runtime.addOption("meshed-impostor-triangles", &s.core.meshedImpostorTriangles,
                     "triangles of a meshed impostor until the first one is measured");
   runtime.addOption("frontend-polygon-cap", &s.core.hardPolygonCap,

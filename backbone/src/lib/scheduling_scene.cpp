@@ -59,6 +59,8 @@ const char* optionKindName(OptionKind kind) {
       return "meshed-impostor";
     case OptionKind::kSimpleImpostor:
       return "simple-impostor";
+    case OptionKind::kHybrid:
+      return "hybrid";
   }
   return "unknown";
 }
@@ -135,7 +137,8 @@ Status validateScene(const SchedulingScene& scene) {
   }
   for (std::size_t k = 0; k < scene.options.size(); ++k) {
     const RepresentationOption& option = scene.options[k];
-    if (static_cast<int>(option.kind) > 3) return invalid(optionName(k) + ": unknown kind");
+    if (static_cast<int>(option.kind) > static_cast<int>(OptionKind::kHybrid))
+      return invalid(optionName(k) + ": unknown kind");
     THINLOD_RETURN_IF_ERROR(checkCurve(option.relativeTriangles, k, "relativeTriangles"));
     THINLOD_RETURN_IF_ERROR(checkCurve(option.relativeLinkBytes, k, "relativeLinkBytes"));
     const AccuracyCurve& t = option.relativeTriangles;

@@ -16,8 +16,8 @@ struct FrameHeader {
   std::uint16_t version = kFrameVersion;
   std::uint8_t codec = 0;
   std::uint8_t flags = 0;
-  std::uint32_t countA = 0;  // mesh vertices / texture width
-  std::uint32_t countB = 0;  // mesh triangles / texture height
+  std::uint32_t countA = 0;  // mesh vertices / texture width / hybrid points
+  std::uint32_t countB = 0;  // mesh triangles / texture height / hybrid triangles
   std::uint32_t payloadBytes = 0;
   std::uint32_t attributes = 0;
   std::uint64_t checksum = 0;
@@ -25,6 +25,7 @@ struct FrameHeader {
 
 inline constexpr std::array<char, 4> kMeshMagic = {'T', 'L', 'M', 'E'};
 inline constexpr std::array<char, 4> kTextureMagic = {'T', 'L', 'T', 'X'};
+inline constexpr std::array<char, 4> kHybridMagic = {'T', 'L', 'H', 'Y'};
 
 // Header + payload; fills payloadBytes and checksum. Precondition: the
 // payload fits in 32 bits (callers check against their limits first).

@@ -11,6 +11,7 @@
 #include <new>
 #include <string>
 
+#include "encoding_draco.h"
 #include "encoding_frame.h"
 #include "thinlod/common/codec/encoding.h"
 
@@ -73,73 +74,25 @@ Status decodeError(ErrorCode code, const std::string& message) {
   return Status(code, "decodeMesh: " + message);
 }
 
-// Reads a per-point attribute of N components of `Element` (what encodeMesh
-// writes: float32, or uint8 for colours). The bytes are copied out of
-// Draco's buffer after checking the type, stride and bounds ourselves,
-// instead of through GeometryAttribute::ConvertValue: that template (inlined
-// here) reads the attribute's `normalized_` bool, which libdraco fills from
-// the bitstream without checking it is 0 or 1 (a load of bool 131 is
-// undefined behaviour; found by fuzz/codec_mesh_frame.cpp, regression seed
-// fuzz/corpus/codec_mesh/crash-draco-bool-131.bin).
-template <int N, typename Store>
-Status readAttribute(const draco::Mesh& mesh, draco::GeometryAttribute::Type type, const char* name,
-                     draco::DataType dataType, Store& out) {
-  using Element = std::remove_reference_t<decltype(out[0][0])>;
-  const draco::PointAttribute* attribute = mesh.GetNamedAttribute(type);
-  if (attribute == nullptr) {
-    return decodeError(ErrorCode::kParseError, std::string("missing attribute ") + name);
-  }
-  if (attribute->num_components() != N || attribute->data_type() != dataType) {
-    return decodeError(ErrorCode::kParseError,
-                       std::string(name) + " has " +
-                           std::to_string(static_cast<int>(attribute->num_components())) +
-                           " components of Draco type " +
-                           std::to_string(static_cast<int>(attribute->data_type())) +
-                           ", expected " + std::to_string(N) + " of type " +
-                           std::to_string(static_cast<int>(dataType)));
-  }
-  constexpr std::int64_t kValueBytes = N * static_cast<std::int64_t>(sizeof(Element));
-  const draco::DataBuffer* buffer = attribute->buffer();
-  const std::int64_t stride = attribute->byte_stride();
-  const std::int64_t offset = attribute->byte_offset();
-  if (buffer == nullptr || stride < kValueBytes || offset < 0 ||
-      static_cast<std::uint64_t>(buffer->data_size()) < static_cast<std::uint64_t>(offset)) {
-    return decodeError(ErrorCode::kParseError, std::string(name) + " has an invalid layout");
-  }
-  // Values that fit in the buffer; every mapped index must be below both.
-  const std::uint64_t valuesInBuffer =
-      (static_cast<std::uint64_t>(buffer->data_size()) - static_cast<std::uint64_t>(offset)) /
-      static_cast<std::uint64_t>(stride);
-  // mapped_index() indexes the explicit map unchecked.
-  if (!attribute->is_mapping_identity() && attribute->indices_map_size() < mesh.num_points()) {
-    return decodeError(ErrorCode::kParseError, std::string(name) + " maps fewer points than exist");
-  }
-  out.resize(mesh.num_points());
-  for (std::uint32_t i = 0; i < mesh.num_points(); ++i) {
-    const draco::AttributeValueIndex value = attribute->mapped_index(draco::PointIndex(i));
-    if (value.value() >= attribute->size() || value.value() >= valuesInBuffer) {
-      return decodeError(ErrorCode::kParseError, std::string(name) + " index out of range");
-    }
-    std::memcpy(&out[i][0], buffer->data() + offset + stride * value.value(), kValueBytes);
-  }
-  return Status();
-}
-
 Result<IndexedMesh> toIndexedMesh(const draco::Mesh& decoded, std::uint32_t attributes) {
   IndexedMesh mesh;
-  THINLOD_RETURN_IF_ERROR(readAttribute<3>(decoded, draco::GeometryAttribute::POSITION, "positions",
-                                           draco::DT_FLOAT32, mesh.positions));
+  THINLOD_RETURN_IF_ERROR(detail::readDracoAttribute<3>(decoded, draco::GeometryAttribute::POSITION,
+                                                        "positions", draco::DT_FLOAT32,
+                                                        "decodeMesh", mesh.positions));
   if (attributes & kHasNormals) {
-    THINLOD_RETURN_IF_ERROR(readAttribute<3>(decoded, draco::GeometryAttribute::NORMAL, "normals",
-                                             draco::DT_FLOAT32, mesh.normals));
+    THINLOD_RETURN_IF_ERROR(detail::readDracoAttribute<3>(decoded, draco::GeometryAttribute::NORMAL,
+                                                          "normals", draco::DT_FLOAT32,
+                                                          "decodeMesh", mesh.normals));
   }
   if (attributes & kHasUvs) {
-    THINLOD_RETURN_IF_ERROR(readAttribute<2>(decoded, draco::GeometryAttribute::TEX_COORD, "uvs",
-                                             draco::DT_FLOAT32, mesh.uvs));
+    THINLOD_RETURN_IF_ERROR(
+        detail::readDracoAttribute<2>(decoded, draco::GeometryAttribute::TEX_COORD, "uvs",
+                                      draco::DT_FLOAT32, "decodeMesh", mesh.uvs));
   }
   if (attributes & kHasColors) {
-    THINLOD_RETURN_IF_ERROR(readAttribute<4>(decoded, draco::GeometryAttribute::COLOR, "colors",
-                                             draco::DT_UINT8, mesh.colors));
+    THINLOD_RETURN_IF_ERROR(detail::readDracoAttribute<4>(decoded, draco::GeometryAttribute::COLOR,
+                                                          "colors", draco::DT_UINT8, "decodeMesh",
+                                                          mesh.colors));
   }
   mesh.indices.reserve(static_cast<std::size_t>(decoded.num_faces()) * 3);
   for (draco::FaceIndex f(0); f < decoded.num_faces(); ++f) {

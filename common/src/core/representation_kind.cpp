@@ -10,6 +10,8 @@ const char* representationKindName(RepresentationKind kind) {
       return "SimpleImpostor";
     case RepresentationKind::kMeshedImpostor:
       return "MeshedImpostor";
+    case RepresentationKind::kHybrid:
+      return "Hybrid";
   }
   return "invalid-kind";
 }

@@ -73,6 +73,8 @@
   X(glVertexAttribPointer, PFNGLVERTEXATTRIBPOINTERPROC)         \
   X(glEnableVertexAttribArray, PFNGLENABLEVERTEXATTRIBARRAYPROC) \
   X(glDrawElements, PFNGLDRAWELEMENTSPROC)                       \
+  X(glDrawArraysInstanced, PFNGLDRAWARRAYSINSTANCEDPROC)         \
+  X(glVertexAttribDivisor, PFNGLVERTEXATTRIBDIVISORPROC)         \
   X(glGenTextures, PFNGLGENTEXTURESPROC)                         \
   X(glDeleteTextures, PFNGLDELETETEXTURESPROC)                   \
   X(glBindTexture, PFNGLBINDTEXTUREPROC)                         \

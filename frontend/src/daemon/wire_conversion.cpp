@@ -21,7 +21,8 @@ Status invalid(const std::string& what, const std::string& problem) {
 bool knownKind(protocol::RepresentationKind kind) {
   return kind == protocol::RepresentationKind::kMesh ||
          kind == protocol::RepresentationKind::kSimpleImpostor ||
-         kind == protocol::RepresentationKind::kMeshedImpostor;
+         kind == protocol::RepresentationKind::kMeshedImpostor ||
+         kind == protocol::RepresentationKind::kHybrid;
 }
 
 // The codec byte a frame of this wire codec must carry, or 0 when the wire
@@ -105,7 +106,31 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
   rep.generation = wire.generation;
   const std::string kindName = representationKindName(rep.kind);
 
-  if (wire.mesh.empty()) {
+  if (rep.kind == RepresentationKind::kHybrid) {
+    if (wire.mesh.empty()) return invalid(what, "Hybrid has no mesh bytes");
+    Result<HybridGeometry> geometry =
+        codec::decodeHybrid(wire.mesh.data(), wire.mesh.size(), options.limits);
+    if (!geometry.ok()) {
+      return Status(geometry.status().code(), what + ": hybrid: " + geometry.status().message());
+    }
+    if (geometry->triangles.triangleCount() != wire.triangleCount ||
+        geometry->points.size() != wire.pointCount) {
+      return invalid(what, "hybrid has " + std::to_string(geometry->triangles.triangleCount()) +
+                               " triangles / " + std::to_string(geometry->points.size()) +
+                               " points, the representation announces " +
+                               std::to_string(wire.triangleCount) + " / " +
+                               std::to_string(wire.pointCount));
+    }
+    if (wire.texture.codec != protocol::TextureCodec::kNone) {
+      return invalid(what, "Hybrid carries a texture");
+    }
+    if (geometry->triangles.triangleCount() > 0) {
+      rep.mesh = std::make_shared<const IndexedMesh>(std::move(geometry->triangles));
+    }
+    if (!geometry->points.empty()) {
+      rep.points = std::make_shared<const DiscPoints>(std::move(geometry->points));
+    }
+  } else if (wire.mesh.empty()) {
     if (rep.kind != RepresentationKind::kSimpleImpostor) {
       return invalid(what, kindName + " has no mesh bytes");
     }
@@ -131,14 +156,16 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
       convertTexture(wire.texture, options, what + ": texture");
   if (!texture.ok()) return texture.status();
   rep.texture = std::move(texture).value();
-  if (rep.kind != RepresentationKind::kMesh && rep.texture == nullptr) {
+  if (rep.kind != RepresentationKind::kMesh && rep.kind != RepresentationKind::kHybrid &&
+      rep.texture == nullptr) {
     return invalid(what, kindName + " has no texture (codec None)");
   }
   if (rep.texture != nullptr && rep.mesh != nullptr && rep.mesh->uvs.empty()) {
     return invalid(what, "textured " + kindName + " mesh has no uvs");
   }
 
-  if (rep.kind == RepresentationKind::kMesh && options.meshColors != nullptr) {
+  if ((rep.kind == RepresentationKind::kMesh || rep.kind == RepresentationKind::kHybrid) &&
+      options.meshColors != nullptr) {
     auto colour = options.meshColors->find(objectId);
     if (colour != options.meshColors->end()) {
       rep.color = glm::clamp(colour->second, glm::vec4(0.0f), glm::vec4(1.0f));

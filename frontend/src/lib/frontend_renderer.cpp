@@ -40,7 +40,21 @@ struct GpuPart {
   int layer = -1;     // own texture layer in `batch.page`, or -1 (untextured: the white layer)
   IndexedMesh world;  // baked to world space, uvs mapped into the layer
   std::vector<std::uint16_t> layers;
+  DiscPoints worldDiscs;  // kHybrid: world space, base colour x representation colour
 };
+
+bool sameLighting(const render::Lighting& a, const render::Lighting& b) {
+  if (a.ambient != b.ambient || a.lights.size() != b.lights.size()) return false;
+  for (std::size_t i = 0; i < a.lights.size(); ++i) {
+    const render::Light& x = a.lights[i];
+    const render::Light& y = b.lights[i];
+    if (x.type != y.type || x.vector != y.vector || x.color != y.color ||
+        x.attenuation != y.attenuation) {
+      return false;
+    }
+  }
+  return true;
+}
 
 struct Page {
   render::TextureHandle texture;
@@ -71,6 +85,13 @@ struct FrontendRenderer::Impl {
   IndexedMesh mergeScratch;
   std::vector<std::uint16_t> layerScratch;
   std::vector<render::DrawItem> items;
+  // Hybrid discs: one merged, pre-lit world-space set drawn in one call.
+  std::unique_ptr<render::DiscRenderer> discs;
+  render::DiscHandle discHandle;
+  bool discsDirty = true;
+  std::size_t discCount = 0;
+  bool discsLit = false;
+  render::Lighting discLighting;
 
   explicit Impl(const FrontendRendererOptions& o) : options(o), scene(o.limits) {}
 
@@ -78,6 +99,7 @@ struct FrontendRenderer::Impl {
     // GL objects must go while the context is current; the renderer frees its
     // meshes and textures itself.
     if (context != nullptr && !context->isCurrent()) (void)context->makeCurrent();
+    discs.reset();
     renderer.reset();
     target.reset();
   }
@@ -136,7 +158,14 @@ struct FrontendRenderer::Impl {
   Status uploadOne(const SceneObject& object) {
     const Representation& rep = object.representation;
     GpuPart part;
-    part.batch.lit = rep.kind == RepresentationKind::kMesh;
+    part.batch.lit =
+        rep.kind == RepresentationKind::kMesh || rep.kind == RepresentationKind::kHybrid;
+    if (rep.points != nullptr && !rep.points->empty()) {
+      render::appendWorldDiscs(part.worldDiscs, *rep.points, rep.transform);
+      for (auto& c : part.worldDiscs.colors) {
+        for (int k = 0; k < 4; ++k) c[k] = toByte(rep.color[k] * static_cast<float>(c[k]) / 255.0f);
+      }
+    }
     render::MeshBatch::Part batchPart;
     batchPart.model = rep.transform;
     batchPart.color = {toByte(rep.color.r), toByte(rep.color.g), toByte(rep.color.b),
@@ -163,7 +192,9 @@ struct FrontendRenderer::Impl {
     }
     render::MeshBatch baked;
     Status status =
-        baked.append(*rep.mesh, batchPart, "object " + std::to_string(object.id) + " mesh");
+        rep.mesh->indices.empty()
+            ? Status()  // a hybrid made of points only
+            : baked.append(*rep.mesh, batchPart, "object " + std::to_string(object.id) + " mesh");
     if (!status.ok()) {
       if (part.layer >= 0) pages[part.batch.page].freeLayers.push_back(part.layer);
       return status;
@@ -195,7 +226,35 @@ struct FrontendRenderer::Impl {
 
   void markDirty(RepresentationKey key) {
     auto it = parts.find(key);
-    if (it != parts.end()) batches[it->second.batch].dirty = true;
+    if (it != parts.end()) {
+      batches[it->second.batch].dirty = true;
+      if (!it->second.worldDiscs.empty()) discsDirty = true;
+    }
+  }
+
+  // Merges the held hybrids' discs and pre-lights them (again when the
+  // lighting changes): the discs get the Lambert term the lit batch's
+  // triangles get (render::preLightDiscs; no specular).
+  Status rebuildDiscs(const render::Lighting& lighting) {
+    if (!discsDirty && discsLit && sameLighting(lighting, discLighting)) return Status();
+    DiscPoints merged;
+    for (const auto& [id, object] : scene.objects()) {
+      auto part = parts.find(object.key);
+      if (part == parts.end() || part->second.worldDiscs.empty()) continue;
+      render::appendWorldDiscs(merged, part->second.worldDiscs, glm::mat4(1.0f));
+    }
+    discsDirty = false;
+    discsLit = true;
+    discLighting = lighting;
+    discCount = merged.size();
+    if (merged.empty()) return Status();
+    const DiscPoints lit =
+        render::preLightDiscs(merged, glm::mat4(1.0f), glm::vec4(1.0f), lighting);
+    if (discHandle.valid()) return discs->update(discHandle, lit);
+    auto handle = discs->upload(lit);
+    if (!handle.ok()) return handle.status();
+    discHandle = *handle;
+    return Status();
   }
 
   Status rebuildDirtyBatches(FrameReport& report) {
@@ -294,6 +353,9 @@ Result<std::unique_ptr<FrontendRenderer>> FrontendRenderer::create(
   auto renderer = render::MeshRenderer::create(context);
   if (!renderer.ok()) return renderer.status();
   impl->renderer = std::move(renderer).value();
+  auto discs = render::DiscRenderer::create(context, options.discStyle);
+  if (!discs.ok()) return discs.status();
+  impl->discs = std::move(discs).value();
   THINLOD_RETURN_IF_ERROR(impl->addPage());
   return std::unique_ptr<FrontendRenderer>(new FrontendRenderer(std::move(impl)));
 }
@@ -358,6 +420,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   for (RepresentationKey key : commit.activated) impl.markDirty(key);
   report.committedBatches = commit.plans.size();
   THINLOD_RETURN_IF_ERROR(impl.rebuildDirtyBatches(report));
+  THINLOD_RETURN_IF_ERROR(impl.rebuildDiscs(lighting));
   report.timing.commitMs = millisecondsSince(commitStart);
 
   // Both kinds of batch have their shader before any batch of that kind
@@ -376,12 +439,18 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   }
   THINLOD_RETURN_IF_ERROR(impl.renderer->beginFrame(*impl.target, impl.options.clearColor));
   THINLOD_RETURN_IF_ERROR(impl.renderer->draw(impl.items, camera, lighting));
+  impl.discs->resetStats();
+  if (impl.discCount > 0 && impl.discHandle.valid()) {
+    const render::DiscDrawItem discs{impl.discHandle, glm::mat4(1.0f)};
+    THINLOD_RETURN_IF_ERROR(impl.discs->draw(&discs, 1, camera));
+  }
   THINLOD_RETURN_IF_ERROR(impl.target->readColor(frame));
   report.timing.drawMs = millisecondsSince(drawStart);
   report.timing.totalMs = millisecondsSince(frameStart);
 
   const render::RenderStats& stats = impl.renderer->stats();
-  report.drawCalls = stats.drawCalls;
+  report.drawCalls = stats.drawCalls + impl.discs->stats().drawCalls;
+  report.discs = impl.discs->stats().discs;
   report.textureBinds = stats.textureBinds;
   report.triangles = stats.triangles;
   report.pendingBatches = impl.scene.pendingBatches();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <memory>
 #include <string>
 #include <unordered_set>
 #include <utility>
@@ -17,7 +18,7 @@ namespace {
 // Checks one add/replace operation; `what` names it ("batch plan 7, operation 3 (object 12)").
 Status validateRepresentation(const Representation& rep, const std::string& what) {
   const int kind = static_cast<int>(rep.kind);
-  if (kind < 0 || kind > 2) {
+  if (kind < 0 || kind > static_cast<int>(RepresentationKind::kHybrid)) {
     return Status(ErrorCode::kInvalidArgument,
                   what + ": unknown representation kind " + std::to_string(kind));
   }
@@ -34,7 +35,23 @@ Status validateRepresentation(const Representation& rep, const std::string& what
                     what + ": colour component " + std::to_string(c) + " outside [0,1]");
     }
   }
-  const bool impostor = rep.kind != RepresentationKind::kMesh;
+  const bool hybrid = rep.kind == RepresentationKind::kHybrid;
+  const bool impostor = rep.kind != RepresentationKind::kMesh && !hybrid;
+  if (rep.points != nullptr && !hybrid) {
+    return Status(ErrorCode::kInvalidArgument,
+                  what + ": " + representationKindName(rep.kind) + " carries disc points");
+  }
+  if (hybrid) {
+    if (rep.texture != nullptr) {
+      return Status(ErrorCode::kInvalidArgument, what + ": Hybrid carries a texture");
+    }
+    if (rep.points != nullptr) THINLOD_RETURN_IF_ERROR(rep.points->validate(what + " points"));
+    const bool hasPoints = rep.points != nullptr && !rep.points->empty();
+    const bool hasTriangles = rep.mesh != nullptr && !rep.mesh->indices.empty();
+    if (!hasPoints && !hasTriangles) {
+      return Status(ErrorCode::kInvalidArgument, what + ": Hybrid has no triangles and no points");
+    }
+  }
   if (impostor && rep.texture == nullptr) {
     return Status(ErrorCode::kInvalidArgument,
                   what + ": " + representationKindName(rep.kind) + " needs a texture");
@@ -48,7 +65,7 @@ Status validateRepresentation(const Representation& rep, const std::string& what
                                                      " bytes is empty or inconsistent");
     }
   }
-  const bool needsMesh = rep.kind != RepresentationKind::kSimpleImpostor;
+  const bool needsMesh = rep.kind != RepresentationKind::kSimpleImpostor && !hybrid;
   if (needsMesh && (rep.mesh == nullptr || rep.mesh->indices.empty())) {
     return Status(ErrorCode::kInvalidArgument,
                   what + ": " + representationKindName(rep.kind) + " needs a non-empty mesh");
@@ -130,9 +147,16 @@ Status FrontendScene::enqueue(SceneBatch batch) {
       object.key = nextKey_++;
       object.representation = std::move(op.representation);
       Representation& rep = object.representation;
-      if (rep.mesh == nullptr || rep.mesh->positions.empty()) rep.mesh = unitQuadMesh();
+      if (rep.kind == RepresentationKind::kHybrid) {
+        static const auto kNoTriangles = std::make_shared<const IndexedMesh>();
+        if (rep.mesh == nullptr) rep.mesh = kNoTriangles;
+      } else if (rep.mesh == nullptr || rep.mesh->positions.empty()) {
+        rep.mesh = unitQuadMesh();
+      }
       object.triangleCount = rep.mesh->triangleCount();
-      object.uploadBytes = uploadBytesOf(*rep.mesh, rep.texture.get());
+      object.pointCount = rep.points != nullptr ? rep.points->size() : 0;
+      object.uploadBytes =
+          uploadBytesOf(*rep.mesh, rep.texture.get()) + object.pointCount * kGpuDiscBytes;
     }
     queued.uploaded.push_back(op.type == SceneOperation::Type::kRemove);
     queued.shownEarly.push_back(false);

@@ -28,7 +28,7 @@ static_assert(static_cast<int>(w::ErrorCode::MAX) == static_cast<int>(ErrorCode:
               "wire ErrorCode and thinlod::ErrorCode must have the same values");
 static_assert(static_cast<int>(w::Role::MAX) == static_cast<int>(Role::kTool));
 static_assert(static_cast<int>(w::RepresentationKind::MAX) ==
-              static_cast<int>(RepresentationKind::kMeshedImpostor));
+              static_cast<int>(RepresentationKind::kHybrid));
 static_assert(static_cast<int>(w::TextureCodec::MAX) == static_cast<int>(TextureCodec::kZstd));
 
 // ---------------------------------------------------------------- encode
@@ -69,7 +69,7 @@ fb::Offset<w::Representation> build(fb::FlatBufferBuilder& b, const Representati
   const w::ConicRange validity = toWire(r.validity);
   return w::CreateRepresentation(b, r.representationId, r.generation,
                                  static_cast<w::RepresentationKind>(r.kind), mesh, texture,
-                                 &transform, &validity, r.accuracy, r.triangleCount);
+                                 &transform, &validity, r.accuracy, r.triangleCount, r.pointCount);
 }
 
 fb::Offset<fb::Vector<std::uint64_t>> idsOrNull(fb::FlatBufferBuilder& b,
@@ -126,7 +126,8 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Simpl
   auto mesh = bytesOrNull(b, m.sourceMesh);
   auto t = w::CreateSimplifyRequest(b, m.requestId, m.objectId, path, mesh,
                                     static_cast<w::SimplifyTarget>(m.target), m.targetTriangles,
-                                    m.targetAccuracy, m.curvePoints, m.sceneFingerprint);
+                                    m.targetAccuracy, m.curvePoints, m.sceneFingerprint,
+                                    static_cast<w::RepresentationKind>(m.representation), m.kappa);
   return {w::Body::SimplifyRequest, t.Union()};
 }
 
@@ -141,7 +142,8 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Simpl
     curve = b.CreateVectorOfStructs(samples);
   }
   auto t = w::CreateSimplifyResult(b, m.requestId, m.objectId, error, mesh, m.triangleCount,
-                                   m.accuracy, curve);
+                                   m.accuracy, curve, static_cast<w::RepresentationKind>(m.kind),
+                                   m.pointCount, m.kappa);
   return {w::Body::SimplifyResult, t.Union()};
 }
 
@@ -318,6 +320,7 @@ Result<Representation> fromWire(const FieldPath& path, const w::Representation* 
   out.validity = fromWire(*r->validity());
   out.accuracy = r->accuracy();
   out.triangleCount = r->triangle_count();
+  out.pointCount = r->point_count();
   return out;
 }
 
@@ -427,6 +430,8 @@ Result<Message> fromWire(const FieldPath& path, const w::SimplifyRequest* m) {
   out.targetAccuracy = m->target_accuracy();
   out.curvePoints = m->curve_points();
   out.sceneFingerprint = m->scene_fingerprint();
+  out.representation = static_cast<RepresentationKind>(m->representation());
+  out.kappa = m->kappa();
   return Message(std::move(out));
 }
 
@@ -438,6 +443,9 @@ Result<Message> fromWire(const FieldPath& path, const w::SimplifyResult* m) {
   out.mesh = toBytes(m->mesh());
   out.triangleCount = m->triangle_count();
   out.accuracy = m->accuracy();
+  out.kind = static_cast<RepresentationKind>(m->kind());
+  out.pointCount = m->point_count();
+  out.kappa = m->kappa();
   THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("curve"), m->curve(), kMaxCurveSamples));
   if (const auto* curve = m->curve()) {
     out.curve.reserve(curve->size());

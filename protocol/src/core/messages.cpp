@@ -62,7 +62,7 @@ bool operator==(const Representation& a, const Representation& b) {
   return a.representationId == b.representationId && a.generation == b.generation &&
          a.kind == b.kind && a.mesh == b.mesh && a.texture == b.texture &&
          a.transform == b.transform && a.validity == b.validity && a.accuracy == b.accuracy &&
-         a.triangleCount == b.triangleCount;
+         a.triangleCount == b.triangleCount && a.pointCount == b.pointCount;
 }
 bool operator==(const Hello& a, const Hello& b) {
   return a.minVersion == b.minVersion && a.maxVersion == b.maxVersion && a.role == b.role &&
@@ -96,12 +96,14 @@ bool operator==(const SimplifyRequest& a, const SimplifyRequest& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && a.sourcePath == b.sourcePath &&
          a.sourceMesh == b.sourceMesh && a.target == b.target &&
          a.targetTriangles == b.targetTriangles && a.targetAccuracy == b.targetAccuracy &&
-         a.curvePoints == b.curvePoints && a.sceneFingerprint == b.sceneFingerprint;
+         a.curvePoints == b.curvePoints && a.sceneFingerprint == b.sceneFingerprint &&
+         a.representation == b.representation && a.kappa == b.kappa;
 }
 bool operator==(const SimplifyResult& a, const SimplifyResult& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && sameStatus(a.status, b.status) &&
          a.mesh == b.mesh && a.triangleCount == b.triangleCount && a.accuracy == b.accuracy &&
-         sameCurve(a.curve, b.curve);
+         sameCurve(a.curve, b.curve) && a.kind == b.kind && a.pointCount == b.pointCount &&
+         a.kappa == b.kappa;
 }
 bool operator==(const ImpostorRequest& a, const ImpostorRequest& b) {
   return a.requestId == b.requestId && a.objectIds == b.objectIds && a.eye == b.eye &&

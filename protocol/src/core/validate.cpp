@@ -93,7 +93,7 @@ bool validRole(Role role) {
   return static_cast<unsigned>(role) <= static_cast<unsigned>(Role::kTool);
 }
 bool validKind(RepresentationKind kind) {
-  return static_cast<unsigned>(kind) <= static_cast<unsigned>(RepresentationKind::kMeshedImpostor);
+  return static_cast<unsigned>(kind) <= static_cast<unsigned>(RepresentationKind::kHybrid);
 }
 bool validCodec(TextureCodec codec) {
   return static_cast<unsigned>(codec) <= static_cast<unsigned>(TextureCodec::kZstd);
@@ -159,11 +159,38 @@ Status checkTexture(const FieldPath& path, const Texture& texture) {
   return Status();
 }
 
+// Points only in hybrid representations, at most kMaxPointCount.
+Status checkPointCount(const FieldPath& path, RepresentationKind kind, std::uint32_t points) {
+  if (points != 0 && kind != RepresentationKind::kHybrid) {
+    return invalidField(path, std::string("is ") + std::to_string(points) +
+                                  ", must be 0 for kind " + representationKindName(kind));
+  }
+  if (points > kMaxPointCount) {
+    return tooLarge(path,
+                    "is " + std::to_string(points) + ", limit " + std::to_string(kMaxPointCount));
+  }
+  return Status();
+}
+
+// kappa of a hybrid request or result: 0 (request: the default) or in [1, kMaxKappa].
+Status checkKappa(const FieldPath& path, RepresentationKind kind, double kappa, bool allowZero) {
+  THINLOD_RETURN_IF_ERROR(checkFinite(path, kappa));
+  if (kind != RepresentationKind::kHybrid) {
+    if (kappa != 0.0)
+      return invalidField(path, "is " + describe(kappa) + ", must be 0 unless Hybrid");
+    return Status();
+  }
+  if ((allowZero && kappa == 0.0) || (kappa >= 1.0 && kappa <= kMaxKappa)) return Status();
+  return invalidField(path, "is " + describe(kappa) + ", must be in [1, " + describe(kMaxKappa) +
+                                "]" + (allowZero ? " or 0" : ""));
+}
+
 Status checkRepresentation(const FieldPath& path, const Representation& rep) {
   if (!validKind(rep.kind))
     return invalidField(path.child("kind"), "is not a known RepresentationKind");
   const bool needsMesh = rep.kind != RepresentationKind::kSimpleImpostor;
-  const bool needsTexture = rep.kind != RepresentationKind::kMesh;
+  const bool needsTexture =
+      rep.kind != RepresentationKind::kMesh && rep.kind != RepresentationKind::kHybrid;
   if (needsMesh && rep.mesh.empty()) {
     return invalidField(path.child("mesh"), std::string("is empty, required for kind ") +
                                                 representationKindName(rep.kind));
@@ -185,6 +212,7 @@ Status checkRepresentation(const FieldPath& path, const Representation& rep) {
         path.child("triangle_count"),
         "is " + std::to_string(rep.triangleCount) + ", limit " + std::to_string(kMaxTriangleCount));
   }
+  THINLOD_RETURN_IF_ERROR(checkPointCount(path.child("point_count"), rep.kind, rep.pointCount));
   return Status();
 }
 
@@ -325,6 +353,11 @@ Status check(const FieldPath& path, const SimplifyRequest& m) {
     return tooLarge(path.child("curve_points"), "is " + std::to_string(m.curvePoints) + ", limit " +
                                                     std::to_string(kMaxCurveSamples));
   }
+  if (m.representation != RepresentationKind::kMesh &&
+      m.representation != RepresentationKind::kHybrid) {
+    return invalidField(path.child("representation"), "must be Mesh or Hybrid");
+  }
+  THINLOD_RETURN_IF_ERROR(checkKappa(path.child("kappa"), m.representation, m.kappa, true));
   return Status();
 }
 
@@ -333,12 +366,20 @@ Status check(const FieldPath& path, const SimplifyResult& m) {
   THINLOD_RETURN_IF_ERROR(checkStatus(path.child("error"), m.status));
   THINLOD_RETURN_IF_ERROR(checkCount(path.child("curve"), m.curve.size(), kMaxCurveSamples));
   if (!m.status.ok()) {
-    if (!m.mesh.empty() || !m.curve.empty() || m.triangleCount != 0 || m.accuracy != 0.0) {
-      return invalidField(path, "an error result must carry no mesh, curve, triangles or accuracy");
+    if (!m.mesh.empty() || !m.curve.empty() || m.triangleCount != 0 || m.accuracy != 0.0 ||
+        m.pointCount != 0 || m.kappa != 0.0) {
+      return invalidField(path,
+                          "an error result must carry no mesh, curve, triangles, points, kappa "
+                          "or accuracy");
     }
     return Status();
   }
   if (m.mesh.empty()) return invalidField(path.child("mesh"), "is empty in a successful result");
+  if (m.kind != RepresentationKind::kMesh && m.kind != RepresentationKind::kHybrid) {
+    return invalidField(path.child("kind"), "must be Mesh or Hybrid");
+  }
+  THINLOD_RETURN_IF_ERROR(checkPointCount(path.child("point_count"), m.kind, m.pointCount));
+  THINLOD_RETURN_IF_ERROR(checkKappa(path.child("kappa"), m.kind, m.kappa, false));
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("accuracy"), m.accuracy));
   if (m.triangleCount > kMaxTriangleCount) {
     return tooLarge(

@@ -223,4 +223,21 @@ std::vector<HybridPoint> HybridCut::pointList() const {
   return points;
 }
 
+HybridGeometry hybridGeometry(const HybridCut& cut) {
+  HybridGeometry out;
+  out.triangles = cut.triangleMesh();
+  const std::vector<HybridPoint> points = cut.pointList();
+  out.points.centres.reserve(points.size());
+  out.points.normals.reserve(points.size());
+  out.points.radii.reserve(points.size());
+  out.points.colors.reserve(points.size());
+  for (const HybridPoint& p : points) {
+    out.points.centres.emplace_back(p.centre);
+    out.points.normals.emplace_back(p.normal);
+    out.points.radii.push_back(static_cast<float>(p.radius));
+    out.points.colors.push_back(p.color);
+  }
+  return out;
+}
+
 }  // namespace thinlod::simplifier

@@ -419,8 +419,10 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
       result = valid;
     } else if (!request.sourceMesh.empty()) {
       Result<MeshModel*> model = impl_->meshModelForSource(request.sourceMesh);
-      result = model.ok() ? impl_->simplifyMesh(request, **model)
-                          : Result<protocol::SimplifyResult>(model.status());
+      result = !model.ok() ? Result<protocol::SimplifyResult>(model.status())
+               : request.representation == protocol::RepresentationKind::kHybrid
+                   ? impl_->simplifyHybrid(request, **model)
+                   : impl_->simplifyMesh(request, **model);
     } else {
       Result<LoadedScene*> loaded = impl_->scene(request.sourcePath);
       Status same = loaded.ok() ? protocol::checkSameScene(
@@ -435,11 +437,18 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
                      scene::findSceneObject((*loaded)->objects, request.objectId)) {
         if (object->shape != nullptr &&
             object->shape->geometry.kind == scene::GeometryKind::kPrimitive) {
-          result = impl_->simplifyPrimitive(request, object->shape->geometry.primitive);
+          result = request.representation == protocol::RepresentationKind::kHybrid
+                       ? Result<protocol::SimplifyResult>(
+                             Status(ErrorCode::kUnsupported,
+                                    "object " + std::to_string(request.objectId) +
+                                        ": analytic primitives have no hybrid representation"))
+                       : impl_->simplifyPrimitive(request, object->shape->geometry.primitive);
         } else {
           Result<MeshModel*> model = impl_->meshModelFor(*object);
-          result = model.ok() ? impl_->simplifyMesh(request, **model)
-                              : Result<protocol::SimplifyResult>(model.status());
+          result = !model.ok() ? Result<protocol::SimplifyResult>(model.status())
+                   : request.representation == protocol::RepresentationKind::kHybrid
+                       ? impl_->simplifyHybrid(request, **model)
+                       : impl_->simplifyMesh(request, **model);
         }
       } else {
         result = Status(ErrorCode::kNotFound, "object " + std::to_string(request.objectId) +

@@ -17,6 +17,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_objects.h"
+#include "thinlod/simplifier/hybrid_graph.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/mesh_curve.h"
 #include "thinlod/simplifier/progressive_mesh.h"
@@ -74,7 +75,18 @@ struct MeshModel {
   std::vector<LevelCredit> ladder;
   // Levels kept for impostor rendering (their GPU copies live as long as these).
   std::map<std::size_t, std::shared_ptr<const IndexedMesh>> renderLevels;
+  // Hybrid graphs by kappa, with their units-vs-error steps.
+  struct Hybrid {
+    HybridGraph graph;
+    std::vector<HybridCurveStep> steps;
+  };
+  std::map<double, std::unique_ptr<Hybrid>> hybrids;
 };
+
+// (accuracy, primitive units) of every step of a hybrid graph's curve, the
+// accuracy credited as deliveredLevel(max(error / L, minRelativeError)).
+std::vector<AccuracySample> hybridCurvePoints(const std::vector<HybridCurveStep>& steps,
+                                              double referenceLength, double minRelativeError);
 
 struct LoadedScene {
   std::string path;  // canonical
@@ -135,6 +147,8 @@ struct SimplifierService::Impl {
 
   Result<protocol::SimplifyResult> simplifyMesh(const protocol::SimplifyRequest& request,
                                                 service_detail::MeshModel& model);
+  Result<protocol::SimplifyResult> simplifyHybrid(const protocol::SimplifyRequest& request,
+                                                  service_detail::MeshModel& model);
   Result<protocol::SimplifyResult> simplifyPrimitive(const protocol::SimplifyRequest& request,
                                                      const PrimitiveShape& shape);
   Result<protocol::Representation> impostor(const protocol::ImpostorRequest& request);

@@ -38,6 +38,9 @@ enum class OptionKind : std::uint8_t {
   kSimplifiedMesh = 1,
   kMeshedImpostor = 2,
   kSimpleImpostor = 3,
+  // Triangles + disc points (docs/hybrid.md): scheduled like a simplified
+  // mesh, its resources primitive units = triangles + points / kappa.
+  kHybrid = 4,
 };
 const char* optionKindName(OptionKind kind);
 

@@ -40,6 +40,7 @@
 #include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
+#include "thinlod/common/render/disc_renderer.h"
 #include "thinlod/common/render/mesh_renderer.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/frontend/frontend_scene.h"
@@ -60,6 +61,9 @@ struct FrontendRendererOptions {
   glm::vec3 meshSpecular{0.0f};  // one Blinn-Phong term for all meshes (they share a draw)
   float meshShininess = 32.0f;
   SceneLimits limits;
+  // How hybrid points are drawn (docs/hybrid.md, "Measured kappa": sprites
+  // are the faster on llvmpipe).
+  render::DiscStyle discStyle = render::DiscStyle::kPointSprites;
 };
 
 struct FrameTiming {
@@ -74,6 +78,7 @@ struct FrameReport {
   std::size_t drawCalls = 0;
   std::size_t textureBinds = 0;
   std::size_t triangles = 0;      // drawn this frame
+  std::size_t discs = 0;          // hybrid disc points drawn this frame
   std::size_t uploadedBytes = 0;  // representation bytes uploaded this frame
   std::size_t uploadedObjects = 0;
   std::size_t geometryBytesRebuilt = 0;  // merged vertex/index bytes re-sent this frame

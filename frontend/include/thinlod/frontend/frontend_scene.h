@@ -11,7 +11,9 @@
 //   consistent, transforms finite and invertible, impostors textured, textured
 //   meshes with uvs) and queues nothing on error (kInvalidArgument naming the
 //   operation). A SimpleImpostor with a null or empty mesh gets the unit quad
-//   (unitQuadMesh()). Limits: kResourceExhausted past maxPendingBatches.
+//   (unitQuadMesh()); a Hybrid without triangles an empty mesh. Limits:
+//   kResourceExhausted past maxPendingBatches. polygons() counts triangles
+//   only (a hybrid's discs are pointCount, not polygons).
 // - Upload bookkeeping (pure; the renderer does the GL work): planUploads()
 //   hands out the queued representations to upload this frame, oldest first,
 //   within a byte bound (one oversized item may go alone so nothing stalls);
@@ -46,6 +48,7 @@
 #include <memory>
 #include <vector>
 
+#include "thinlod/common/core/disc_points.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/representation_kind.h"
 #include "thinlod/common/core/rgba_image.h"
@@ -70,6 +73,10 @@ struct Representation {
   glm::mat4 transform{1.0f};  // object -> world
   glm::vec4 color{1.0f};      // multiplies texture and vertex colours, components in [0,1]
   std::uint32_t generation = 0;
+  // kHybrid only: the disc points (object space, base colours; the renderer
+  // pre-lights them). A hybrid needs triangles (mesh) or points or both; its
+  // triangles are drawn lit like a kMesh.
+  std::shared_ptr<const DiscPoints> points;
 };
 
 struct SceneOperation {
@@ -90,6 +97,7 @@ struct SceneObject {
   RepresentationKey key = 0;
   Representation representation;  // mesh never null (unit quad substituted)
   std::size_t triangleCount = 0;
+  std::size_t pointCount = 0;   // kHybrid discs
   std::size_t uploadBytes = 0;  // texture bytes + GPU vertex/index bytes (see uploadBytesOf)
 };
 
@@ -117,6 +125,7 @@ struct SceneLimits {
 // GPU bytes MeshRenderer stores per vertex (interleaved) and per index.
 constexpr std::size_t kGpuVertexBytes = 40;
 constexpr std::size_t kGpuIndexBytes = 4;
+constexpr std::size_t kGpuDiscBytes = 20;  // DiscRenderer's per-disc instance data
 std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture);
 
 // Two counter-clockwise triangles spanning [-0.5, 0.5]^2 at z = 0, facing +z,

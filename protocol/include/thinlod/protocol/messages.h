@@ -48,6 +48,8 @@ inline constexpr std::size_t kMaxSceneOperations = 65536;  // per SceneUpdate
 inline constexpr std::size_t kMaxObjectIdsPerRequest = 4096;
 inline constexpr std::size_t kMaxCurveSamples = 4096;
 inline constexpr std::uint32_t kMaxTriangleCount = 1u << 26;  // per representation
+inline constexpr std::uint32_t kMaxPointCount = 1u << 26;     // per representation
+inline constexpr double kMaxKappa = 64.0;                     // point rate / triangle rate
 inline constexpr std::uint32_t kMaxViewportDimension = 16384;
 inline constexpr std::uint32_t kMaxWorkerCapacity = 1024;
 inline constexpr std::size_t kMaxRejectedPlans = 1024;  // per FrameStats
@@ -105,6 +107,7 @@ struct Representation {
   ConicRange validity;
   double accuracy = 0.0;  // what this representation reaches (1/d)
   std::uint32_t triangleCount = 0;
+  std::uint32_t pointCount = 0;  // kHybrid: disc points in `mesh` (an encodeHybrid frame)
 };
 
 // --- Handshake (every connection starts with Hello / HelloReply) ---
@@ -191,6 +194,10 @@ struct SimplifyRequest {
   // The backbone's scene::Scene::fingerprint (0: not checked): a worker whose
   // load of sourcePath differs answers kFailedPrecondition naming both.
   std::uint64_t sceneFingerprint = 0;
+  // kMesh, or kHybrid: triangles + disc points (mesh bytes an encodeHybrid
+  // frame, curve resources in primitive units = triangles + points / kappa).
+  RepresentationKind representation = RepresentationKind::kMesh;
+  double kappa = 0.0;  // kHybrid: in [1, kMaxKappa]; 0: the simplifier's default
 };
 
 struct SimplifyResult {
@@ -200,7 +207,10 @@ struct SimplifyResult {
   Bytes mesh;     // Draco-encoded
   std::uint32_t triangleCount = 0;
   double accuracy = 0.0;
-  std::vector<AccuracySample> curve;  // resources in triangles
+  std::vector<AccuracySample> curve;  // resources: triangles, or primitive units (kHybrid)
+  RepresentationKind kind = RepresentationKind::kMesh;  // as requested
+  std::uint32_t pointCount = 0;                         // kHybrid
+  double kappa = 0.0;                                   // kHybrid: units = tris + points / kappa
 };
 
 struct ImpostorRequest {

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "thinlod/common/core/accuracy_curve.h"
+#include "thinlod/common/core/disc_points.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/simplifier/surface_error.h"
@@ -208,6 +209,11 @@ class HybridCut {
   std::size_t triangles_ = 0;
   std::size_t moved_ = 0;
 };
+
+// The cut in common's terms, for the link encoder and the renderer: its
+// triangles (graph vertices, vertex colours when the graph has them) and its
+// discs (centre, normal, radius, colour; float).
+HybridGeometry hybridGeometry(const HybridCut& cut);
 
 // ---- Building blocks, public for tests -------------------------------------
 

@@ -27,6 +27,11 @@
 //   raw RGBA8 for kRawRgba8, else encodeTextureWith frames. JPEG needs an
 //   opaque texture: impostors have alpha, so a JPEG request gets PNG (the
 //   texture's codec says which).
+// - Hybrid requests (SimplifyRequest.representation = kHybrid): one hybrid
+//   graph per (mesh, kappa), cached; the cut at the requested accuracy (or
+//   at most targetTriangles primitive units) is an encodeHybrid frame, its
+//   accuracy 1 / (bound / L + quantization), the curve in primitive units.
+//   Analytic primitives have no hybrid form (kUnsupported).
 // - Impostors: world-space geometry, identity transform, world validity;
 //   representationId/generation stay 0 (the backbone numbers them).
 // - Errors are returned in the result's status, never thrown: kInvalidArgument
@@ -79,6 +84,10 @@ struct ServiceOptions {
   MeshCurveOptions curve = defaultCurveOptions();
   // Called (on the service's thread) with one log line per step of long work.
   std::function<void(const std::string&)> progress;
+  // Hybrid requests (RepresentationKind::kHybrid, docs/hybrid.md): kappa when
+  // the request leaves it 0, and the transition factor tau.
+  double hybridKappa = 3.0;
+  double hybridTau = 1.0;
 
   static MeshCurveOptions defaultCurveOptions();
 };
@@ -94,6 +103,7 @@ struct ServiceStats {
   std::uint64_t impostorRequests = 0;
   std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
   std::uint64_t failedRequests = 0;
+  std::uint64_t hybridGraphBuilds = 0;  // one per (mesh, kappa)
 };
 
 class SimplifierService {

@@ -32,6 +32,7 @@
 #include <limits>
 #include <vector>
 
+#include "thinlod/common/core/disc_points.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/rgba_image.h"
 #include "thinlod/common/core/status.h"
@@ -48,6 +49,7 @@ struct DecodeLimits {
   std::size_t maxVertices = 1u << 24;
   std::size_t maxTriangles = 1u << 24;
   std::uint32_t maxTextureDimension = 8192;  // per side
+  std::size_t maxPoints = 1u << 24;          // hybrid frames' disc points
 
   // The largest texture side a decoder may accept: maxTextureDimension, but
   // never above INT_MAX (RgbaImage sides are int).
@@ -75,6 +77,26 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& mesh,
                                              const MeshEncodeOptions& options = {});
 Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
                                const DecodeLimits& limits = {});
+
+// --- Hybrid triangles + points (docs/hybrid.md, "Link encoding") ---
+// Frame magic "TLHY", codec 1 (Draco): countA = points, countB = triangles,
+// attributes bit 1 = point normals. Payload: u32 LE M, then M bytes of an
+// encodeMesh frame of the triangles (M = 0: no triangles), then the rest: a
+// Draco point cloud (empty: no points) with POSITION (float32 x3, quantized
+// to options.positionBits over the points' own bbox: each centre moves by at
+// most positionErrorBound of those points), NORMAL (optional, normalBits),
+// GENERIC (the radius, float32, exact) and COLOR (uint8 x4, exact). Draco
+// may reorder points (all attributes move together).
+// Errors: invalid geometry or options (kInvalidArgument), nothing to encode.
+Result<std::vector<std::uint8_t>> encodeHybrid(const HybridGeometry& geometry,
+                                               const MeshEncodeOptions& options = {});
+// The decoded triangles pass IndexedMesh::validate, the points
+// DiscPoints::validate (finite, radii > 0), with exactly the header's counts
+// (points <= limits.maxPoints; the triangles' frame obeys decodeMesh).
+Result<HybridGeometry> decodeHybrid(const std::uint8_t* data, std::size_t size,
+                                    const DecodeLimits& limits = {});
+// Largest centre displacement of `points` encoded with `bits` (units).
+double pointPositionErrorBound(const DiscPoints& points, int bits);
 
 // --- Textures: thinlod::RgbaImage (rgba_image.h) ---
 // Encoders reject (kInvalidArgument) a zero or negative side, a side longer

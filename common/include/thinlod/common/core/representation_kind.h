@@ -12,8 +12,11 @@ enum class RepresentationKind : std::uint8_t {
   kMesh = 0,
   kSimpleImpostor = 1,
   kMeshedImpostor = 2,
+  // Triangles + disc points (Cohen-Aliaga-Zhang; docs/hybrid.md): the mesh
+  // bytes are an encodeHybrid frame.
+  kHybrid = 3,
 };
-// "Mesh", "SimpleImpostor", "MeshedImpostor"; "invalid-kind" otherwise.
+// "Mesh", "SimpleImpostor", "MeshedImpostor", "Hybrid"; "invalid-kind" otherwise.
 const char* representationKindName(RepresentationKind kind);
 
 }  // namespace thinlod

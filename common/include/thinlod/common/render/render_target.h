@@ -6,7 +6,7 @@
 //   else kInvalidArgument. GL failures (incomplete FBO, GL errors) are kInternal
 //   or kResourceExhausted (out of memory) with the GL error named.
 // - Rows: the framebuffer holds the picture upside down. Whatever draws into
-//   a RenderTarget (MeshRenderer, the only drawer) applies kMirrorClipY after
+//   a RenderTarget (MeshRenderer, DiscRenderer) applies kMirrorClipY after
 //   its projection, so glReadPixels' bottom-up rows are the picture's
 //   top-down rows and readback copies nothing (a CPU row flip cost 5% of a
 //   640x480 frontend frame on llvmpipe). Front faces are then clockwise.
