@@ -550,7 +550,9 @@ TEST(BackboneCoreLink, SchedulerLogAndShaperAgreeOnTheBytesSent) {
       ASSERT_EQ(double(core->shapedLinkBytes()), total) << "step " << step;
     }
     EXPECT_GT(total, 0.0);
-    if (meshBytesPerTriangle > 10.0) EXPECT_GT(deferred, 0u);  // the shaper had work to do
+    if (meshBytesPerTriangle > 10.0) {
+      EXPECT_GT(deferred, 0u);  // the shaper had work to do
+    }
   }
 }
 
