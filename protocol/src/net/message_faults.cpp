@@ -53,13 +53,13 @@ Status sendWithFaults(FaultInjector& injector, TransportStats& stats, const std:
       return sendOnce();
     case FaultInjector::Action::kDrop:
       ++stats.faultsDropped;
-      spdlog::debug("event=fault_injected {} action=drop message={}", who, messageName);
+      spdlog::info("event=fault_injected {} action=drop message={}", who, messageName);
       return Status();  // lost on the way: the sender cannot tell
     case FaultInjector::Action::kDuplicate: {
       const Status first = sendOnce();
       if (!first.ok()) return first;
       ++stats.faultsDuplicated;
-      spdlog::debug("event=fault_injected {} action=duplicate message={}", who, messageName);
+      spdlog::info("event=fault_injected {} action=duplicate message={}", who, messageName);
       const Status second = sendOnce();
       if (!second.ok()) {
         spdlog::debug("event=fault_duplicate_not_sent {} message={} error=\"{}\"", who, messageName,

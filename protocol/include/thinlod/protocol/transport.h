@@ -80,7 +80,7 @@ Status checkLinkSecurity(const std::string& address, const CurveOptions& curve, 
 // returns OK, as a lost message would look) or sent twice back to back.
 // Probabilities must be finite, in [0, 1], with a sum of at most 1, or bind
 // / connect fails with kInvalidArgument. Counted in TransportStats and
-// logged (event=fault_injected, debug level).
+// logged (event=fault_injected, info level).
 struct MessageFaults {
   double dropProbability = 0.0;
   double duplicateProbability = 0.0;
