@@ -514,17 +514,23 @@ TEST_F(ReplayLoopTest, LostUpdateIsReportedAsRefusedWhenTheNextOneArrives) {
 TEST_F(ReplayLoopTest, RepeatedOrRestartedPlanNumbersAreNoGap) {
   options.lockstep = true;
   options.rate = -1.0;
-  // Plans 5, 5 (an empty repeat), then a new backbone process: 1, 2, then a
-  // jump over 3 and 4.
+  // Plans 5 (refused), 5 (an empty repeat), then a new backbone process: 1,
+  // 2, then a jump over 3 and 4.
   const std::vector<std::uint64_t> plans = {5, 5, 1, 2, 5};
   link.responder = [&plans](const protocol::ViewerPose& pose) {
     protocol::SceneUpdate update = sphereUpdate(plans[pose.sequence], pose.sequence, 1, 1.0);
+    if (pose.sequence == 0) update.operations[0].representation.mesh.resize(3);
     if (pose.sequence == 1) update.operations.clear();
     return std::make_optional(std::make_pair(kMs, update));
   };
   Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
   ASSERT_EQ(link.frameStats.size(), 5u);
-  for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(link.frameStats[i].rejectedPlans.empty()) << i;
+  const std::vector<std::uint64_t> five = {5};
+  EXPECT_EQ(link.frameStats[0].rejectedPlans, five);
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, five);
+  // The new process never sent a plan 5 of the old one: its repeats stop.
+  EXPECT_TRUE(link.frameStats[2].rejectedPlans.empty());
+  EXPECT_TRUE(link.frameStats[3].rejectedPlans.empty());
   EXPECT_EQ(link.frameStats[4].rejectedPlans, (std::vector<std::uint64_t>{3, 4}));
   EXPECT_EQ(result.updatesMissed, 2u);
 }

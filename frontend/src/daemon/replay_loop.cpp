@@ -212,6 +212,7 @@ class Replay {
   void notePlanGap(std::uint64_t plan) {
     if (lastPlanSeen_ && plan < *lastPlanSeen_) {
       refusalsToRepeat_.clear();
+      refusedPlans_.clear();  // all of the old process (this update is not absorbed yet)
     } else if (lastPlanSeen_ && plan > *lastPlanSeen_ + 1) {
       const std::uint64_t first = std::max<std::uint64_t>(
           *lastPlanSeen_ + 1,
