@@ -511,12 +511,13 @@ TEST_F(ReplayLoopTest, LostUpdateIsReportedAsRefusedWhenTheNextOneArrives) {
   EXPECT_EQ(link.frameStats[5].rejectedPlans, none);
 }
 
-TEST_F(ReplayLoopTest, RepeatedOrRestartedPlanNumbersAreNoGap) {
+TEST_F(ReplayLoopTest, PlanNumbersCountFromOneInEveryBackboneProcess) {
   options.lockstep = true;
   options.rate = -1.0;
-  // Plans 5 (refused), 5 (an empty repeat), then a new backbone process: 1,
-  // 2, then a jump over 3 and 4.
-  const std::vector<std::uint64_t> plans = {5, 5, 1, 2, 5};
+  // Plan 5 first (refused): plans 1-4 were never seen (another session's, or
+  // lost), then plan 0 (a superseded pose's empty answer: no plan, no
+  // restart), then a new backbone process: 1, 2, then a jump over 3 and 4.
+  const std::vector<std::uint64_t> plans = {5, 0, 1, 2, 5};
   link.responder = [&plans](const protocol::ViewerPose& pose) {
     protocol::SceneUpdate update = sphereUpdate(plans[pose.sequence], pose.sequence, 1, 1.0);
     if (pose.sequence == 0) update.operations[0].representation.mesh.resize(3);
@@ -525,14 +526,31 @@ TEST_F(ReplayLoopTest, RepeatedOrRestartedPlanNumbersAreNoGap) {
   };
   Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
   ASSERT_EQ(link.frameStats.size(), 5u);
-  const std::vector<std::uint64_t> five = {5};
-  EXPECT_EQ(link.frameStats[0].rejectedPlans, five);
-  EXPECT_EQ(link.frameStats[1].rejectedPlans, five);
-  // The new process never sent a plan 5 of the old one: its repeats stop.
+  const std::vector<std::uint64_t> upToFive = {1, 2, 3, 4, 5};
+  EXPECT_EQ(link.frameStats[0].rejectedPlans, upToFive);
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, upToFive);
+  // The new process never sent the old one's plans: their repeats stop.
   EXPECT_TRUE(link.frameStats[2].rejectedPlans.empty());
   EXPECT_TRUE(link.frameStats[3].rejectedPlans.empty());
   EXPECT_EQ(link.frameStats[4].rejectedPlans, (std::vector<std::uint64_t>{3, 4}));
-  EXPECT_EQ(result.updatesMissed, 2u);
+  EXPECT_EQ(result.updatesMissed, 6u);
+}
+
+// The first update of a session lost: the next one's number says so.
+TEST_F(ReplayLoopTest, LostFirstUpdateOfASessionIsReported) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(50);
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose)
+      -> std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> {
+    if (pose.sequence == 0) return std::nullopt;  // plan 1 lost
+    return std::make_pair(kMs, sphereUpdate(pose.sequence + 1, pose.sequence, 1, 1.0));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_EQ(link.frameStats.size(), 3u);
+  EXPECT_TRUE(link.frameStats[0].rejectedPlans.empty());
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, (std::vector<std::uint64_t>{1}));
+  EXPECT_EQ(result.updatesMissed, 1u);
 }
 
 TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {

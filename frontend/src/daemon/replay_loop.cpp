@@ -203,26 +203,33 @@ class Replay {
   }
 
   // The backbone numbers the updates of its process 1, 2, ... (one per pose
-  // it plans; the empty answer to a superseded pose repeats the last
-  // number). A jump means updates lost on the way (or never sent): they are
-  // reported as refused, so the backbone's mirror takes back what they
-  // carried (reporting a plan that carried nothing changes nothing there).
-  // A smaller number is a new backbone process: its numbers start again,
-  // and the old process's refusals mean nothing to it.
+  // it plans; the empty answer to a superseded pose has plan 0, no plan, and
+  // is no evidence either way). A jump means updates lost on the way (or
+  // never sent): they are reported as refused, so the backbone's mirror
+  // takes back what they carried. Reporting a plan that carried nothing, or
+  // one of an earlier session (whose mirror was reset), changes nothing
+  // there, so the count starts at 0: the first update seen by a new
+  // frontend reports every plan before it (at most kMaxRejectedPlans), and
+  // a lost first update of a session is caught like any other. A smaller
+  // number is a new backbone process counting from 1 again: the old
+  // process's refusals mean nothing to it.
   void notePlanGap(std::uint64_t plan) {
-    if (lastPlanSeen_ && plan < *lastPlanSeen_) {
+    if (plan == 0) return;
+    if (plan < lastPlanSeen_) {
       refusalsToRepeat_.clear();
       refusedPlans_.clear();  // all of the old process (this update is not absorbed yet)
-    } else if (lastPlanSeen_ && plan > *lastPlanSeen_ + 1) {
+      lastPlanSeen_ = 0;
+    }
+    if (plan > lastPlanSeen_ + 1) {
       const std::uint64_t first = std::max<std::uint64_t>(
-          *lastPlanSeen_ + 1,
+          lastPlanSeen_ + 1,
           plan > protocol::kMaxRejectedPlans ? plan - protocol::kMaxRejectedPlans : 0);
       for (std::uint64_t missing = first; missing < plan; ++missing) {
         refusedPlans_.push_back(missing);
         ++result_.updatesMissed;
       }
     }
-    lastPlanSeen_ = plan;
+    lastPlanSeen_ = std::max(lastPlanSeen_, plan);
   }
 
   // The frame's identity and what was drawn, into record_.
@@ -299,7 +306,7 @@ class Replay {
   // Refusals already reported, with the reports still to repeat them.
   static constexpr int kRefusalReports = 3;
   std::deque<std::pair<std::uint64_t, int>> refusalsToRepeat_;
-  std::optional<std::uint64_t> lastPlanSeen_;  // the last update's plan number
+  std::uint64_t lastPlanSeen_ = 0;  // the highest plan number of this backbone process
   double targetAccuracy_ = kMissingValue;
   std::optional<std::int64_t> firstSampledNs_;  // frame 0's pose
   FrameRecord record_;                          // the frame being made
