@@ -8,6 +8,10 @@
 //                      ViewerPose -> SceneUpdate with a 256 KiB mesh)
 //   throughput: server streams 256 KiB messages to the client
 //               (raw bytes vs SceneUpdates encoded, sent, decoded)
+//   CURVE:      the same two "ours" cases with ZeroMQ CURVE on the link
+//               (keys made for the run in a temporary directory), next to
+//               plain text in the same rounds: the cost of authentication
+//               and encryption per message (docs/results/reliability.md)
 //
 // Usage: thinlod_protocol_bench [--rtt N] [--stream N] [--rounds R] [--json FILE]
 // (defaults 1000, 1000, 5).
@@ -18,8 +22,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <filesystem>
 #include <fstream>
 #include <future>
 #include <nlohmann/json.hpp>
@@ -30,6 +36,7 @@
 
 #include "seed_messages.h"
 #include "thinlod/protocol/codec.h"
+#include "thinlod/protocol/curve.h"
 #include "thinlod/protocol/transport.h"
 
 namespace {
@@ -151,13 +158,41 @@ Throughput rawThroughput(int count) {
 
 // ---------------------------------------------------------------- ours
 
+// CURVE options of the bench's two sides, or none (plain text).
+struct LinkSecurity {
+  CurveOptions server;
+  CurveOptions client;
+};
+const LinkSecurity kPlain{};
+
+// Key files for one run under a fresh temporary directory (removed by the
+// caller): a server pair, a client pair, the client in authorized_keys.
+LinkSecurity makeCurveKeys(const std::filesystem::path& directory) {
+  auto server = generateCurveKeyPair();
+  auto client = generateCurveKeyPair();
+  if (!server.ok() || !client.ok()) die("CURVE keys: not available in this libzmq");
+  const std::string dir = directory.string();
+  for (const auto& [keys, name] : {std::pair{*server, "server"}, std::pair{*client, "client"}}) {
+    const Status written = writeKeyFiles(keys, dir, name);
+    if (!written.ok()) die(written.toString());
+  }
+  std::filesystem::copy_file(directory / "client.pub", directory / "authorized_keys");
+  LinkSecurity security;
+  security.server.keyFile = (directory / "server.key").string();
+  security.server.authorizedKeysFile = (directory / "authorized_keys").string();
+  security.client.keyFile = (directory / "client.key").string();
+  security.client.serverKeyFile = (directory / "server.pub").string();
+  return security;
+}
+
 // Backbone thread: an Endpoint answering each ViewerPose with `update`
 // (plan = pose sequence), or streaming `streamCount` updates when the pose's
 // viewport width is 1 (the stream request).
 void oursServer(std::promise<std::string> address, SceneUpdate update, int streamCount,
-                std::atomic<bool>& stop) {
+                std::atomic<bool>& stop, CurveOptions curve) {
   Endpoint::Options options;
   options.address = "tcp://127.0.0.1:0";
+  options.transport.curve = std::move(curve);
   auto endpoint = Endpoint::bind(options);
   if (!endpoint.ok()) die(endpoint.status().toString());
   address.set_value((*endpoint)->address());
@@ -180,9 +215,10 @@ void oursServer(std::promise<std::string> address, SceneUpdate update, int strea
   }
 }
 
-std::unique_ptr<Channel> connectFrontend(const std::string& address) {
+std::unique_ptr<Channel> connectFrontend(const std::string& address, const CurveOptions& curve) {
   Channel::Options options;
   options.address = address;
+  options.transport.curve = curve;
   options.hello.role = Role::kFrontend;
   options.hello.name = "bench-frontend";
   auto channel = Channel::connect(options);
@@ -230,12 +266,12 @@ SceneUpdate smallUpdate() {
 }
 
 std::vector<double> oursLatency(const SceneUpdate& update, int iterations, int warmup,
-                                std::size_t* updateBytes) {
+                                std::size_t* updateBytes, const LinkSecurity& security) {
   std::atomic<bool> stop{false};
   std::promise<std::string> address;
   auto bound = address.get_future();
-  std::thread server(oursServer, std::move(address), update, 0, std::ref(stop));
-  auto channel = connectFrontend(bound.get());
+  std::thread server(oursServer, std::move(address), update, 0, std::ref(stop), security.server);
+  auto channel = connectFrontend(bound.get(), security.client);
   std::deque<SceneUpdate> backlog;
   std::vector<double> us;
   for (int i = 0; i < warmup + iterations; ++i) {
@@ -257,13 +293,14 @@ std::vector<double> oursLatency(const SceneUpdate& update, int iterations, int w
   return us;
 }
 
-Throughput oursThroughput(int count) {
+Throughput oursThroughput(int count, const LinkSecurity& security) {
   const SceneUpdate update = seeds::sceneUpdateOfSize(kLargeBytes, 0);
   std::atomic<bool> stop{false};
   std::promise<std::string> address;
   auto bound = address.get_future();
-  std::thread server(oursServer, std::move(address), update, count, std::ref(stop));
-  auto channel = connectFrontend(bound.get());
+  std::thread server(oursServer, std::move(address), update, count, std::ref(stop),
+                     security.server);
+  auto channel = connectFrontend(bound.get(), security.client);
   std::deque<SceneUpdate> backlog;
   ViewerPose request = benchPose(1);
   request.viewportWidth = 1;  // "stream"
@@ -341,18 +378,36 @@ int main(int argc, char** argv) {
   std::size_t smallUpdateBytes = 0, largeUpdateBytes = 0;
   std::vector<double> raw64Us, ours64Us, raw256Us, ours256Us;
   std::vector<double> rawRates, oursRates;
+  std::vector<double> curve64Us, curve256Us, curveRates;
+  const bool withCurve = curveAvailable();
+  std::filesystem::path keyDir;
+  LinkSecurity curve;
+  if (withCurve) {
+    char pattern[] = "/tmp/thinlod-bench-keys-XXXXXX";
+    if (mkdtemp(pattern) == nullptr) die("mkdtemp failed");
+    keyDir = pattern;
+    curve = makeCurveKeys(keyDir);
+  }
+  std::size_t curveSmallBytes = 0, curveLargeBytes = 0;
   const SceneUpdate largeUpdate = seeds::sceneUpdateOfSize(kLargeBytes, 0);
   auto append = [](std::vector<double>& to, const std::vector<double>& from) {
     to.insert(to.end(), from.begin(), from.end());
   };
   for (int round = 0; round < rounds; ++round) {
     append(raw64Us, rawLatency(64, rttIterations, warmup));
-    append(ours64Us, oursLatency(smallUpdate(), rttIterations, warmup, &smallUpdateBytes));
+    append(ours64Us, oursLatency(smallUpdate(), rttIterations, warmup, &smallUpdateBytes, kPlain));
     append(raw256Us, rawLatency(kLargeBytes, largeIterations, warmup));
-    append(ours256Us, oursLatency(largeUpdate, largeIterations, warmup, &largeUpdateBytes));
+    append(ours256Us, oursLatency(largeUpdate, largeIterations, warmup, &largeUpdateBytes, kPlain));
     rawRates.push_back(rawThroughput(streamCount).messagesPerSecond);
-    oursRates.push_back(oursThroughput(streamCount).messagesPerSecond);
+    oursRates.push_back(oursThroughput(streamCount, kPlain).messagesPerSecond);
+    if (withCurve) {
+      append(curve64Us, oursLatency(smallUpdate(), rttIterations, warmup, &curveSmallBytes, curve));
+      append(curve256Us,
+             oursLatency(largeUpdate, largeIterations, warmup, &curveLargeBytes, curve));
+      curveRates.push_back(oursThroughput(streamCount, curve).messagesPerSecond);
+    }
   }
+  if (withCurve) std::filesystem::remove_all(keyDir);
   const LatencyStats raw64 = summarize(raw64Us);
   const LatencyStats ours64 = summarize(ours64Us);
   const LatencyStats raw256 = summarize(raw256Us);
@@ -365,6 +420,10 @@ int main(int argc, char** argv) {
   const Throughput rawStream{median(rawRates), median(rawRates) * mb};
   const Throughput oursStream{median(oursRates), median(oursRates) * mb};
   const auto [encodeUs, decodeUs] = codecMicros(200);
+  const LatencyStats curve64 = withCurve ? summarize(curve64Us) : LatencyStats{};
+  const LatencyStats curve256 = withCurve ? summarize(curve256Us) : LatencyStats{};
+  const Throughput curveStream =
+      withCurve ? Throughput{median(curveRates), median(curveRates) * mb} : Throughput{};
 
   std::printf(
       "protocol bench: tcp://127.0.0.1, server thread (ROUTER) + client thread (DEALER), %d "
@@ -386,6 +445,21 @@ int main(int argc, char** argv) {
               oursStream.messagesPerSecond, oursStream.megabytesPerSecond);
   std::printf("codec alone, 256 KiB SceneUpdate: encode %.1f us, decode %.1f us (median)\n",
               encodeUs, decodeUs);
+  if (withCurve) {
+    row("ours + CURVE, small update", curve64);
+    row("ours + CURVE, 256 KiB mesh", curve256);
+    std::printf("%-44s %10.0f %10.0f\n", "ours + CURVE stream", curveStream.messagesPerSecond,
+                curveStream.megabytesPerSecond);
+    std::printf(
+        "CURVE / plain: latency %.2fx (small, +%.1f us), %.2fx (256 KiB, +%.1f us); stream "
+        "%.0f -> %.0f MB/s (+%.1f us per 256 KiB message)\n",
+        curve64.medianUs / ours64.medianUs, curve64.medianUs - ours64.medianUs,
+        curve256.medianUs / ours256.medianUs, curve256.medianUs - ours256.medianUs,
+        oursStream.megabytesPerSecond, curveStream.megabytesPerSecond,
+        1e6 / curveStream.messagesPerSecond - 1e6 / oursStream.messagesPerSecond);
+  } else {
+    std::printf("CURVE: not available in this libzmq, not measured\n");
+  }
   const double latencyRatio64 = ours64.medianUs / raw64.medianUs;
   const double latencyRatio256 = ours256.medianUs / raw256.medianUs;
   const double throughputRatio = rawStream.messagesPerSecond / oursStream.messagesPerSecond;
@@ -414,6 +488,13 @@ int main(int argc, char** argv) {
                              {{"msg_per_s", oursStream.messagesPerSecond},
                               {"MB_per_s", oursStream.megabytesPerSecond}}}}},
                           {"codec_256KiB_median_us", {{"encode", encodeUs}, {"decode", decodeUs}}},
+                          {"curve",
+                           {{"available", withCurve},
+                            {"pose_to_small_update", lat(curve64)},
+                            {"pose_to_256KiB_update", lat(curve256)},
+                            {"stream_256KiB",
+                             {{"msg_per_s", curveStream.messagesPerSecond},
+                              {"MB_per_s", curveStream.megabytesPerSecond}}}}},
                           {"ratio_ours_over_raw",
                            {{"latency_small", latencyRatio64},
                             {"latency_256KiB", latencyRatio256},

@@ -455,11 +455,102 @@ TEST_F(ReplayLoopTest, MalformedUpdateIsDroppedWholeAndLaterOnesStillApply) {
   EXPECT_FALSE(result.records[1].lockstepTimedOut);  // the answer came, it was just bad
   EXPECT_EQ(result.records[2].plan, 3u);
   EXPECT_EQ(producer.scene.objects().size(), 1u);
-  // The backbone hears of the refusal once, in the FrameStats of that frame.
+  // The backbone hears of the refusal from the FrameStats of that frame on,
+  // repeated in the next ones (a FrameStats can be lost).
   ASSERT_EQ(link.frameStats.size(), 3u);
   EXPECT_TRUE(link.frameStats[0].rejectedPlans.empty());
   EXPECT_EQ(link.frameStats[1].rejectedPlans, (std::vector<std::uint64_t>{2}));
+  EXPECT_EQ(link.frameStats[2].rejectedPlans, (std::vector<std::uint64_t>{2}));
+}
+
+TEST_F(ReplayLoopTest, RefusalsAreRepeatedInThreeFrameStatsThenDropped) {
+  options.lockstep = true;
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    protocol::SceneUpdate update = sphereUpdate(pose.sequence + 1, pose.sequence, 1, 1.0);
+    if (pose.sequence == 1) update.operations[0].representation.mesh.resize(3);  // refused
+    return std::make_optional(std::make_pair(kMs, update));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4, 0.5}));
+  ASSERT_EQ(link.frameStats.size(), 6u);
+  const std::vector<std::uint64_t> none;
+  const std::vector<std::uint64_t> two = {2};
+  EXPECT_EQ(link.frameStats[0].rejectedPlans, none);
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[2].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[3].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[4].rejectedPlans, none);
+  EXPECT_EQ(link.frameStats[5].rejectedPlans, none);
+  EXPECT_EQ(result.updatesMissed, 0u);
+}
+
+// A SceneUpdate lost on the way (the fault campaign's --drop): the next
+// update's plan number jumps, and the frontend reports the missing plan as
+// refused so the backbone's mirror takes back what it carried.
+TEST_F(ReplayLoopTest, LostUpdateIsReportedAsRefusedWhenTheNextOneArrives) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(50);
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose)
+      -> std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> {
+    if (pose.sequence == 1) return std::nullopt;  // plan 2 lost
+    return std::make_pair(kMs, sphereUpdate(pose.sequence + 1, pose.sequence, 1, 1.0));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4, 0.5}));
+  ASSERT_EQ(result.records.size(), 6u);
+  EXPECT_EQ(result.lockstepTimeouts, 1u);  // frame 1's answer never came
+  EXPECT_EQ(result.updatesMissed, 1u);
+  ASSERT_EQ(link.frameStats.size(), 6u);
+  const std::vector<std::uint64_t> none;
+  const std::vector<std::uint64_t> two = {2};
+  EXPECT_EQ(link.frameStats[0].rejectedPlans, none);
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, none);  // nothing known yet
+  EXPECT_EQ(link.frameStats[2].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[3].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[4].rejectedPlans, two);
+  EXPECT_EQ(link.frameStats[5].rejectedPlans, none);
+}
+
+TEST_F(ReplayLoopTest, PlanNumbersCountFromOneInEveryBackboneProcess) {
+  options.lockstep = true;
+  options.rate = -1.0;
+  // Plan 5 first (refused): plans 1-4 were never seen (another session's, or
+  // lost), then plan 0 (a superseded pose's empty answer: no plan, no
+  // restart), then a new backbone process: 1, 2, then a jump over 3 and 4.
+  const std::vector<std::uint64_t> plans = {5, 0, 1, 2, 5};
+  link.responder = [&plans](const protocol::ViewerPose& pose) {
+    protocol::SceneUpdate update = sphereUpdate(plans[pose.sequence], pose.sequence, 1, 1.0);
+    if (pose.sequence == 0) update.operations[0].representation.mesh.resize(3);
+    if (pose.sequence == 1) update.operations.clear();
+    return std::make_optional(std::make_pair(kMs, update));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3, 0.4}));
+  ASSERT_EQ(link.frameStats.size(), 5u);
+  const std::vector<std::uint64_t> upToFive = {1, 2, 3, 4, 5};
+  EXPECT_EQ(link.frameStats[0].rejectedPlans, upToFive);
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, upToFive);
+  // The new process never sent the old one's plans: their repeats stop.
   EXPECT_TRUE(link.frameStats[2].rejectedPlans.empty());
+  EXPECT_TRUE(link.frameStats[3].rejectedPlans.empty());
+  EXPECT_EQ(link.frameStats[4].rejectedPlans, (std::vector<std::uint64_t>{3, 4}));
+  EXPECT_EQ(result.updatesMissed, 6u);
+}
+
+// The first update of a session lost: the next one's number says so.
+TEST_F(ReplayLoopTest, LostFirstUpdateOfASessionIsReported) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(50);
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose)
+      -> std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> {
+    if (pose.sequence == 0) return std::nullopt;  // plan 1 lost
+    return std::make_pair(kMs, sphereUpdate(pose.sequence + 1, pose.sequence, 1, 1.0));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_EQ(link.frameStats.size(), 3u);
+  EXPECT_TRUE(link.frameStats[0].rejectedPlans.empty());
+  EXPECT_EQ(link.frameStats[1].rejectedPlans, (std::vector<std::uint64_t>{1}));
+  EXPECT_EQ(result.updatesMissed, 1u);
 }
 
 TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {

@@ -344,6 +344,38 @@ TEST(MeshIo, OffLayoutsOpenMeshReadsDifferentlyAreRejected) {
   EXPECT_EQ(good->mesh.triangleCount(), 1u);
 }
 
+// Fuzz finding (mesh, timeout): OpenMesh reads the PLY header word by word
+// across lines, so a property line with a word too few or too many shifted
+// the header until 'end_header' was read as a property name and OpenMesh
+// looped at the end of the file. Every header line must hold exactly its words.
+TEST(MeshIo, PlyHeaderLinesWithExtraOrMissingWordsAreRejected) {
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string vertex =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::pair<std::string, const char*> cases[] = {
+      {"ply\nformat ascii 1.0\n" + vertex + "element face 1\nproperty ls\nend_header\n" + body,
+       "bad.ply:8: bad property line"},
+      {"ply\nformat ascii 1.0\nelement vertex 3 py float y\nproperty float x\n", "bad.ply:3:"},
+      {"ply\nformat ascii 1.0\n" + vertex + "element face 1\nproperty list uchar int a b\n" +
+           "end_header\n" + body,
+       "bad.ply:8: bad property line"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x y\n", "bad.ply:4:"},
+      {"ply\nformat ascii 1.0 x\n" + vertex + face + "end_header\n" + body, "bad.ply:2:"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header 0\n" + body,
+       "bad.ply:9: end_header line holds only"},
+  };
+  for (const auto& [text, message] : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(text, "ply", "bad.ply");
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_TRUE(contains(r.status().message(), message)) << r.status().message();
+  }
+  Result<LoadedMesh> good = loadMeshFromMemory(
+      "ply\nformat ascii 1.0\n" + vertex + face + "end_header\n" + body, "ply", "good.ply");
+  ASSERT_TRUE(good.ok()) << good.status().toString();
+  EXPECT_EQ(good->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

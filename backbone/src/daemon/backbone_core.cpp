@@ -817,7 +817,11 @@ Status BackboneCore::replan() {
 
 protocol::SceneUpdate BackboneCore::emptyUpdate(const protocol::ViewerPose& pose) {
   protocol::SceneUpdate update;
-  update.plan = poseCounter_;
+  // Plan 0: no plan. Repeating the last plan's number would let this empty
+  // answer stand in for that plan's update when the update itself was lost,
+  // and the frontend could not tell the loss (it reports jumps in the plan
+  // numbers as refused plans: docs/frontend.md, "Updates").
+  update.plan = 0;
   update.frame = pose.sequence;
   update.targetAccuracy = 0.0;
   return update;

@@ -190,7 +190,8 @@ class BackboneCore {
   // Requests of the current pose still without a result.
   std::size_t awaitedResults() const;
   PoseOutcome finishPose();
-  // Answers a pose without planning (e.g. superseded by a newer one).
+  // Answers a pose without planning (e.g. superseded by a newer one): no
+  // operations, plan 0 (no plan: it never stands for a plan's update).
   protocol::SceneUpdate emptyUpdate(const protocol::ViewerPose& pose);
 
   // Forgets the frontend (mirror, planner state, shaper); the frame-cost

@@ -387,8 +387,13 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
     const int ln = scanner.lineNumber();
     if (tokens.empty()) continue;
     const std::string_view key = tokens[0];
+    // OpenMesh reads the header as a stream of words, not lines: a word
+    // more or less on a line shifts everything after it (the words of a
+    // short property line ran into 'end_header', which it then never saw
+    // and looped at the end of the file). So every line has exactly its
+    // words.
     if (key == "format") {
-      if (tokens.size() < 3 || tokens[2] != "1.0") {
+      if (tokens.size() != 3 || tokens[2] != "1.0") {
         return Status(ErrorCode::kVersionMismatch,
                       name + ":" + std::to_string(ln) + ": unsupported PLY format line");
       }
@@ -398,27 +403,29 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
       }
     } else if (key == "element") {
       PlyElement e;
-      if (tokens.size() < 3 || !parseUnsigned(tokens[2], &e.count)) {
-        return lineError(name, ln, "element line needs a name and a count");
+      if (tokens.size() != 3 || !parseUnsigned(tokens[2], &e.count)) {
+        return lineError(name, ln, "element line needs a name and a count, nothing else");
       }
       e.name = std::string(tokens[1]);
       elements.push_back(e);
     } else if (key == "property") {
       if (elements.empty()) return lineError(name, ln, "property before any element");
       PlyProperty p;
-      if (tokens.size() >= 5 && tokens[1] == "list") {
+      if (tokens.size() == 5 && tokens[1] == "list") {
         p.listCountBytes = plyTypeBytes(tokens[2]);
         p.scalarBytes = plyTypeBytes(tokens[3]);
         p.name = std::string(tokens[4]);
-      } else if (tokens.size() >= 3) {
+      } else if (tokens.size() == 3 && tokens[1] != "list") {
         p.scalarBytes = plyTypeBytes(tokens[1]);
         p.name = std::string(tokens[2]);
       }
       if (p.scalarBytes == 0 || (tokens[1] == "list" && p.listCountBytes == 0)) {
-        return lineError(name, ln, "bad property line");
+        return lineError(name, ln,
+                         "bad property line (property TYPE NAME or property list TYPE TYPE NAME)");
       }
       elements.back().properties.push_back(p);
     } else if (key == "end_header") {
+      if (tokens.size() != 1) return lineError(name, ln, "end_header line holds only 'end_header'");
       ended = true;
     } else if (key != "comment" && key != "obj_info") {
       return lineError(name, ln, "unknown PLY header keyword " + quoted(key));

@@ -186,6 +186,7 @@ class Replay {
     for (protocol::SceneUpdate& update : updates) {
       ++result_.updatesReceived;
       ++record_.updatesReceived;
+      notePlanGap(update.plan);
       if (update.frame < answered_.size()) answered_[update.frame] = true;
       Result<SceneBatch> batch = convertUpdate(update, options_.conversion);
       const Status submitted =
@@ -199,6 +200,36 @@ class Replay {
       }
       submitted_.push_back({update.plan, update.frame, update.targetAccuracy});
     }
+  }
+
+  // The backbone numbers the updates of its process 1, 2, ... (one per pose
+  // it plans; the empty answer to a superseded pose has plan 0, no plan, and
+  // is no evidence either way). A jump means updates lost on the way (or
+  // never sent): they are reported as refused, so the backbone's mirror
+  // takes back what they carried. Reporting a plan that carried nothing, or
+  // one of an earlier session (whose mirror was reset), changes nothing
+  // there, so the count starts at 0: the first update seen by a new
+  // frontend reports every plan before it (at most kMaxRejectedPlans), and
+  // a lost first update of a session is caught like any other. A smaller
+  // number is a new backbone process counting from 1 again: the old
+  // process's refusals mean nothing to it.
+  void notePlanGap(std::uint64_t plan) {
+    if (plan == 0) return;
+    if (plan < lastPlanSeen_) {
+      refusalsToRepeat_.clear();
+      refusedPlans_.clear();  // all of the old process (this update is not absorbed yet)
+      lastPlanSeen_ = 0;
+    }
+    if (plan > lastPlanSeen_ + 1) {
+      const std::uint64_t first = std::max<std::uint64_t>(
+          lastPlanSeen_ + 1,
+          plan > protocol::kMaxRejectedPlans ? plan - protocol::kMaxRejectedPlans : 0);
+      for (std::uint64_t missing = first; missing < plan; ++missing) {
+        refusedPlans_.push_back(missing);
+        ++result_.updatesMissed;
+      }
+    }
+    lastPlanSeen_ = std::max(lastPlanSeen_, plan);
   }
 
   // The frame's identity and what was drawn, into record_.
@@ -234,16 +265,30 @@ class Replay {
 
   void sendStats(const Pose& pose) {
     if (!link_.connected()) return;
-    // Oldest first; a flood beyond the message's limit keeps the newest.
-    const std::size_t skip = refusedPlans_.size() > protocol::kMaxRejectedPlans
-                                 ? refusedPlans_.size() - protocol::kMaxRejectedPlans
+    // A FrameStats can be lost like any message, so each refusal is reported
+    // in kRefusalReports FrameStats in a row (a repeat is a no-op at the
+    // backbone). Oldest first; a flood beyond the message's limit keeps the
+    // newest.
+    std::vector<std::uint64_t> report;
+    for (const auto& [plan, left] : refusalsToRepeat_) report.push_back(plan);
+    report.insert(report.end(), refusedPlans_.begin(), refusedPlans_.end());
+    const std::size_t skip = report.size() > protocol::kMaxRejectedPlans
+                                 ? report.size() - protocol::kMaxRejectedPlans
                                  : 0;
-    const Status sent = link_.send(toFrameStats(
-        record_, secondsToNanoseconds(pose.time),
-        std::vector<std::uint64_t>(refusedPlans_.begin() + static_cast<std::ptrdiff_t>(skip),
-                                   refusedPlans_.end())));
-    if (sent.ok()) refusedPlans_.clear();
-    if (!sent.ok()) observer_.onSendFailed("FrameStats", record_.frame, sent);
+    report.erase(report.begin(), report.begin() + static_cast<std::ptrdiff_t>(skip));
+    const Status sent =
+        link_.send(toFrameStats(record_, secondsToNanoseconds(pose.time), std::move(report)));
+    if (!sent.ok()) {
+      observer_.onSendFailed("FrameStats", record_.frame, sent);
+      return;
+    }
+    for (auto it = refusalsToRepeat_.begin(); it != refusalsToRepeat_.end();)
+      it = --it->second == 0 ? refusalsToRepeat_.erase(it) : std::next(it);
+    if (kRefusalReports > 1)
+      for (std::uint64_t plan : refusedPlans_)
+        refusalsToRepeat_.push_back({plan, kRefusalReports - 1});
+    while (refusalsToRepeat_.size() > protocol::kMaxRejectedPlans) refusalsToRepeat_.pop_front();
+    refusedPlans_.clear();
   }
 
   PoseSource& source_;
@@ -256,8 +301,12 @@ class Replay {
   std::vector<std::int64_t> poseSentNs_;  // -1: not sent
   std::vector<bool> answered_;            // an update for this pose arrived
   std::deque<SubmittedUpdate> submitted_;
-  // Plans of updates refused or dropped since the last FrameStats.
+  // Plans of updates refused, dropped or missed since the last FrameStats.
   std::vector<std::uint64_t> refusedPlans_;
+  // Refusals already reported, with the reports still to repeat them.
+  static constexpr int kRefusalReports = 3;
+  std::deque<std::pair<std::uint64_t, int>> refusalsToRepeat_;
+  std::uint64_t lastPlanSeen_ = 0;  // the highest plan number of this backbone process
   double targetAccuracy_ = kMissingValue;
   std::optional<std::int64_t> firstSampledNs_;  // frame 0's pose
   FrameRecord record_;                          // the frame being made

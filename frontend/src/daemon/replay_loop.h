@@ -12,6 +12,10 @@
 //   the frame; then measure it against the reference (FrameProducer::measure
 //   fills FrameRecord::quality), hand the frame's FrameRecord to
 //   ReplayObserver::onFrame and send FrameStats (toFrameStats, wire_conversion.h).
+// - Refusals: FrameStats.rejectedPlans lists the plans of updates refused
+//   (bad update, upload dropped) and of updates missed (a jump in the plan
+//   numbers of one backbone process: lost on the way); each is repeated in 3
+//   FrameStats in a row, since a FrameStats can be lost too.
 // - Memory: the loop keeps no records (the observer streams them, e.g. into a
 //   FrameLog); per frame it keeps 8 bytes (when the pose was sent, for
 //   update_latency_ms of a later answer) and 1 bit (answered), whatever the
@@ -163,6 +167,9 @@ struct ReplayResult {
   std::size_t updatesReceived = 0;
   std::size_t updatesApplied = 0;  // became visible
   std::size_t updatesRejected = 0;
+  // Plan numbers skipped by the updates that arrived (lost on the way);
+  // reported as refused in FrameStats.
+  std::size_t updatesMissed = 0;
   std::size_t lockstepTimeouts = 0;
   std::size_t posesNotSent = 0;  // link down at the time
   std::size_t posesSkipped = 0;  // a stream's poses overtaken by newer ones before a frame

@@ -32,7 +32,9 @@ Result<std::unique_ptr<Channel>> Channel::connect(Options options) {
   options.hello.maxVersion = kProtocolVersion;
   if (options.hello.instanceId == 0) options.hello.instanceId = randomInstanceId();
   THINLOD_RETURN_IF_ERROR(validate(options.hello));
+  THINLOD_RETURN_IF_ERROR(detail::FaultInjector::check(options.transport.faults));
   auto impl = std::make_unique<Impl>();
+  impl->faults = detail::FaultInjector(options.transport.faults);
   impl->context = detail::sharedContext();
   auto security = detail::prepareClientSecurity(options.address, options.transport.curve);
   if (!security.ok()) return security.status();
@@ -81,7 +83,9 @@ Status Channel::send(const Message& message) {
     return Status(ErrorCode::kUnavailable,
                   "not connected to " + impl_->options.address + " (no handshake yet)");
   }
-  return impl_->sendMessage(message, Clock::now());
+  return detail::sendWithFaults(impl_->faults, impl_->stats, "channel=" + impl_->options.hello.name,
+                                messageName(message),
+                                [&] { return impl_->sendMessage(message, Clock::now()); });
 }
 
 Status Channel::sendEncoded(const Bytes& encoded) {
@@ -92,7 +96,9 @@ Status Channel::sendEncoded(const Bytes& encoded) {
   auto version = peekVersion(encoded.data(), encoded.size());
   if (!version.ok())
     return Status(ErrorCode::kInvalidArgument, "sendEncoded: " + version.status().message());
-  return impl_->sendRaw(encoded.data(), encoded.size(), Clock::now());
+  return detail::sendWithFaults(
+      impl_->faults, impl_->stats, "channel=" + impl_->options.hello.name, "encoded",
+      [&] { return impl_->sendRaw(encoded.data(), encoded.size(), Clock::now()); });
 }
 
 Status Channel::Impl::openSocket(Clock::time_point now) {

@@ -28,7 +28,9 @@ Result<std::unique_ptr<Endpoint>> Endpoint::bind(Options options) {
     return Status(ErrorCode::kInvalidArgument,
                   "heartbeat interval and liveness misses must be positive");
   }
+  THINLOD_RETURN_IF_ERROR(detail::FaultInjector::check(options.transport.faults));
   auto impl = std::make_unique<Impl>();
+  impl->faults = detail::FaultInjector(options.transport.faults);
   impl->context = detail::sharedContext();
   auto security = detail::prepareServerSecurity(impl->context, options.address,
                                                 options.transport.curve, options.name);
@@ -102,7 +104,10 @@ Status Endpoint::send(PeerId peer, const Message& message) {
   if (it == impl_->peers.end()) {
     return Status(ErrorCode::kNotFound, "peer " + std::to_string(peer.value) + " is not connected");
   }
-  return impl_->sendMessage(it->second.routingId, message);
+  const std::string& routingId = it->second.routingId;
+  return detail::sendWithFaults(impl_->faults, impl_->stats, "endpoint=" + impl_->options.name,
+                                messageName(message),
+                                [&] { return impl_->sendMessage(routingId, message); });
 }
 
 Status Endpoint::sendEncoded(PeerId peer, const Bytes& encoded) {
@@ -113,7 +118,10 @@ Status Endpoint::sendEncoded(PeerId peer, const Bytes& encoded) {
   auto version = peekVersion(encoded.data(), encoded.size());
   if (!version.ok())
     return Status(ErrorCode::kInvalidArgument, "sendEncoded: " + version.status().message());
-  return impl_->sendRaw(it->second.routingId, encoded.data(), encoded.size());
+  const std::string& routingId = it->second.routingId;
+  return detail::sendWithFaults(
+      impl_->faults, impl_->stats, "endpoint=" + impl_->options.name, "encoded",
+      [&] { return impl_->sendRaw(routingId, encoded.data(), encoded.size()); });
 }
 
 Status Endpoint::Impl::sendRaw(const std::string& routingId, const std::uint8_t* data,

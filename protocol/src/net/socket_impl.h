@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -54,6 +55,29 @@ Status serverSecurityCheck(const std::string& address, const CurveOptions& curve
 void applyServerSecurity(zmq::socket_t& socket, const ServerSecurity& security);
 void applyClientSecurity(zmq::socket_t& socket, const ClientSecurity& security);
 
+// MessageFaults on the send side: one decision per application message.
+// Deterministic for a seed (SplitMix64, no std distribution, so every
+// standard library draws the same sequence).
+class FaultInjector {
+ public:
+  enum class Action { kSend, kDrop, kDuplicate };
+  // kInvalidArgument when a probability is not finite, outside [0, 1], or
+  // their sum exceeds 1.
+  static Status check(const MessageFaults& faults);
+  explicit FaultInjector(const MessageFaults& faults = {});
+  bool enabled() const { return faults_.enabled(); }
+  Action next();
+
+ private:
+  MessageFaults faults_;
+  std::uint64_t state_;
+};
+
+// Sends through `sendOnce` according to `injector` (which may be disabled:
+// then exactly one send). Logs and counts what it did.
+Status sendWithFaults(FaultInjector& injector, TransportStats& stats, const std::string& who,
+                      const char* messageName, const std::function<Status()>& sendOnce);
+
 // Reads the socket's handshake-failure events (zmq_socket_monitor) and logs
 // them: a peer with a wrong or missing key, or refused by ZAP.
 class HandshakeMonitor {
@@ -99,6 +123,7 @@ struct Endpoint::Impl {
   std::map<std::string, std::uint64_t> byRouting;  // routing id -> PeerId
   std::uint64_t nextPeerId = 1;
   TransportStats stats;
+  detail::FaultInjector faults;  // tests only (TransportOptions::faults)
   std::vector<EndpointEvent> events;
 
   Status sendRaw(const std::string& routingId, const std::uint8_t* data, std::size_t size);
@@ -127,6 +152,7 @@ struct Channel::Impl {
   detail::Clock::time_point lastHello;
   std::uint64_t heartbeatSequence = 0;
   TransportStats stats;
+  detail::FaultInjector faults;  // tests only (TransportOptions::faults)
   std::vector<ChannelEvent> events;
 
   Status openSocket(detail::Clock::time_point now);

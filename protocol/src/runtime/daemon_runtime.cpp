@@ -196,8 +196,19 @@ void DaemonRuntime::addTransportOptions(TransportOptions* target) {
             "binding daemons: the public keys of the clients let in (.pub files concatenated)");
   addOption("transport.curve_plaintext_remote", &target->curve.plaintextRemote,
             "allow plain text (no CURVE) beyond loopback: isolated test networks only");
-  impl_->afterParse.push_back([target, heartbeatMs] {
+  // Fault tests only (TransportOptions::faults): off unless a probability is set.
+  auto faultSeed = std::make_unique<std::int64_t>(static_cast<std::int64_t>(target->faults.seed));
+  std::int64_t* faultSeedValue = faultSeed.get();
+  impl_->staging.push_back(std::move(faultSeed));
+  addOption("transport.test_drop_probability", &target->faults.dropProbability,
+            "fault tests only: drop this share of the messages this daemon sends (0: off)");
+  addOption("transport.test_duplicate_probability", &target->faults.duplicateProbability,
+            "fault tests only: send this share of the messages twice (0: off)");
+  addOption("transport.test_fault_seed", faultSeedValue,
+            "fault tests only: seed of the drop/duplicate draws");
+  impl_->afterParse.push_back([target, heartbeatMs, faultSeedValue] {
     target->heartbeatInterval = std::chrono::milliseconds(*heartbeatMs);
+    target->faults.seed = static_cast<std::uint64_t>(*faultSeedValue);
   });
 }
 

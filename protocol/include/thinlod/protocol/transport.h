@@ -70,11 +70,30 @@ struct CurveOptions {
 enum class LinkSide { kBind, kConnect };
 Status checkLinkSecurity(const std::string& address, const CurveOptions& curve, LinkSide side);
 
+// Single-message faults, for fault tests and campaigns only (off by default;
+// docs/results/reliability.md, "Single-message faults"). ZeroMQ over TCP
+// delivers each message once or loses the session, so a lost or repeated
+// message never happens on its own: this makes it happen. Each message the
+// application sends (Endpoint/Channel send and sendEncoded; never the
+// session's Hello, HelloReply, Heartbeat or Shutdown) is, with these
+// probabilities drawn from a generator seeded with `seed`, dropped (send
+// returns OK, as a lost message would look) or sent twice back to back.
+// Probabilities must be finite, in [0, 1], with a sum of at most 1, or bind
+// / connect fails with kInvalidArgument. Counted in TransportStats and
+// logged (event=fault_injected, info level).
+struct MessageFaults {
+  double dropProbability = 0.0;
+  double duplicateProbability = 0.0;
+  std::uint64_t seed = 1;
+  bool enabled() const { return dropProbability > 0.0 || duplicateProbability > 0.0; }
+};
+
 struct TransportOptions {
   std::chrono::milliseconds heartbeatInterval{500};
   int livenessMisses = 4;        // silent for heartbeatInterval * livenessMisses => gone
   int sendHighWaterMark = 1000;  // messages queued per peer before send fails
   CurveOptions curve;
+  MessageFaults faults;  // tests only: see MessageFaults
   std::chrono::milliseconds livenessTimeout() const { return heartbeatInterval * livenessMisses; }
 };
 
@@ -86,6 +105,8 @@ struct TransportStats {
   std::uint64_t malformedDropped = 0;   // failed decode or bad framing
   std::uint64_t unexpectedDropped = 0;  // valid but not allowed here (e.g. before Hello)
   std::uint64_t handshakesFailed = 0;   // CURVE: ZMTP handshakes refused (wrong key, no key)
+  std::uint64_t faultsDropped = 0;      // MessageFaults: sends dropped on purpose
+  std::uint64_t faultsDuplicated = 0;   // MessageFaults: sends made twice on purpose
 };
 
 // Opaque handle of a peer as seen by an Endpoint; a restarted peer gets a new one.
