@@ -181,7 +181,9 @@ TEST(MessageFaults, SeededDrawsRepeatAndMatchTheProbabilities) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_GE(a[i], 1u);
     ASSERT_LE(a[i], kMessages);
-    if (i > 0) ASSERT_GE(a[i], a[i - 1]);
+    if (i > 0) {
+      ASSERT_GE(a[i], a[i - 1]);
+    }
     ++copies[a[i]];
   }
   std::size_t dropped = 0;

@@ -376,6 +376,24 @@ TEST(MeshIo, PlyHeaderLinesWithExtraOrMissingWordsAreRejected) {
   EXPECT_EQ(good->mesh.triangleCount(), 1u);
 }
 
+// Fuzz finding 19 (mesh, OpenMesh's texture-coordinate property written out of
+// bounds): OpenMesh ends OBJ lines at line feeds only, so "v 1 1 0\rv 0 1 0"
+// is one vertex to it and two to a scanner that also ends lines at a lone
+// carriage return; faces checked against two then indexed past its vertices.
+TEST(MeshIo, ObjCarriageReturnWithoutLineFeedIsRejected) {
+  const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\rv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\n";
+  Result<LoadedMesh> r = loadMeshFromMemory(quad, "obj", "cr.obj");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(contains(r.status().message(), "cr.obj:3: carriage return without a line feed"))
+      << r.status().message();
+  // CR LF line ends (and a final lone CR) read the same for both and load.
+  Result<LoadedMesh> crlf = loadMeshFromMemory(
+      "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nvt 0 0\r\nf 1/1 2/1 3/1\r", "obj", "crlf.obj");
+  ASSERT_TRUE(crlf.ok()) << crlf.status().toString();
+  EXPECT_EQ(crlf->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

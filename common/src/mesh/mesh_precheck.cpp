@@ -140,8 +140,27 @@ Status checkObjVertexColour(const std::vector<std::string_view>& tokens, const s
   return checkColourRange(tokens, 4, name, line);
 }
 
+// OpenMesh's OBJ reader ends lines at line feeds only, so a carriage return
+// without one ("v 1 1 0\rv 0 1 0", old Mac line ends) hides the rest of its
+// line from OpenMesh while our scanner saw two lines: face references
+// checked against our vertex count then went past OpenMesh's vertices (an
+// out-of-bounds texture-coordinate write, fuzz finding 19, seed
+// fuzz/corpus/mesh/crash-obj-lone-carriage-return.obj). Refused, naming the line.
+Status checkObjLineEnds(std::string_view bytes, const std::string& name) {
+  int line = 1;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (bytes[i] == '\n') ++line;
+    if (bytes[i] == '\r' && (i + 1 == bytes.size() || bytes[i + 1] != '\n')) {
+      if (i + 1 == bytes.size()) break;  // a final CR ends the last line for both readers
+      return lineError(name, line, "carriage return without a line feed (old Mac line end)");
+    }
+  }
+  return Status();
+}
+
 Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& name,
                                    const MeshLoadOptions& options) {
+  THINLOD_RETURN_IF_ERROR(checkObjLineEnds(bytes, name));
   LineScanner scanner(bytes);
   std::string_view line;
   std::uint64_t vertices = 0;
