@@ -21,20 +21,11 @@
 namespace thinlod::simplifier {
 
 using namespace service_detail;
-using codec::MeshEncodeOptions;
 namespace fs = std::filesystem;
 
 namespace {
 
 Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
-
-// Triangle count stored in an encodeMesh frame (header offset 12, u32 LE).
-std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
-  if (frame.size() < codec::kFrameHeaderBytes) return 0;
-  return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |
-         (static_cast<std::uint32_t>(frame[14]) << 16) |
-         (static_cast<std::uint32_t>(frame[15]) << 24);
-}
 
 // True when `path` lies strictly inside `root` (both canonical).
 bool isInside(const fs::path& path, const fs::path& root) {
@@ -277,16 +268,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     ++stats.levelsMeasuredAlone;
     const double d =
         std::max(relativeError(error->max(), model.diameter), options.curve.minRelativeError);
-    const DeliveredLevel delivered = deliveredLevel(d);
-    MeshEncodeOptions encode;
-    encode.positionBits = delivered.positionBits;
-    Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
-    if (!frame.ok()) return frame.status();
-    protocol::SimplifyResult result;
-    result.mesh = std::move(frame).value();
-    result.triangleCount = frameTriangles(result.mesh);
-    result.accuracy = delivered.accuracy;
-    return result;
+    return encodedMeshResult(mesh, deliveredLevel(d));
   }
   THINLOD_RETURN_IF_ERROR(ensureCurve(model));
   const ProgressiveMesh& pm = model.pm;
@@ -303,16 +285,10 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
   }
   const IndexedMesh mesh = pm.extract(target);
   const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
-  const DeliveredLevel delivered = deliveredLevel(credit.relativeError);
-  MeshEncodeOptions encode;
-  encode.positionBits = delivered.positionBits;
-  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
-  if (!frame.ok()) return frame.status();
-
-  protocol::SimplifyResult result;
-  result.mesh = std::move(frame).value();
-  result.triangleCount = frameTriangles(result.mesh);
-  result.accuracy = delivered.accuracy;
+  Result<protocol::SimplifyResult> encoded =
+      encodedMeshResult(mesh, deliveredLevel(credit.relativeError));
+  if (!encoded.ok()) return encoded.status();
+  protocol::SimplifyResult result = std::move(encoded).value();
   if (request.curvePoints > 0) {
     std::vector<AccuracySample> points;
     for (const LevelCredit& rung : model.ladder) {
@@ -349,16 +325,9 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyPrimitive(
     }
   }
   const IndexedMesh mesh = tessellate(shape, params);
-  const DeliveredLevel level = delivered(params);
-  MeshEncodeOptions encode;
-  encode.positionBits = level.positionBits;
-  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
-  if (!frame.ok()) return frame.status();
-
-  protocol::SimplifyResult result;
-  result.mesh = std::move(frame).value();
-  result.triangleCount = frameTriangles(result.mesh);
-  result.accuracy = level.accuracy;
+  Result<protocol::SimplifyResult> encoded = encodedMeshResult(mesh, delivered(params));
+  if (!encoded.ok()) return encoded.status();
+  protocol::SimplifyResult result = std::move(encoded).value();
   if (request.curvePoints > 0) {
     const int coarsest = tessellationTriangles(shape, chooseTessellation(shape, 0));
     const int finest = std::min(maxTriangles, 16384);

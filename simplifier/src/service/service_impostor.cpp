@@ -33,13 +33,6 @@ Status invalid(const std::string& message) {
   return Status(ErrorCode::kInvalidArgument, "impostor: " + message);
 }
 
-std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
-  if (frame.size() < codec::kFrameHeaderBytes) return 0;
-  return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |
-         (static_cast<std::uint32_t>(frame[14]) << 16) |
-         (static_cast<std::uint32_t>(frame[15]) << 24);
-}
-
 // Takes the image by value: the raw codec moves its pixels onto the wire.
 Result<protocol::Texture> encodeTexture(RgbaImage image, protocol::TextureCodec requested) {
   protocol::Texture texture;

@@ -50,6 +50,13 @@ struct DeliveredLevel {
   double accuracy = 0.0;
 };
 DeliveredLevel deliveredLevel(double relativeError);
+// Triangle count stored in an encodeMesh frame (header offset 12, u32 LE):
+// what the client will hold; 0 for a frame shorter than its header.
+std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame);
+// A SimplifyResult carrying `mesh` encoded at `delivered`'s position bits and
+// credited its accuracy (triangleCount from the encoded frame).
+Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
+                                                   const DeliveredLevel& delivered);
 
 // Credits from measured levels (increasing triangles): each rung gets the
 // worst error measured at it or any finer rung, so credits never improve by

@@ -25,6 +25,26 @@ DeliveredLevel deliveredLevel(double relativeError) {
   return out;
 }
 
+std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
+  if (frame.size() < codec::kFrameHeaderBytes) return 0;
+  return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |
+         (static_cast<std::uint32_t>(frame[14]) << 16) |
+         (static_cast<std::uint32_t>(frame[15]) << 24);
+}
+
+Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
+                                                   const DeliveredLevel& delivered) {
+  codec::MeshEncodeOptions encode;
+  encode.positionBits = delivered.positionBits;
+  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
+  if (!frame.ok()) return frame.status();
+  protocol::SimplifyResult result;
+  result.mesh = std::move(frame).value();
+  result.triangleCount = frameTriangles(result.mesh);
+  result.accuracy = delivered.accuracy;
+  return result;
+}
+
 std::vector<LevelCredit> creditLevels(const std::vector<CurveLevel>& levels,
                                       double minRelativeError) {
   const std::vector<double> credits = creditedRelativeErrors(levels, minRelativeError);
