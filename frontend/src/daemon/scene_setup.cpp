@@ -9,16 +9,6 @@
 #include "thinlod/common/scene_render/scene_render.h"
 
 namespace thinlod::frontend::daemon {
-namespace {
-
-// The bytes of a texture file, at most `limit` of them.
-Result<std::vector<std::uint8_t>> readTextureFile(const std::string& path, std::size_t limit) {
-  Result<std::string> bytes = readFileBounded(path, limit);
-  if (!bytes.ok()) return bytes.status();
-  return std::vector<std::uint8_t>(bytes->begin(), bytes->end());
-}
-
-}  // namespace
 
 Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::string& modelsDir) {
   scene::SceneLoadOptions loadOptions;
@@ -44,10 +34,11 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     if (known != textures.end()) return known->second;
     std::shared_ptr<const RgbaImage> image;
     const codec::DecodeLimits limits;
-    Result<std::vector<std::uint8_t>> bytes = readTextureFile(path, limits.maxPayloadBytes);
-    Result<RgbaImage> decoded = bytes.ok()
-                                    ? codec::decodeImageFile(bytes->data(), bytes->size(), limits)
-                                    : Result<RgbaImage>(bytes.status());
+    Result<std::string> bytes = readFileBounded(path, limits.maxPayloadBytes);
+    Result<RgbaImage> decoded =
+        bytes.ok() ? codec::decodeImageFile(reinterpret_cast<const std::uint8_t*>(bytes->data()),
+                                            bytes->size(), limits)
+                   : Result<RgbaImage>(bytes.status());
     if (decoded.ok()) {
       image = std::make_shared<const RgbaImage>(std::move(decoded).value());
       ++loaded.textures;
