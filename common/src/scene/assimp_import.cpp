@@ -21,6 +21,7 @@
 
 #include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_import.h"
+#include "thinlod/common/scene/skinned_import.h"
 
 namespace thinlod::scene {
 namespace {
@@ -651,6 +652,331 @@ Result<LoadedMesh> importSceneAsMesh(const std::string& path, const ImportLimits
                          std::string(anyMaterialOrTexture ? " and textures" : "") +
                          " are replaced by the Shape's Appearance");
   return out;
+}
+
+}  // namespace thinlod::scene
+
+// ---------------------------------------------------------------------------
+// Skinned models (contract in skinned_import.h). Here, not in a file of its
+// own, because it shares the bounded IO system and the glTF pre-check.
+namespace thinlod::scene {
+namespace {
+
+// Keys of one Assimp channel component, seconds, repeated times keep the
+// last, clamped into [0, duration].
+template <typename AiKey, typename Key, typename Convert>
+std::vector<Key> convertKeys(const AiKey* keys, unsigned count, double ticksPerSecond,
+                             double duration, Convert convert) {
+  std::vector<Key> out;
+  out.reserve(count);
+  for (unsigned k = 0; k < count; ++k) {
+    Key key;
+    key.time = std::clamp(keys[k].mTime / ticksPerSecond, 0.0, duration);
+    key.value = convert(keys[k].mValue);
+    if (!out.empty() && !(key.time > out.back().time)) {
+      if (key.time == out.back().time) out.back() = key;  // repeated time: keep the last
+      continue;                                           // out of order: dropped
+    }
+    out.push_back(key);
+  }
+  return out;
+}
+
+class SkinnedConverter {
+ public:
+  SkinnedConverter(const std::string& path, const aiScene& ai, const SkinnedImportLimits& limits)
+      : path_(path), ai_(ai), limits_(limits) {}
+
+  Result<SkinnedModel> run() {
+    THINLOD_RETURN_IF_ERROR(buildSkeleton());
+    THINLOD_RETURN_IF_ERROR(copyMeshes());
+    THINLOD_RETURN_IF_ERROR(copyClips());
+    THINLOD_RETURN_IF_ERROR(model_.skeleton.validate(path_));
+    THINLOD_RETURN_IF_ERROR(model_.mesh.validate(path_));
+    THINLOD_RETURN_IF_ERROR(anim::validateSkin(model_.skin, model_.mesh.vertexCount(),
+                                               model_.skeleton.bones.size(), path_));
+    for (const anim::AnimationClip& clip : model_.clips) {
+      THINLOD_RETURN_IF_ERROR(clip.validate(model_.skeleton, path_));
+    }
+    return std::move(model_);
+  }
+
+ private:
+  Status fail(ErrorCode code, const std::string& message) const {
+    return Status(code, path_ + ": " + message);
+  }
+
+  Status buildSkeleton() {
+    if (ai_.mRootNode == nullptr) return fail(ErrorCode::kInvalidArgument, "no node tree");
+    // Preorder with an explicit stack: parents get lower indices.
+    std::vector<std::pair<const aiNode*, int>> stack{{ai_.mRootNode, -1}};
+    std::vector<int> depth;
+    while (!stack.empty()) {
+      const auto [node, parent] = stack.back();
+      stack.pop_back();
+      if (model_.skeleton.bones.size() >= limits_.files.maxNodes) {
+        return fail(ErrorCode::kResourceExhausted,
+                    "more than " + std::to_string(limits_.files.maxNodes) + " nodes");
+      }
+      const int d = parent < 0 ? 0 : depth[static_cast<std::size_t>(parent)] + 1;
+      if (d > limits_.files.maxDepth) {
+        return fail(ErrorCode::kResourceExhausted,
+                    "node tree deeper than " + std::to_string(limits_.files.maxDepth));
+      }
+      anim::Bone bone;
+      bone.name = node->mName.C_Str();
+      bone.parent = parent;
+      bone.restLocal = toGlm(node->mTransformation);
+      const int index = static_cast<int>(model_.skeleton.bones.size());
+      model_.skeleton.bones.push_back(std::move(bone));
+      depth.push_back(d);
+      nodeIndex_.emplace(node, index);
+      byName_.emplace(node->mName.C_Str(), index);  // first node of a name wins
+      if (node->mNumChildren > 0 && node->mChildren == nullptr) {
+        return fail(ErrorCode::kInvalidArgument, "node without its children");
+      }
+      for (unsigned c = node->mNumChildren; c-- > 0;) {
+        if (node->mChildren[c] == nullptr) continue;
+        stack.push_back({node->mChildren[c], index});
+      }
+    }
+    return Status::okStatus();
+  }
+
+  Status copyMeshes() {
+    std::vector<bool> skinnedCopied(ai_.mNumMeshes, false);
+    // Mesh instances in node order.
+    for (const auto& [node, index] : orderedNodes()) {
+      for (unsigned m = 0; m < node->mNumMeshes; ++m) {
+        const unsigned meshIndex = node->mMeshes[m];
+        if (meshIndex >= ai_.mNumMeshes || ai_.mMeshes[meshIndex] == nullptr) {
+          return fail(ErrorCode::kInvalidArgument, "node refers to a missing mesh");
+        }
+        const aiMesh& mesh = *ai_.mMeshes[meshIndex];
+        if (mesh.mNumBones > 0) {
+          if (skinnedCopied[meshIndex]) continue;  // bones place it, not the node
+          skinnedCopied[meshIndex] = true;
+          ++model_.skinnedMeshes;
+        }
+        THINLOD_RETURN_IF_ERROR(copyMesh(mesh, static_cast<std::uint32_t>(index)));
+      }
+    }
+    if (model_.mesh.triangleCount() == 0) {
+      return fail(ErrorCode::kInvalidArgument, "contains no triangles");
+    }
+    if (!allNormals_) model_.mesh.normals.clear();
+    if (!allUvs_) model_.mesh.uvs.clear();
+    if (model_.mesh.normals.empty()) model_.mesh.computeNormals();
+    return Status::okStatus();
+  }
+
+  std::vector<std::pair<const aiNode*, int>> orderedNodes() const {
+    std::vector<std::pair<const aiNode*, int>> nodes(nodeIndex_.begin(), nodeIndex_.end());
+    std::sort(nodes.begin(), nodes.end(),
+              [](const auto& a, const auto& b) { return a.second < b.second; });
+    return nodes;
+  }
+
+  Status copyMesh(const aiMesh& mesh, std::uint32_t node) {
+    IndexedMesh& out = model_.mesh;
+    if (mesh.mVertices == nullptr && mesh.mNumVertices > 0) {
+      return fail(ErrorCode::kInvalidArgument, "mesh without vertex positions");
+    }
+    if (out.vertexCount() + mesh.mNumVertices > limits_.files.maxVertices) {
+      return fail(ErrorCode::kResourceExhausted,
+                  "more than " + std::to_string(limits_.files.maxVertices) + " vertices");
+    }
+    if (out.triangleCount() + mesh.mNumFaces > limits_.files.maxTriangles) {
+      return fail(ErrorCode::kResourceExhausted,
+                  "more than " + std::to_string(limits_.files.maxTriangles) + " triangles");
+    }
+    const auto base = static_cast<std::uint32_t>(out.vertexCount());
+    allNormals_ &= mesh.mNormals != nullptr;
+    allUvs_ &= mesh.mTextureCoords[0] != nullptr;
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      if (!finite3(mesh.mVertices[v])) {
+        return fail(ErrorCode::kInvalidArgument, "non-finite vertex position");
+      }
+      out.positions.emplace_back(mesh.mVertices[v].x, mesh.mVertices[v].y, mesh.mVertices[v].z);
+      if (mesh.mNormals != nullptr) {
+        const aiVector3D& n = mesh.mNormals[v];
+        out.normals.emplace_back(finite3(n) ? glm::vec3(n.x, n.y, n.z) : glm::vec3(0, 0, 1));
+      }
+      if (mesh.mTextureCoords[0] != nullptr) {
+        const aiVector3D& t = mesh.mTextureCoords[0][v];
+        out.uvs.emplace_back(std::isfinite(t.x) ? t.x : 0.0f, std::isfinite(t.y) ? t.y : 0.0f);
+      }
+    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines: dropped
+      for (unsigned i = 0; i < 3; ++i) {
+        if (face.mIndices[i] >= mesh.mNumVertices) {
+          return fail(ErrorCode::kInvalidArgument, "face index out of range");
+        }
+        out.indices.push_back(base + face.mIndices[i]);
+      }
+    }
+    // Weights: every (vertex, weight) of every bone, then the two largest.
+    std::vector<std::vector<std::pair<float, std::uint32_t>>> influences(mesh.mNumVertices);
+    for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+      const aiBone* bone = mesh.mBones[b];
+      if (bone == nullptr) return fail(ErrorCode::kInvalidArgument, "missing bone");
+      const auto found = byName_.find(bone->mName.C_Str());
+      if (found == byName_.end()) {
+        return fail(ErrorCode::kInvalidArgument,
+                    std::string("bone '") + bone->mName.C_Str() + "' names no node");
+      }
+      const glm::mat4 offset = toGlm(bone->mOffsetMatrix);
+      if (model_.skeleton.bones.size() >= limits_.files.maxNodes) {
+        return fail(ErrorCode::kResourceExhausted, "too many bones");
+      }
+      anim::Bone binding;
+      binding.name = std::string(bone->mName.C_Str()) + "#bind";
+      binding.parent = found->second;
+      binding.inverseBind = offset;
+      const auto bindingIndex = static_cast<std::uint32_t>(model_.skeleton.bones.size());
+      model_.skeleton.bones.push_back(std::move(binding));
+      for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+        const aiVertexWeight& weight = bone->mWeights[w];
+        if (weight.mVertexId >= mesh.mNumVertices) {
+          return fail(ErrorCode::kInvalidArgument, "bone weight for a vertex out of range");
+        }
+        if (!std::isfinite(weight.mWeight) || weight.mWeight < 0.0f) {
+          return fail(ErrorCode::kInvalidArgument, "non-finite or negative bone weight");
+        }
+        if (weight.mWeight > 0.0f) influences[weight.mVertexId].push_back({weight.mWeight, bindingIndex});
+      }
+    }
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      auto& list = influences[v];
+      anim::VertexSkin skin;
+      if (list.empty()) {
+        skin.boneA = skin.boneB = node;  // rigid on the node holding the mesh
+        if (mesh.mNumBones > 0) ++model_.unweightedVertices;
+      } else {
+        std::sort(list.begin(), list.end(), std::greater<>());
+        if (list.size() > 2) {
+          ++model_.verticesOverTwoBones;
+          model_.largestDroppedWeight = std::max(model_.largestDroppedWeight, list[2].first);
+        }
+        skin.boneA = skin.boneB = list[0].second;
+        if (list.size() > 1) {
+          skin.boneB = list[1].second;
+          skin.weightB = list[1].first / (list[0].first + list[1].first);
+        }
+      }
+      model_.skin.push_back(skin);
+    }
+    return Status::okStatus();
+  }
+
+  Status copyClips() {
+    std::size_t keys = 0;
+    for (unsigned a = 0; a < ai_.mNumAnimations; ++a) {
+      const aiAnimation* animation = ai_.mAnimations[a];
+      if (animation == nullptr) continue;
+      const double ticksPerSecond =
+          animation->mTicksPerSecond > 0.0 && std::isfinite(animation->mTicksPerSecond)
+              ? animation->mTicksPerSecond
+              : 25.0;
+      if (!std::isfinite(animation->mDuration) || animation->mDuration <= 0.0) continue;
+      anim::AnimationClip clip;
+      clip.name = animation->mName.C_Str();
+      clip.duration = animation->mDuration / ticksPerSecond;
+      std::set<std::uint32_t> driven;
+      for (unsigned c = 0; c < animation->mNumChannels; ++c) {
+        const aiNodeAnim* channel = animation->mChannels[c];
+        if (channel == nullptr) continue;
+        const auto found = byName_.find(channel->mNodeName.C_Str());
+        if (found == byName_.end() ||
+            !driven.insert(static_cast<std::uint32_t>(found->second)).second) {
+          ++model_.unmatchedChannels;
+          continue;
+        }
+        keys += std::size_t{channel->mNumPositionKeys} + channel->mNumRotationKeys +
+                channel->mNumScalingKeys;
+        if (keys > limits_.maxKeys) {
+          return fail(ErrorCode::kResourceExhausted,
+                      "more than " + std::to_string(limits_.maxKeys) + " animation keys");
+        }
+        anim::BoneChannel out;
+        out.bone = static_cast<std::uint32_t>(found->second);
+        const auto vec = [](const aiVector3D& v) { return glm::vec3(v.x, v.y, v.z); };
+        out.positions = convertKeys<aiVectorKey, anim::VectorKey>(
+            channel->mPositionKeys, channel->mNumPositionKeys, ticksPerSecond, clip.duration, vec);
+        out.scales = convertKeys<aiVectorKey, anim::VectorKey>(
+            channel->mScalingKeys, channel->mNumScalingKeys, ticksPerSecond, clip.duration, vec);
+        out.rotations = convertKeys<aiQuatKey, anim::RotationKey>(
+            channel->mRotationKeys, channel->mNumRotationKeys, ticksPerSecond, clip.duration,
+            [](const aiQuaternion& q) {
+              glm::quat r(q.w, q.x, q.y, q.z);
+              const float n = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+              // Files store slightly denormalised quaternions; a zero or
+              // non-finite one stays as it is and fails validation.
+              return n > 1e-6f && std::isfinite(n) ? r / n : r;
+            });
+        clip.channels.push_back(std::move(out));
+      }
+      model_.clips.push_back(std::move(clip));
+    }
+    return Status::okStatus();
+  }
+
+  const std::string& path_;
+  const aiScene& ai_;
+  SkinnedImportLimits limits_;
+  SkinnedModel model_;
+  std::map<const aiNode*, int> nodeIndex_;
+  std::map<std::string, int> byName_;
+  bool allNormals_ = true;
+  bool allUvs_ = true;
+};
+
+}  // namespace
+
+Result<SkinnedModel> importSkinnedModel(const std::string& path,
+                                        const SkinnedImportLimits& limits) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Status(ErrorCode::kNotFound, path + ": no such file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
+  if (size == 0) return Status(ErrorCode::kInvalidArgument, path + ": empty file");
+  if (size > limits.files.maxFileBytes) {
+    return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
+                                                     " bytes exceed the limit of " +
+                                                     std::to_string(limits.files.maxFileBytes));
+  }
+  try {
+    const std::string ext = lowerExtension(path);
+    if (ext == ".gltf" || ext == ".glb") {
+      Result<GltfDeclared> checked = precheckGltf(path, size, limits.files);
+      if (!checked.ok()) return checked.status();
+    }
+    Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
+    auto* io = new BoundedIOSystem(limits.files);
+    importer.SetIOHandler(io);  // the importer owns it
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                           aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+    const aiScene* ai = importer.ReadFile(path, flags);
+    if (!io->refusal().empty()) {
+      return Status(ErrorCode::kResourceExhausted, path + ": " + io->refusal());
+    }
+    if (ai == nullptr) {
+      const std::string why = importer.GetErrorString();
+      return Status(ErrorCode::kParseError,
+                    path + ": import failed: " + (why.empty() ? "unknown Assimp error" : why));
+    }
+    return SkinnedConverter(path, *ai, limits).run();
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kResourceExhausted, path + ": out of memory while importing");
+  } catch (const std::exception& e) {
+    return Status(ErrorCode::kParseError, path + ": import failed: " + e.what());
+  } catch (...) {
+    return Status(ErrorCode::kInternal, path + ": import failed with an unknown exception");
+  }
 }
 
 }  // namespace thinlod::scene

@@ -1,0 +1,124 @@
+// Skinned import (scene/skinned_import.h) over assimp-testmodels' skinned,
+// animated files (installed by deploy/setup) and hostile input.
+#include "thinlod/common/scene/skinned_import.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace thinlod::scene {
+namespace {
+
+const std::string kModels = "/usr/share/assimp/models";
+
+std::string packageFile(const std::string& relative) {
+  const std::string path = kModels + "/" + relative;
+  EXPECT_TRUE(std::filesystem::exists(path))
+      << path << " is missing: deploy/setup installs the Debian package assimp-testmodels";
+  return path;
+}
+
+// The model's largest vertex displacement between two times of clip 0.
+double motion(const SkinnedModel& model, double t0, double t1) {
+  return anim::sampledMaxDisplacement(model.skeleton, model.clips[0], model.mesh.positions,
+                                      model.skin, t0, t1, (t1 - t0) / 16.0,
+                                      anim::ClipWrap::kClamp);
+}
+
+struct SkinnedFile {
+  const char* path;
+  bool skinned;  // has bone weights (else: animated rigid parts)
+  bool animated;  // has a clip
+};
+
+class SkinnedPackageFile : public ::testing::TestWithParam<SkinnedFile> {};
+
+TEST_P(SkinnedPackageFile, ImportsSkeletonSkinAndClipsThatMoveIt) {
+  const std::string path = packageFile(GetParam().path);
+  Result<SkinnedModel> model = importSkinnedModel(path);
+  ASSERT_TRUE(model.ok()) << model.status().toString();
+  EXPECT_GT(model->mesh.triangleCount(), 0u);
+  EXPECT_EQ(model->skin.size(), model->mesh.vertexCount());
+  EXPECT_GT(model->skeleton.bones.size(), 1u);
+  if (GetParam().skinned) {
+    EXPECT_GT(model->skinnedMeshes, 0u);
+  }
+  if (!GetParam().animated) {
+    EXPECT_TRUE(model->clips.empty());
+    return;
+  }
+  ASSERT_FALSE(model->clips.empty());
+  const anim::AnimationClip& clip = model->clips[0];
+  EXPECT_GT(clip.duration, 0.0);
+  EXPECT_GT(motion(*model, 0.0, clip.duration), 0.0) << "the clip moves no vertex";
+  // Every deformed vertex is finite at every sampled time.
+  std::vector<glm::vec3> out(model->mesh.vertexCount());
+  for (int i = 0; i <= 8; ++i) {
+    const double t = clip.duration * i / 8.0;
+    anim::deform(model->mesh.positions, model->skin,
+                 anim::skinningMatrices(model->skeleton,
+                                        anim::samplePose(model->skeleton, clip, t,
+                                                         anim::ClipWrap::kLoop)),
+                 {}, out);
+    for (const glm::vec3& p : out) {
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << t;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Package, SkinnedPackageFile,
+    ::testing::Values(SkinnedFile{"glTF2/simple_skin/simple_skin.gltf", true, true},
+                      SkinnedFile{"X/Testwuson.X", true, true},
+                      SkinnedFile{"SMD/WusonSMD.smd", true, false},
+                      SkinnedFile{"FBX/animation_with_skeleton.fbx", true, true}),
+    [](const auto& info) {
+      std::string name = std::filesystem::path(info.param.path).stem().string();
+      for (char& c : name) {
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      }
+      return name;
+    });
+
+TEST(SkinnedImport, MissingEmptyAndInvalidFilesAreCleanErrors) {
+  EXPECT_EQ(importSkinnedModel("/nonexistent/x.gltf").status().code(), ErrorCode::kNotFound);
+  const std::string empty = testing::TempDir() + "/empty-skin.x";
+  { std::ofstream(empty).flush(); }
+  EXPECT_EQ(importSkinnedModel(empty).status().code(), ErrorCode::kInvalidArgument);
+  for (const char* invalid : {"invalid/empty.x", "invalid/empty.smd"}) {
+    const Result<SkinnedModel> model = importSkinnedModel(packageFile(invalid));
+    EXPECT_FALSE(model.ok()) << invalid;
+    EXPECT_NE(model.status().message().find(invalid), std::string::npos)
+        << "the error names the file: " << model.status().toString();
+  }
+}
+
+TEST(SkinnedImport, BoneThatNamesNoNodeIsRefused) {
+  // The package's anim_test.x binds vertices to 'joint3', which is no frame
+  // of the file: where such a vertex belongs is unknown, so the file is
+  // refused rather than drawn with a guess.
+  const Result<SkinnedModel> model = importSkinnedModel(packageFile("X/anim_test.x"));
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(model.status().message().find("bone 'joint3' names no node"), std::string::npos)
+      << model.status().toString();
+}
+
+TEST(SkinnedImport, LimitsAreCheckedBeforeTheFileIsRead) {
+  SkinnedImportLimits small;
+  small.files.maxFileBytes = 16;
+  EXPECT_EQ(importSkinnedModel(packageFile("X/Testwuson.X"), small).status().code(),
+            ErrorCode::kResourceExhausted);
+  SkinnedImportLimits fewNodes;
+  fewNodes.files.maxNodes = 2;
+  EXPECT_EQ(importSkinnedModel(packageFile("X/Testwuson.X"), fewNodes).status().code(),
+            ErrorCode::kResourceExhausted);
+  SkinnedImportLimits fewKeys;
+  fewKeys.maxKeys = 3;
+  EXPECT_EQ(importSkinnedModel(packageFile("X/Testwuson.X"), fewKeys).status().code(),
+            ErrorCode::kResourceExhausted);
+}
+
+}  // namespace
+}  // namespace thinlod::scene
