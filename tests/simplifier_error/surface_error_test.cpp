@@ -216,5 +216,91 @@ TEST(SurfaceError, DegenerateTrianglesAreMeasuredSafely) {
   EXPECT_NEAR(e->maxBackward, 0.5, 1e-6);  // the sliver's vertices are 0.5 above
 }
 
+// A grid with uv = (x, y) / size: object units per uv unit = size.
+IndexedMesh texturedGrid(int cells, float size) {
+  IndexedMesh m = makeGrid(cells, size, 0.0f);
+  for (const glm::vec3& p : m.positions) m.uvs.emplace_back(p.x / size, p.y / size);
+  return m;
+}
+
+TEST(UvError, IdenticalMeshesGiveZeroAndTheScaleIsLengthPerUv) {
+  const IndexedMesh m = texturedGrid(8, 2.0f);
+  Result<UvError> e = measureUvError(m, m);
+  ASSERT_TRUE(e.ok()) << e.status().toString();
+  EXPECT_LT(e->maxUv, 1e-6);
+  EXPECT_NEAR(e->uvScale, 2.0, 1e-9);
+  EXPECT_EQ(e->samples, UvErrorOptions{}.samples);
+}
+
+TEST(UvError, ShiftedUvsGiveTheShiftInUvAndInLength) {
+  const IndexedMesh m = texturedGrid(8, 2.0f);
+  IndexedMesh shifted = m;
+  for (glm::vec2& uv : shifted.uvs) uv += glm::vec2(0.03f, -0.04f);  // |shift| = 0.05
+  Result<UvError> e = measureUvError(m, shifted);
+  ASSERT_TRUE(e.ok());
+  // Points near the grid's edge find original points within the tie radius
+  // only at their own place (the surfaces coincide), so every sample is 0.05.
+  EXPECT_NEAR(e->meanUv, 0.05, 1e-5);
+  EXPECT_NEAR(e->maxUv, 0.05, 1e-5);
+  EXPECT_NEAR(e->maxLength(), 0.1, 1e-4);
+}
+
+TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
+  // Two halves of a strip with their own uv charts (x < 0.5 -> u in [0, 0.25],
+  // x >= 0.5 -> u in [0.75, 1]): the vertices at x = 0.5 are duplicated.
+  IndexedMesh m;
+  for (int side = 0; side < 2; ++side) {
+    const auto first = static_cast<std::uint32_t>(m.positions.size());
+    for (int j = 0; j <= 1; ++j) {
+      for (int i = 0; i <= 4; ++i) {
+        const float x = 0.5f * side + 0.125f * i;
+        m.positions.emplace_back(x, static_cast<float>(j), 0.0f);
+        m.uvs.emplace_back(side == 0 ? 0.5f * x : 0.75f + 0.5f * (x - 0.5f),
+                           static_cast<float>(j));
+      }
+    }
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t v = first + i;
+      m.indices.insert(m.indices.end(), {v, v + 1, v + 6, v, v + 6, v + 5});
+    }
+  }
+  Result<UvError> self = measureUvError(m, m);
+  ASSERT_TRUE(self.ok());
+  EXPECT_LT(self->maxUv, 1e-6) << "a sample on the seam has two correct uvs";
+  // Welding the seam by position (the right half takes the left half's uvs
+  // at x = 0.5) interpolates across the atlas in the first right column.
+  IndexedMesh welded = m;
+  for (std::uint32_t& v : welded.indices) {
+    if (v == 10) v = 4;
+    if (v == 15) v = 9;
+  }
+  Result<UvError> torn = measureUvError(m, welded);
+  ASSERT_TRUE(torn.ok());
+  // In that column (1/8 of the area) the error falls linearly from 0.5 at
+  // the seam to 0 at x = 0.625: mean 0.25 there, 1/32 overall.
+  EXPECT_GT(torn->maxUv, 0.45);
+  EXPECT_NEAR(torn->meanUv, 1.0 / 32.0, 0.002);
+}
+
+TEST(UvError, BadInputsAreErrors) {
+  const IndexedMesh m = texturedGrid(2, 1.0f);
+  IndexedMesh bare = m;
+  bare.uvs.clear();
+  EXPECT_EQ(measureUvError(m, bare).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(measureUvError(bare, m).status().code(), ErrorCode::kInvalidArgument);
+  IndexedMesh flatUv = m;
+  for (glm::vec2& uv : flatUv.uvs) uv = glm::vec2(0.5f);
+  EXPECT_EQ(measureUvError(flatUv, m).status().code(), ErrorCode::kInvalidArgument);
+  UvErrorOptions none;
+  none.samples = 0;
+  EXPECT_EQ(measureUvError(m, m, none).status().code(), ErrorCode::kInvalidArgument);
+  UvErrorOptions nan;
+  nan.tieFactor = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(measureUvError(m, m, nan).status().code(), ErrorCode::kInvalidArgument);
+  IndexedMesh broken = m;
+  broken.uvs[0].x = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(measureUvError(m, broken).status().code(), ErrorCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace thinlod::simplifier

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <functional>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <limits>
 #include <glm/vec3.hpp>
 #include <random>
 #include <string>
@@ -279,6 +281,90 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
   error.meanBackward = backward.mean;
   error.pointsBackward = backward.points;
   error.diagonal = original.diameter();
+  return error;
+}
+
+}  // namespace thinlod::simplifier
+
+namespace thinlod::simplifier {
+
+Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& simplified,
+                               const UvErrorOptions& options) {
+  if (options.samples == 0) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: samples is 0");
+  }
+  if (!(options.tieTolerance >= 0.0) || !std::isfinite(options.tieTolerance) ||
+      !(options.tieFactor >= 0.0) || !std::isfinite(options.tieFactor)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "measureUvError: tieFactor and tieTolerance must be finite and >= 0");
+  }
+  const MeshGeometry originalGeometry(original);
+  const MeshGeometry simplifiedGeometry(simplified);
+  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
+  if (!originalAreas.ok()) return originalAreas.status();
+  Result<std::vector<double>> simplifiedAreas =
+      cumulativeAreas(simplifiedGeometry, "simplified mesh");
+  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  if (original.uvs.empty() || simplified.uvs.empty()) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: both meshes need uvs");
+  }
+  auto uvOf = [](const IndexedMesh& mesh, std::size_t triangle, int k) {
+    const glm::vec2 uv = mesh.uvs[mesh.indices[3 * triangle + k]];
+    return glm::dvec2(uv.x, uv.y);
+  };
+  double uvArea = 0.0;
+  for (std::size_t t = 0; t < original.triangleCount(); ++t) {
+    const glm::dvec2 a = uvOf(original, t, 0);
+    const glm::dvec2 e1 = uvOf(original, t, 1) - a, e2 = uvOf(original, t, 2) - a;
+    uvArea += 0.5 * std::abs(e1.x * e2.y - e1.y * e2.x);
+  }
+  if (!(uvArea > 0.0)) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: the original's uv area is zero");
+  }
+
+  UvError error;
+  error.diagonal = original.diameter();
+  error.uvScale = std::sqrt(originalAreas->back() / uvArea);
+  const double tie = options.tieTolerance * error.diagonal;
+  SurfaceErrorOptions sampling;
+  sampling.samplesPerMesh = options.samples;
+  sampling.seed = options.seed;
+  sampling.includeVerticesAndEdges = false;
+  const SamplePoints points = samplePoints(simplifiedGeometry, *simplifiedAreas, sampling);
+  const TriangleBvh bvh(original);
+  std::uint32_t hint = 0;
+  double sum = 0.0;
+  for (const SurfacePoint& sp : points.random) {
+    const dvec3 q = simplifiedGeometry.at(sp);
+    const glm::dvec2 a = uvOf(simplified, sp.triangle, 0);
+    const glm::dvec2 s = a + sp.u * (uvOf(simplified, sp.triangle, 1) - a) +
+                         sp.v * (uvOf(simplified, sp.triangle, 2) - a);
+    const double nearest = std::sqrt(bvh.squaredDistance(q, hint));
+    const double radius = (1.0 + options.tieFactor) * nearest + tie;
+    double best = std::numeric_limits<double>::infinity();
+    bvh.forEachWithin(q, radius * radius, [&](std::uint32_t i, const detail::Triangle& tri) {
+      // Barycentrics of the closest point (areas of the sub-triangles).
+      const dvec3 c = detail::closestPointOnTriangle(q, tri);
+      const dvec3 n = glm::cross(tri.b - tri.a, tri.c - tri.a);
+      const double n2 = glm::dot(n, n);
+      const std::uint32_t t = bvh.sourceTriangle(i);
+      glm::dvec2 o;
+      if (n2 > 0.0) {
+        const double wb = glm::dot(glm::cross(c - tri.a, tri.c - tri.a), n) / n2;
+        const double wc = glm::dot(glm::cross(tri.b - tri.a, c - tri.a), n) / n2;
+        const glm::dvec2 o0 = uvOf(original, t, 0);
+        o = o0 + wb * (uvOf(original, t, 1) - o0) + wc * (uvOf(original, t, 2) - o0);
+      } else {
+        o = uvOf(original, t, 0);  // zero area: no interpolation to speak of
+      }
+      best = std::min(best, glm::length(s - o));
+    });
+    if (!std::isfinite(best)) continue;  // cannot happen: the nearest is within the radius
+    sum += best;
+    error.maxUv = std::max(error.maxUv, best);
+    ++error.samples;
+  }
+  error.meanUv = error.samples > 0 ? sum / static_cast<double>(error.samples) : 0.0;
   return error;
 }
 

@@ -55,4 +55,41 @@ struct SurfaceError {
 Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const IndexedMesh& simplified,
                                          const SurfaceErrorOptions& options = {});
 
+// Texture-coordinate error of a simplification (docs/simplifier.md, "UV
+// error"): `samples` area-weighted points of the simplified surface, each
+// with its interpolated uv s; the original's uv o at the closest point of
+// the original surface; the error of the point is |s - o| (uv units).
+// Every original point within (1 + tieFactor) d + tieTolerance * diagonal
+// of the sample (d: the sample's distance to the original) is a candidate
+// and the one whose uv is nearest s is taken: on a seam the original has
+// two uvs at one place, and a point on it, or off it by no more than the
+// geometry moved, must not be charged the distance between the charts.
+// With tieFactor 0 a sample next to a seam is charged whichever chart is
+// a hair closer; 1 (the default) says the correspondent of a point that
+// moved by d is not known better than to within d. Converted to a length through the
+// original's texture scale (object units per uv unit: sqrt of its surface
+// area over its uv area), the error says how far from its place on the
+// surface a texel is drawn, comparable with the geometric error.
+// Errors (kInvalidArgument): a mesh fails validate, has no triangles, zero
+// area or no uvs; samples == 0; the original's uv area is zero.
+struct UvErrorOptions {
+  std::size_t samples = 100000;
+  std::uint64_t seed = 1;
+  double tieFactor = 1.0;
+  double tieTolerance = 1e-5;  // relative to the original's bbox diagonal
+};
+
+struct UvError {
+  double meanUv = 0.0;  // mean of |s - o| over the samples (uv units)
+  double maxUv = 0.0;
+  double uvScale = 0.0;  // original's object units per uv unit
+  double diagonal = 0.0;  // original's bbox diagonal
+  std::size_t samples = 0;
+  double meanLength() const { return meanUv * uvScale; }
+  double maxLength() const { return maxUv * uvScale; }
+};
+
+Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& simplified,
+                               const UvErrorOptions& options = {});
+
 }  // namespace thinlod::simplifier
