@@ -223,26 +223,34 @@ IndexedMesh texturedGrid(int cells, float size) {
   return m;
 }
 
-TEST(UvError, IdenticalMeshesGiveZeroAndTheScaleIsLengthPerUv) {
+TEST(UvError, IdenticalMeshesGiveZero) {
   const IndexedMesh m = texturedGrid(8, 2.0f);
   Result<UvError> e = measureUvError(m, m);
   ASSERT_TRUE(e.ok()) << e.status().toString();
   EXPECT_LT(e->maxUv, 1e-6);
-  EXPECT_NEAR(e->uvScale, 2.0, 1e-9);
+  EXPECT_LT(e->maxDisplacement, 1e-6);
   EXPECT_EQ(e->samples, UvErrorOptions{}.samples);
+  EXPECT_NEAR(uvArea(m), 1.0, 1e-6);
 }
 
-TEST(UvError, ShiftedUvsGiveTheShiftInUvAndInLength) {
-  const IndexedMesh m = texturedGrid(8, 2.0f);
+TEST(UvError, ShiftedUvsGiveTheShiftInUvAndTheTexelsDisplacement) {
+  const IndexedMesh m = texturedGrid(8, 2.0f);  // 2 object units per uv unit
   IndexedMesh shifted = m;
   for (glm::vec2& uv : shifted.uvs) uv += glm::vec2(0.03f, -0.04f);  // |shift| = 0.05
   Result<UvError> e = measureUvError(m, shifted);
   ASSERT_TRUE(e.ok());
-  // Points near the grid's edge find original points within the tie radius
-  // only at their own place (the surfaces coincide), so every sample is 0.05.
+  // The surfaces coincide, so the uv at the closest point is the
+  // sample's own: every sample is off by the shift.
   EXPECT_NEAR(e->meanUv, 0.05, 1e-5);
   EXPECT_NEAR(e->maxUv, 0.05, 1e-5);
-  EXPECT_NEAR(e->maxLength(), 0.1, 1e-4);
+  EXPECT_NEAR(e->p95Uv, 0.05, 1e-5);
+  // Each texel is drawn 0.05 * 2 = 0.1 from its place, except where the
+  // shifted uv leaves the texture's square (strips of width 0.03 and 0.04
+  // along two sides): there the texel's nearest place is on the border.
+  EXPECT_NEAR(e->maxDisplacement, 0.1, 1e-4);
+  EXPECT_NEAR(e->p95Displacement, 0.1, 1e-4);
+  EXPECT_GT(e->meanDisplacement, 0.09);
+  EXPECT_LE(e->meanDisplacement, 0.1 + 1e-6);
 }
 
 TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
@@ -267,6 +275,7 @@ TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
   Result<UvError> self = measureUvError(m, m);
   ASSERT_TRUE(self.ok());
   EXPECT_LT(self->maxUv, 1e-6) << "a sample on the seam has two correct uvs";
+  EXPECT_LT(self->maxDisplacement, 1e-6);
   // Welding the seam by position (the right half takes the left half's uvs
   // at x = 0.5) interpolates across the atlas in the first right column.
   IndexedMesh welded = m;
@@ -280,6 +289,11 @@ TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
   // the seam to 0 at x = 0.625: mean 0.25 there, 1/32 overall.
   EXPECT_GT(torn->maxUv, 0.45);
   EXPECT_NEAR(torn->meanUv, 1.0 / 32.0, 0.002);
+  // The texels of that column come from between the charts or from the
+  // left chart's edge, so none lands farther than the column's width from
+  // where it is drawn.
+  EXPECT_GT(torn->maxDisplacement, 0.05);
+  EXPECT_LE(torn->maxDisplacement, 0.125 + 1e-6);
 }
 
 TEST(UvError, BadInputsAreErrors) {
