@@ -165,6 +165,10 @@ int main(int argc, char** argv) {
   app.add_option("--samples", samples, "surface samples per measurement")->check(CLI::PositiveNumber);
   app.add_option("--attribute-weight", attributeWeight, "attributeWeight of ours+attr")
       ->check(CLI::PositiveNumber);
+  std::vector<double> ratios = {0.5, 0.1, 0.01};
+  app.add_option("--ratios", ratios, "target fractions of the input's triangles");
+  std::string only;
+  app.add_option("--only", only, "run only the models whose name contains this");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<Model> models;
@@ -188,6 +192,7 @@ int main(int argc, char** argv) {
               "open place edges |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Model& model : models) {
+    if (!only.empty() && model.name.find(only) == std::string::npos) continue;
     const IndexedMesh& input = model.mesh;
     std::cerr << model.name << ": " << input.triangleCount() << " triangles\n";
     BuildOptions attr;
@@ -209,7 +214,7 @@ int main(int argc, char** argv) {
       pms.emplace_back(o.name, std::move(pm.value()));
     }
     const int inputOpen = openPlaceEdges(input);
-    for (double ratio : {0.5, 0.1, 0.01}) {
+    for (double ratio : ratios) {
       const std::size_t target = std::max<std::size_t>(
           1, static_cast<std::size_t>(std::lround(ratio * static_cast<double>(input.triangleCount()))));
       std::vector<Row> rows;

@@ -328,9 +328,11 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
     return Status(ErrorCode::kInvalidArgument, "measureUvError: samples is 0");
   }
   if (!(options.tieTolerance >= 0.0) || !std::isfinite(options.tieTolerance) ||
-      !(options.tieFactor >= 0.0) || !std::isfinite(options.tieFactor)) {
+      !(options.tieFactor >= 0.0) || !std::isfinite(options.tieFactor) ||
+      !(options.texelTolerance >= 0.0) || !std::isfinite(options.texelTolerance)) {
     return Status(ErrorCode::kInvalidArgument,
-                  "measureUvError: tieFactor and tieTolerance must be finite and >= 0");
+                  "measureUvError: tieFactor, tieTolerance and texelTolerance must be finite "
+                  "and >= 0");
   }
   const MeshGeometry originalGeometry(original);
   const MeshGeometry simplifiedGeometry(simplified);
@@ -369,8 +371,6 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   for (const glm::vec2& uv : original.uvs) uvLayout.positions.emplace_back(uv.x, uv.y, 0.0f);
   uvLayout.indices = original.indices;
   const TriangleBvh uvBvh(uvLayout);
-  // Overlapping charts and shared chart edges: preimages this close in uv.
-  constexpr double kUvTie = 1e-7;
   std::uint32_t hint = 0, uvHint = 0;
   std::vector<double> uvErrors, displacements;
   uvErrors.reserve(points.random.size());
@@ -396,7 +396,7 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
     // Texture displacement: where the texel s is on the original.
     const dvec3 su(s.x, s.y, 0.0);
     const double uvNearest = std::sqrt(uvBvh.squaredDistance(su, uvHint));
-    const double uvRadius = uvNearest + kUvTie;
+    const double uvRadius = uvNearest + options.texelTolerance;
     double bestDisplacement = std::numeric_limits<double>::infinity();
     uvBvh.forEachWithin(su, uvRadius * uvRadius, [&](std::uint32_t i, const detail::Triangle& tri) {
       const std::uint32_t t = uvBvh.sourceTriangle(i);

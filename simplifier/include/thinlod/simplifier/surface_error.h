@@ -69,8 +69,12 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
 //   there), so this measure's max is a poor bound: see the next.
 // - texture displacement |P(s) - q| (object units): P(s) is where the texel
 //   s lies on the original surface (the point of the original whose uv is
-//   s; where charts overlap in uv, the preimage nearest q; where s lies
-//   outside every chart, the preimage of the nearest uv the original has).
+//   s, or within texelTolerance of s, the one nearest q: texels that close
+//   show the same colour, and an atlas packs charts next to each other, so
+//   a uv a hair outside its own chart (a simplified chart border cutting a
+//   concave corner) lands in a neighbouring chart whose place is anywhere;
+//   where s lies farther outside every chart, the preimage of the nearest
+//   uv the original has).
 //   It is how far from its place a texel is drawn, comparable with (and,
 //   since P(s) is on the original, never below) q's geometric distance, and
 //   indifferent to seams: both sides of a seam map to the same place.
@@ -82,6 +86,8 @@ struct UvErrorOptions {
   std::uint64_t seed = 1;
   double tieFactor = 1.0;
   double tieTolerance = 1e-5;  // relative to the original's bbox diagonal
+  // uv units: a texel of a 1024-texel texture.
+  double texelTolerance = 1.0 / 1024.0;
 };
 
 struct UvError {
