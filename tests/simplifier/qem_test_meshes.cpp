@@ -34,6 +34,59 @@ IndexedMesh makeIcosphere(int level, const glm::vec3& centre) {
   return m;
 }
 
+ChartedSphere makeChartedSphere(int chartsPerSide, int cellsPerChart, float bump) {
+  ChartedSphere out;
+  const int charts = 6 * chartsPerSide * chartsPerSide;
+  out.atlasColumns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(charts))));
+  const float cell = 1.0f / static_cast<float>(out.atlasColumns);
+  out.padding = 0.1f * cell;
+  static const glm::vec3 kNormal[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                       {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const glm::vec3 kAxisA[6] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0},
+                                      {1, 0, 0},  {1, 0, 0}, {-1, 0, 0}};
+  IndexedMesh& mesh = out.mesh;
+  const int n = chartsPerSide * cellsPerChart;  // quads per face side
+  int chart = 0;
+  for (int face = 0; face < 6; ++face) {
+    const glm::vec3 normal = kNormal[face];
+    const glm::vec3 a = kAxisA[face];
+    const glm::vec3 b = glm::cross(normal, a);  // counter-clockwise seen from outside
+    for (int cy = 0; cy < chartsPerSide; ++cy) {
+      for (int cx = 0; cx < chartsPerSide; ++cx, ++chart) {
+        const glm::vec2 origin(static_cast<float>(chart % out.atlasColumns) * cell + out.padding,
+                               static_cast<float>(chart / out.atlasColumns) * cell + out.padding);
+        const float island = cell - 2.0f * out.padding;
+        const auto first = static_cast<std::uint32_t>(mesh.positions.size());
+        for (int j = 0; j <= cellsPerChart; ++j) {
+          for (int i = 0; i <= cellsPerChart; ++i) {
+            // Face coordinates as (2k - n) / n: a point shared by two faces
+            // whose coordinates run in opposite directions comes out as
+            // exactly the negated value, so every chart computes it bit for bit.
+            const float s = static_cast<float>(2 * (cx * cellsPerChart + i) - n) / n;
+            const float t = static_cast<float>(2 * (cy * cellsPerChart + j) - n) / n;
+            const glm::vec3 d = glm::normalize(normal + s * a + t * b);
+            const float r = 1.0f + bump * std::sin(3.0f * d.x) * std::sin(4.0f * d.y + 1.0f) *
+                                       std::sin(5.0f * d.z + 2.0f);
+            mesh.positions.push_back(r * d);
+            mesh.uvs.push_back(origin + island * glm::vec2(static_cast<float>(i) / cellsPerChart,
+                                                           static_cast<float>(j) / cellsPerChart));
+            out.chartOf.push_back(static_cast<std::uint32_t>(chart));
+          }
+        }
+        const auto row = static_cast<std::uint32_t>(cellsPerChart + 1);
+        for (int j = 0; j < cellsPerChart; ++j) {
+          for (int i = 0; i < cellsPerChart; ++i) {
+            const std::uint32_t v = first + static_cast<std::uint32_t>(j) * row +
+                                    static_cast<std::uint32_t>(i);
+            mesh.indices.insert(mesh.indices.end(), {v, v + 1, v + row + 1, v, v + row + 1, v + row});
+          }
+        }
+      }
+    }
+  }
+  return out;
+}
+
 IndexedMesh makeBumpySphere(int level, float amplitude, std::uint32_t seed) {
   IndexedMesh m = makeIcosphere(level);
   std::mt19937 rng(seed);

@@ -22,6 +22,21 @@ IndexedMesh makeGrid(int cells);
 IndexedMesh makeIcosphere(int level, const glm::vec3& centre = glm::vec3(0.0f));
 // Icosphere with every vertex moved radially by up to `amplitude` (seeded).
 IndexedMesh makeBumpySphere(int level, float amplitude, std::uint32_t seed);
+// A closed, bumpy, textured sphere cut into uv charts: a cube of 6 faces,
+// each split into chartsPerSide x chartsPerSide charts of cellsPerChart x
+// cellsPerChart quads, projected onto the unit sphere with radius
+// 1 + bump * (a smooth product of sines). Every chart is its own uv island
+// of a square atlas (a padded cell); vertices on a chart border are
+// duplicated, one per chart (same position, other uv): seams everywhere a
+// chart meets another, three or four charts at the chart corners.
+// ChartedSphere::chartOf gives the chart of each vertex, and its uv cell.
+struct ChartedSphere {
+  IndexedMesh mesh;
+  std::vector<std::uint32_t> chartOf;  // per vertex
+  int atlasColumns = 0;                // the atlas is atlasColumns^2 cells of side 1/atlasColumns
+  float padding = 0.0f;                // island inset inside its cell, uv units
+};
+ChartedSphere makeChartedSphere(int chartsPerSide, int cellsPerChart, float bump);
 IndexedMesh concatenate(const IndexedMesh& a, const IndexedMesh& b);
 // Every triangle gets its own three vertices (a "soup": welding must undo it).
 IndexedMesh unweld(const IndexedMesh& mesh);

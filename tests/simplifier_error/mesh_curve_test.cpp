@@ -107,6 +107,54 @@ TEST(MeshCurve, IcosphereLevelsMatchTheirSagitta) {
   EXPECT_DOUBLE_EQ(curves->levels.back().accuracy, 1.0 / quickOptions().minRelativeError);
 }
 
+// A flat textured grid (uv = position / size) whose coarser "levels" are
+// coarser grids of the same square with their uvs shifted by 0.01: no
+// geometric error at all, every texel drawn 0.01 * size from its place.
+struct ShiftedUvLadder {
+  static IndexedMesh grid(int cells, float shift) {
+    IndexedMesh m = thinlod::testing::makeGrid(cells, 2.0f, 0.0f);
+    for (const glm::vec3& p : m.positions) {
+      m.uvs.emplace_back(p.x / 2.0f + shift, p.y / 2.0f);
+    }
+    return m;
+  }
+  IndexedMesh operator()(std::size_t target) const {
+    int cells = 16;
+    while (cells > 1 && static_cast<std::size_t>(2 * cells * cells) > target) --cells;
+    return grid(cells, cells == 16 ? 0.0f : 0.01f);
+  }
+};
+
+TEST(MeshCurve, TexturedLevelsAreCreditedWithTheirTexelDisplacement) {
+  const IndexedMesh original = ShiftedUvLadder::grid(16, 0.0f);
+  const double reference = referenceLength(referenceSphere(original));
+  MeshCurveOptions options = quickOptions();
+  options.measureEncodedBytes = false;
+  Result<MeshCurves> curves =
+      measureMeshCurves(original, 2, original.triangleCount(), ShiftedUvLadder{}, options);
+  ASSERT_TRUE(curves.ok()) << curves.status().toString();
+  for (std::size_t i = 0; i + 1 < curves->levels.size(); ++i) {
+    const CurveLevel& l = curves->levels[i];
+    SCOPED_TRACE(l.triangles);
+    EXPECT_LT(l.relativeHausdorffError, 1e-6);
+    // 0.01 uv x 2 units per uv: 0.02 units, but no farther than the square
+    // reaches (most samples: the shift leaves the texture on one side only).
+    EXPECT_NEAR(l.relativeTextureError, 0.02 / reference, 1e-4 / reference);
+    EXPECT_DOUBLE_EQ(l.relativeMaxError, l.relativeTextureError);
+    EXPECT_NEAR(l.accuracy, 1.0 / l.relativeMaxError, 1e-9 * l.accuracy);
+  }
+  EXPECT_LT(curves->levels.back().relativeTextureError, 1e-9);  // the full mesh: rounding only
+  // Switched off: the geometric error alone (0, floored).
+  options.textureCredit = false;
+  Result<MeshCurves> plain =
+      measureMeshCurves(original, 2, original.triangleCount(), ShiftedUvLadder{}, options);
+  ASSERT_TRUE(plain.ok());
+  for (const CurveLevel& l : plain->levels) {
+    EXPECT_EQ(l.relativeTextureError, 0.0);
+    EXPECT_DOUBLE_EQ(l.accuracy, 1.0 / options.minRelativeError);
+  }
+}
+
 TEST(MeshCurve, TriangleAndByteCurvesAreMonotoneAndConservative) {
   int calls = 0;
   const IndexedMesh original = makeIcosphere(kFinestLevel, kRadius);

@@ -216,5 +216,105 @@ TEST(SurfaceError, DegenerateTrianglesAreMeasuredSafely) {
   EXPECT_NEAR(e->maxBackward, 0.5, 1e-6);  // the sliver's vertices are 0.5 above
 }
 
+// A grid with uv = (x, y) / size: object units per uv unit = size.
+IndexedMesh texturedGrid(int cells, float size) {
+  IndexedMesh m = makeGrid(cells, size, 0.0f);
+  for (const glm::vec3& p : m.positions) m.uvs.emplace_back(p.x / size, p.y / size);
+  return m;
+}
+
+TEST(UvError, IdenticalMeshesGiveZero) {
+  const IndexedMesh m = texturedGrid(8, 2.0f);
+  Result<UvError> e = measureUvError(m, m);
+  ASSERT_TRUE(e.ok()) << e.status().toString();
+  EXPECT_LT(e->maxUv, 1e-6);
+  EXPECT_LT(e->maxDisplacement, 1e-6);
+  EXPECT_EQ(e->samples, UvErrorOptions{}.samples);
+  EXPECT_NEAR(uvArea(m), 1.0, 1e-6);
+}
+
+TEST(UvError, ShiftedUvsGiveTheShiftInUvAndTheTexelsDisplacement) {
+  const IndexedMesh m = texturedGrid(8, 2.0f);  // 2 object units per uv unit
+  IndexedMesh shifted = m;
+  for (glm::vec2& uv : shifted.uvs) uv += glm::vec2(0.03f, -0.04f);  // |shift| = 0.05
+  Result<UvError> e = measureUvError(m, shifted);
+  ASSERT_TRUE(e.ok());
+  // The surfaces coincide, so the uv at the closest point is the
+  // sample's own: every sample is off by the shift.
+  EXPECT_NEAR(e->meanUv, 0.05, 1e-5);
+  EXPECT_NEAR(e->maxUv, 0.05, 1e-5);
+  EXPECT_NEAR(e->p95Uv, 0.05, 1e-5);
+  // Each texel is drawn 0.05 * 2 = 0.1 from its place, except where the
+  // shifted uv leaves the texture's square (strips of width 0.03 and 0.04
+  // along two sides): there the texel's nearest place is on the border.
+  EXPECT_NEAR(e->maxDisplacement, 0.1, 1e-4);
+  EXPECT_NEAR(e->p95Displacement, 0.1, 1e-4);
+  EXPECT_GT(e->meanDisplacement, 0.09);
+  EXPECT_LE(e->meanDisplacement, 0.1 + 1e-6);
+}
+
+TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
+  // Two halves of a strip with their own uv charts (x < 0.5 -> u in [0, 0.25],
+  // x >= 0.5 -> u in [0.75, 1]): the vertices at x = 0.5 are duplicated.
+  IndexedMesh m;
+  for (int side = 0; side < 2; ++side) {
+    const auto first = static_cast<std::uint32_t>(m.positions.size());
+    for (int j = 0; j <= 1; ++j) {
+      for (int i = 0; i <= 4; ++i) {
+        const float x = 0.5f * side + 0.125f * i;
+        m.positions.emplace_back(x, static_cast<float>(j), 0.0f);
+        m.uvs.emplace_back(side == 0 ? 0.5f * x : 0.75f + 0.5f * (x - 0.5f),
+                           static_cast<float>(j));
+      }
+    }
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t v = first + i;
+      m.indices.insert(m.indices.end(), {v, v + 1, v + 6, v, v + 6, v + 5});
+    }
+  }
+  Result<UvError> self = measureUvError(m, m);
+  ASSERT_TRUE(self.ok());
+  EXPECT_LT(self->maxUv, 1e-6) << "a sample on the seam has two correct uvs";
+  EXPECT_LT(self->maxDisplacement, 1e-6);
+  // Welding the seam by position (the right half takes the left half's uvs
+  // at x = 0.5) interpolates across the atlas in the first right column.
+  IndexedMesh welded = m;
+  for (std::uint32_t& v : welded.indices) {
+    if (v == 10) v = 4;
+    if (v == 15) v = 9;
+  }
+  Result<UvError> torn = measureUvError(m, welded);
+  ASSERT_TRUE(torn.ok());
+  // In that column (1/8 of the area) the error falls linearly from 0.5 at
+  // the seam to 0 at x = 0.625: mean 0.25 there, 1/32 overall.
+  EXPECT_GT(torn->maxUv, 0.45);
+  EXPECT_NEAR(torn->meanUv, 1.0 / 32.0, 0.002);
+  // The texels of that column come from between the charts or from the
+  // left chart's edge, so none lands farther than the column's width from
+  // where it is drawn.
+  EXPECT_GT(torn->maxDisplacement, 0.05);
+  EXPECT_LE(torn->maxDisplacement, 0.125 + 1e-6);
+}
+
+TEST(UvError, BadInputsAreErrors) {
+  const IndexedMesh m = texturedGrid(2, 1.0f);
+  IndexedMesh bare = m;
+  bare.uvs.clear();
+  EXPECT_EQ(measureUvError(m, bare).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(measureUvError(bare, m).status().code(), ErrorCode::kInvalidArgument);
+  IndexedMesh flatUv = m;
+  for (glm::vec2& uv : flatUv.uvs) uv = glm::vec2(0.5f);
+  EXPECT_EQ(measureUvError(flatUv, m).status().code(), ErrorCode::kInvalidArgument);
+  UvErrorOptions none;
+  none.samples = 0;
+  EXPECT_EQ(measureUvError(m, m, none).status().code(), ErrorCode::kInvalidArgument);
+  UvErrorOptions nan;
+  nan.tieFactor = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(measureUvError(m, m, nan).status().code(), ErrorCode::kInvalidArgument);
+  IndexedMesh broken = m;
+  broken.uvs[0].x = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(measureUvError(m, broken).status().code(), ErrorCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace thinlod::simplifier

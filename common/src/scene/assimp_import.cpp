@@ -19,6 +19,7 @@
 #include <optional>
 #include <set>
 
+#include "import_precheck.h"
 #include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_import.h"
 #include "thinlod/common/scene/skinned_import.h"
@@ -117,6 +118,8 @@ struct TreeCensus {
 // log line. So: the .glb header and chunks must fit the file, and the
 // triangles the JSON declares are counted here, to be compared with what
 // Assimp returns.
+constexpr int kMaxJsonDepth = 4096;
+
 struct GltfDeclared {
   std::uint64_t triangles = 0;  // mode-4 primitives
   bool onlyTriangleLists = true;
@@ -169,9 +172,54 @@ Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
   } else {
     json = std::move(*bytes);
   }
-  const nlohmann::json doc = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
+  // Nesting depth is bounded here (nlohmann's parser keeps its own stack;
+  // the importer's JSON reader need not).
+  bool tooDeep = false;
+  const nlohmann::json::parser_callback_t depthCheck =
+      [&tooDeep](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+        tooDeep = tooDeep || depth > kMaxJsonDepth;
+        return !tooDeep;
+      };
+  const nlohmann::json doc = nlohmann::json::parse(json, depthCheck, /*allow_exceptions=*/false);
+  if (tooDeep) {
+    return Status(ErrorCode::kResourceExhausted,
+                  path + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth));
+  }
   if (doc.is_discarded() || !doc.is_object()) {
     return Status(ErrorCode::kParseError, path + ": not valid glTF JSON");
+  }
+  // The node graph: Assimp recurses over it without a depth limit (a chain
+  // of 100 000 nodes overflowed the stack) and follows children indices as
+  // given. Indices out of range are left to Assimp's own checks.
+  const auto nodes = doc.find("nodes");
+  if (nodes != doc.end() && nodes->is_array()) {
+    std::vector<std::vector<std::uint32_t>> children(nodes->size());
+    std::vector<bool> hasParent(nodes->size(), false);
+    for (std::size_t n = 0; n < nodes->size(); ++n) {
+      const nlohmann::json& node = (*nodes)[n];
+      if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) continue;
+      for (const nlohmann::json& c : node["children"]) {
+        if (!c.is_number_unsigned() || c.get<std::uint64_t>() >= nodes->size()) continue;
+        children[n].push_back(static_cast<std::uint32_t>(c.get<std::uint64_t>()));
+        hasParent[children[n].back()] = true;
+      }
+    }
+    std::vector<std::uint32_t> roots;
+    const auto scenes = doc.find("scenes");
+    if (scenes != doc.end() && scenes->is_array()) {
+      for (const nlohmann::json& scene : *scenes) {
+        if (!scene.is_object() || !scene.contains("nodes") || !scene["nodes"].is_array()) continue;
+        for (const nlohmann::json& r : scene["nodes"]) {
+          if (r.is_number_unsigned() && r.get<std::uint64_t>() < nodes->size()) {
+            roots.push_back(static_cast<std::uint32_t>(r.get<std::uint64_t>()));
+          }
+        }
+      }
+    }
+    for (std::uint32_t n = 0; roots.empty() && n < nodes->size(); ++n) {
+      if (!hasParent[n]) roots.push_back(n);  // no scene: every parentless node
+    }
+    THINLOD_RETURN_IF_ERROR(detail::checkNodeGraph(path, children, roots, limits));
   }
   GltfDeclared declared;
   const auto accessors = doc.find("accessors");
@@ -565,6 +613,12 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
       Result<GltfDeclared> checked = precheckGltf(path, size, limits);
       if (!checked.ok()) return checked.status();
       declared = *checked;
+    } else if (ext == ".dae") {
+      // Assimp's Collada reader recurses over nodes and instance_node
+      // references unchecked: a cycle or deep nesting crashed it.
+      Result<std::string> bytes = readFileBounded(path, size);
+      if (!bytes.ok()) return bytes.status();
+      THINLOD_RETURN_IF_ERROR(detail::precheckCollada(path, *bytes, limits));
     }
     Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
     auto* io = new BoundedIOSystem(limits);

@@ -43,8 +43,19 @@ Result<CurveLevel> measureLevel(const IndexedMesh& original, double reference, s
   CurveLevel out;
   out.requestedTriangles = target;
   out.triangles = level.triangleCount();
-  out.relativeMaxError = relativeError(error->max(), reference);
+  out.relativeHausdorffError = relativeError(error->max(), reference);
   out.relativeMeanError = relativeError(error->mean(), reference);
+  if (options.textureCredit && level.uvs.size() == level.positions.size() &&
+      uvArea(original) > 0.0) {
+    UvErrorOptions uv;
+    uv.samples = options.error.samplesPerMesh;
+    uv.seed = options.error.seed;
+    Result<UvError> texture = measureUvError(original, level, uv);
+    if (!texture.ok()) return texture.status();
+    out.relativeTextureError = relativeError(texture->p95Displacement, reference);
+    out.relativeTextureMaxError = relativeError(texture->maxDisplacement, reference);
+  }
+  out.relativeMaxError = std::max(out.relativeHausdorffError, out.relativeTextureError);
   const double d = std::max(out.relativeMaxError, options.minRelativeError);
   out.accuracy = 1.0 / d;
   if (options.measureEncodedBytes) {

@@ -163,6 +163,7 @@ std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& pr
   h.number(options.error.seed);
   h.number(options.error.includeVerticesAndEdges);
   h.number(options.measureEncodedBytes);
+  h.number(options.textureCredit);
   h.number(options.quantizationBudgetFraction);
   h.number(options.encode.normalBits);
   h.number(options.encode.texcoordBits);
@@ -182,6 +183,9 @@ std::string serializeMeshCurves(const MeshCurves& curves, const std::string& key
     levels.push_back({{"requestedTriangles", l.requestedTriangles},
                       {"triangles", l.triangles},
                       {"relativeMaxError", l.relativeMaxError},
+                      {"relativeHausdorffError", l.relativeHausdorffError},
+                      {"relativeTextureError", l.relativeTextureError},
+                      {"relativeTextureMaxError", l.relativeTextureMaxError},
                       {"relativeMeanError", l.relativeMeanError},
                       {"accuracy", l.accuracy},
                       {"encodedBytes", l.encodedBytes},
@@ -220,6 +224,9 @@ Result<MeshCurves> parseMeshCurves(const std::string& text, const std::string& e
       level.requestedTriangles = l.at("requestedTriangles").get<std::size_t>();
       level.triangles = l.at("triangles").get<std::size_t>();
       level.relativeMaxError = finiteNumber(l, "relativeMaxError");
+      level.relativeHausdorffError = finiteNumber(l, "relativeHausdorffError");
+      level.relativeTextureError = finiteNumber(l, "relativeTextureError");
+      level.relativeTextureMaxError = finiteNumber(l, "relativeTextureMaxError");
       level.relativeMeanError = finiteNumber(l, "relativeMeanError");
       level.accuracy = finiteNumber(l, "accuracy");
       level.encodedBytes = l.at("encodedBytes").get<std::size_t>();

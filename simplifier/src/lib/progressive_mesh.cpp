@@ -85,7 +85,7 @@ Result<ProgressiveMesh> ProgressiveMesh::build(const IndexedMesh& mesh,
                       " vertex constraints for " + std::to_string(mesh.positions.size()) +
                       " vertices");
   }
-  Result<qem::CleanMesh> cleaned = qem::cleanMesh(mesh, options.weldEpsilon);
+  Result<qem::CleanMesh> cleaned = qem::cleanMesh(mesh, options.weldEpsilon, options.preserveSeams);
   if (!cleaned.ok()) return cleaned.status();
   const qem::CleanMesh& clean = cleaned.value();
   const qem::VertexAttributes attributes = attributesFor(mesh, clean, options);

@@ -35,18 +35,24 @@ class WeldGrid {
   WeldGrid(const Bounds& bounds, double cellSize, std::size_t expectedVertices)
       : origin_(bounds.min), invCell_(1.0 / cellSize), slots_(tableCapacity(expectedVertices)) {}
 
-  // Clean vertex within `epsilon` of p, or kEmpty.
-  std::uint32_t find(const glm::vec3& p, double epsilon,
-                     const std::vector<glm::vec3>& cleanPositions) const {
+  // Clean vertex within `epsilon` of p for which accept(v) holds, or kEmpty;
+  // *near (when given) is set to the first clean vertex within `epsilon`
+  // whether accepted or not (kEmpty when there is none).
+  template <typename Accept>
+  std::uint32_t find(const glm::vec3& p, double epsilon, const std::vector<glm::vec3>& cleanPositions,
+                     Accept accept, std::uint32_t* near = nullptr) const {
     const std::array<std::int64_t, 3> lo = cellOf(p, -epsilon);
     const std::array<std::int64_t, 3> hi = cellOf(p, epsilon);
     const double eps2 = epsilon * epsilon;
+    if (near != nullptr) *near = kEmpty;
     for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
       for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
         for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
           for (std::uint32_t v = head({x, y, z}); v != kEmpty; v = next_[v]) {
             const glm::dvec3 d = glm::dvec3(cleanPositions[v]) - glm::dvec3(p);
-            if (d.x * d.x + d.y * d.y + d.z * d.z <= eps2) return v;
+            if (d.x * d.x + d.y * d.y + d.z * d.z > eps2) continue;
+            if (near != nullptr && *near == kEmpty) *near = v;
+            if (accept(v)) return v;
           }
         }
       }
@@ -162,14 +168,17 @@ void sortSpatially(CleanMesh& mesh, const Bounds& bounds) {
   std::vector<std::uint32_t> newIndex(vertexCount);
   std::vector<glm::vec3> positions(vertexCount);
   std::vector<std::uint32_t> source(vertexCount);
+  std::vector<std::uint32_t> group(vertexCount);
   for (std::size_t i = 0; i < vertexCount; ++i) {
     const auto old = static_cast<std::uint32_t>(keyed[i]);
     newIndex[old] = static_cast<std::uint32_t>(i);
     positions[i] = mesh.positions[old];
     source[i] = mesh.sourceVertex[old];
+    group[i] = mesh.positionGroup[old];
   }
   mesh.positions = std::move(positions);
   mesh.sourceVertex = std::move(source);
+  mesh.positionGroup = std::move(group);
   // Counting sort of the triangles by their lowest new vertex (stable).
   const std::size_t triangleCount = mesh.indices.size() / 3;
   std::vector<std::uint32_t> start(vertexCount + 1, 0);
@@ -188,9 +197,20 @@ void sortSpatially(CleanMesh& mesh, const Bounds& bounds) {
   mesh.indices = std::move(sorted);
 }
 
+// Whether input vertices a and b carry the same uv and colour (the
+// attributes whose discontinuities are seams).
+bool sameSeamAttributes(const IndexedMesh& mesh, std::uint32_t a, std::uint32_t b) {
+  constexpr float kUvTolerance = 1e-6f;
+  if (!mesh.uvs.empty()) {
+    const glm::vec2 d = glm::abs(mesh.uvs[a] - mesh.uvs[b]);
+    if (d.x > kUvTolerance || d.y > kUvTolerance) return false;
+  }
+  return mesh.colors.empty() || mesh.colors[a] == mesh.colors[b];
+}
+
 }  // namespace
 
-Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
+Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool splitSeams) {
   THINLOD_RETURN_IF_ERROR(mesh.validate("input mesh"));
   if (mesh.indices.empty()) {
     return Status(ErrorCode::kInvalidArgument, "input mesh: has no triangles");
@@ -229,15 +249,34 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
   std::vector<std::uint32_t> weldedIndex(mesh.positions.size(), kEmpty);
   clean.positions.reserve(referencedCount);
   clean.sourceVertex.reserve(referencedCount);
+  clean.positionGroup.reserve(referencedCount);
+  std::uint32_t groupCount = 0;
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (!referenced[v]) continue;
     const glm::vec3& p = mesh.positions[v];
-    std::uint32_t target = grid.find(p, epsilon, clean.positions);
+    std::uint32_t near = kEmpty;
+    std::uint32_t target =
+        splitSeams ? grid.find(p, epsilon, clean.positions,
+                               [&](std::uint32_t c) {
+                                 return sameSeamAttributes(mesh, clean.sourceVertex[c],
+                                                           static_cast<std::uint32_t>(v));
+                               },
+                               &near)
+                   : grid.find(p, epsilon, clean.positions, [](std::uint32_t) { return true; });
     if (target == kEmpty) {
       target = static_cast<std::uint32_t>(clean.positions.size());
-      clean.positions.push_back(p);
+      if (near != kEmpty) {
+        // A seam: same place, other attributes. The new clean vertex takes
+        // its sibling's position exactly, so the two sides stay together.
+        clean.positions.push_back(clean.positions[near]);
+        clean.positionGroup.push_back(clean.positionGroup[near]);
+        ++clean.seamVertices;
+      } else {
+        clean.positions.push_back(p);
+        clean.positionGroup.push_back(groupCount++);
+      }
       clean.sourceVertex.push_back(static_cast<std::uint32_t>(v));
-      grid.insert(p, target);
+      grid.insert(clean.positions.back(), target);
     } else {
       ++clean.weldedVertices;
     }
@@ -250,7 +289,9 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
     const std::array<std::uint32_t, 3> tri = {weldedIndex[mesh.indices[t]],
                                               weldedIndex[mesh.indices[t + 1]],
                                               weldedIndex[mesh.indices[t + 2]]};
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+    const std::uint32_t g0 = clean.positionGroup[tri[0]], g1 = clean.positionGroup[tri[1]],
+                        g2 = clean.positionGroup[tri[2]];
+    if (g0 == g1 || g1 == g2 || g0 == g2) {  // repeated corner, or two corners at one place
       ++clean.droppedDegenerate;
       continue;
     }
@@ -276,10 +317,12 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon) {
     compact[v] = kept;
     clean.positions[kept] = clean.positions[v];
     clean.sourceVertex[kept] = clean.sourceVertex[v];
+    clean.positionGroup[kept] = clean.positionGroup[v];
     ++kept;
   }
   clean.positions.resize(kept);
   clean.sourceVertex.resize(kept);
+  clean.positionGroup.resize(kept);
   for (std::uint32_t& v : clean.indices) v = compact[v];
   sortSpatially(clean, bounds);
   return clean;

@@ -57,6 +57,11 @@ enum class VertexKind : std::uint8_t {
   kInterior,  // collapses onto any neighbour
   kBoundary,  // slides along its border only
   kLocked,    // on a non-manifold edge or a pinched border: never moves
+  // One side of a seam (a place where the uv or colour jumps): a border
+  // vertex whose place holds exactly one other vertex, its sibling, with
+  // the same two border edges on the other side. The pair moves together,
+  // along the seam only (see seamCandidates).
+  kSeam,
 };
 
 class Collapser {
@@ -97,6 +102,35 @@ class Collapser {
       const float length = glm::length(n);
       n = length > 0.0f ? n / length : glm::vec3(0.0f);
     }
+    // Seam siblings: the clean vertices that share a place.
+    sibling_.assign(vertexCount, kNone);
+    groupSize_.assign(vertexCount, 1);
+    group_ = mesh.positionGroup;
+    if (group_.size() != vertexCount) {  // no groups given: every vertex its own place
+      group_.resize(vertexCount);
+      for (std::uint32_t v = 0; v < vertexCount; ++v) group_[v] = v;
+    }
+    {
+      std::uint32_t groups = 0;
+      for (std::uint32_t g : group_) groups = std::max(groups, g + 1);
+      std::vector<std::uint32_t> first(groups, kNone), count(groups, 0);
+      for (std::uint32_t v = 0; v < vertexCount; ++v) {
+        const std::uint32_t g = group_[v];
+        if (first[g] == kNone) first[g] = v;
+        ++count[g];
+      }
+      for (std::uint32_t v = 0; v < vertexCount; ++v) {
+        groupSize_[v] = count[group_[v]];
+        if (count[group_[v]] == 2) {
+          const std::uint32_t f = first[group_[v]];
+          if (f != v) {
+            sibling_[v] = f;
+            sibling_[f] = v;
+          }
+        }
+      }
+    }
+    pairTarget_.assign(vertexCount, kNone);
     removed_.assign(vertexCount, 0);
     kind_.assign(vertexCount, VertexKind::kUnknown);
     target_.assign(vertexCount, kNone);
@@ -115,6 +149,7 @@ class Collapser {
   // once an exact key is the smallest.
   CollapseRecord run() {
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
+      if (isSeamFollower(v)) continue;  // its leader stands for the pair
       const double key = chooseTarget(v, /*exact=*/false);
       if (key < kInfinity) heap_.push(v, key);
     }
@@ -135,8 +170,8 @@ class Collapser {
         const std::uint32_t w = target_[u];
         const double key = heap_.topKey();
         compact(u);
-        if (isValidCollapse(u, w)) {
-          const double cost = fullCost(u, w);
+        if (isValidMove(u, w)) {
+          const double cost = moveCost(u, w);
           if (cost <= key) {
             collapse(u, w, cost);
           } else {
@@ -198,6 +233,7 @@ class Collapser {
       for (std::uint32_t v : t.v) quadric_[v] += q;
     }
     classifyAndAddBoundaryPlanes();
+    classifySeams();
     if (attributes_.dimension > 0) buildAttributeQuadrics();
 
     for (std::size_t v = 0; v < point_.size(); ++v)
@@ -233,6 +269,102 @@ class Collapser {
         quadric_[nb.vertex] += q;
       }
     }
+  }
+
+  // Seams (CleanMesh::positionGroup): a vertex sharing its place with others
+  // is kSeam when it and its one sibling are border vertices whose border
+  // edges match (each leads to the same place on both sides); any other
+  // shared place (three or more sides meet, a seam meeting a true border,
+  // coincident interior vertices) is kLocked. A border vertex alone at its
+  // place whose two border edges lead to one place is the closed end of a
+  // seam (the sides part there): kLocked too, or moving it would drag one
+  // side's attributes onto the other.
+  void classifySeams() {
+    for (std::uint32_t v = 0; v < point_.size(); ++v) {
+      if (kind_[v] == VertexKind::kLocked) continue;
+      if (groupSize_[v] == 1) {
+        if (kind_[v] != VertexKind::kBoundary) continue;
+        gather(v, neighborsU_);
+        std::uint32_t places[2] = {kNone, kNone};
+        int found = 0;
+        for (const Neighbor& nb : neighborsU_) {
+          if (nb.triangles == 1 && found < 2) places[found++] = group_[nb.vertex];
+        }
+        if (found == 2 && places[0] == places[1]) kind_[v] = VertexKind::kLocked;
+        continue;
+      }
+      const std::uint32_t s = sibling_[v];
+      if (s == kNone || kind_[v] != VertexKind::kBoundary || kind_[s] == VertexKind::kLocked ||
+          (!constraints_.empty() && constraints_[s] != VertexConstraint::kFree)) {
+        kind_[v] = VertexKind::kLocked;
+        continue;
+      }
+      gather(v, neighborsU_);
+      gather(s, neighborsS_);
+      bool matched = true;
+      for (const Neighbor& nb : neighborsU_) {
+        if (nb.triangles != 1) continue;
+        if (borderNeighborAt(neighborsS_, group_[nb.vertex]) == kNone) matched = false;
+      }
+      if (!matched) kind_[v] = VertexKind::kLocked;
+    }
+    // A pair is a seam only when both sides qualified.
+    for (std::uint32_t v = 0; v < point_.size(); ++v) {
+      if (sibling_[v] == kNone || kind_[v] != VertexKind::kBoundary) continue;
+      kind_[v] = kind_[sibling_[v]] == VertexKind::kLocked ? VertexKind::kLocked : VertexKind::kSeam;
+    }
+    for (std::uint32_t v = 0; v < point_.size(); ++v) {
+      if (kind_[v] == VertexKind::kSeam && kind_[sibling_[v]] != VertexKind::kSeam) {
+        kind_[v] = VertexKind::kLocked;
+      }
+    }
+  }
+
+  // The neighbour across a border edge (one live triangle) in `neighbors`
+  // whose place is `place`, kNone when there is none.
+  std::uint32_t borderNeighborAt(const std::vector<Neighbor>& neighbors, std::uint32_t place) const {
+    for (const Neighbor& nb : neighbors) {
+      if (nb.triangles == 1 && group_[nb.vertex] == place) return nb.vertex;
+    }
+    return kNone;
+  }
+
+  // The pair's leader (the lower index) is the one in the heap.
+  bool isSeamFollower(std::uint32_t v) const {
+    return kind_[v] == VertexKind::kSeam && sibling_[v] < v;
+  }
+  std::uint32_t heapVertex(std::uint32_t v) const {
+    return isSeamFollower(v) ? sibling_[v] : v;
+  }
+
+  // For a seam leader u and a border neighbour w: the vertex u's sibling
+  // moves onto, the sibling's border neighbour at w's place (kNone: none,
+  // or w is alone at its place, the closed end of the seam, which a pair
+  // never reaches: the two sides would have to be glued there, see
+  // docs/simplifier.md "Seams"). Gathers (so compacts) the sibling.
+  std::uint32_t counterpart(std::uint32_t u, std::uint32_t w) {
+    if (groupSize_[w] == 1) return kNone;
+    gather(sibling_[u], neighborsS_);
+    const std::uint32_t sw = borderNeighborAt(neighborsS_, group_[w]);
+    return sw != kNone && sw != w && mayTarget(sw) ? sw : kNone;
+  }
+
+  // A move of u onto w, with u's sibling when u is a seam leader; u's list
+  // is compacted.
+  bool isValidMove(std::uint32_t u, std::uint32_t w) {
+    if (kind_[u] != VertexKind::kSeam) return isValidCollapse(u, w);
+    if (w == kNone || edgeTriangleCount(u, w) != 1) return false;
+    const std::uint32_t sw = counterpart(u, w);
+    if (sw == kNone || !isValidCollapse(sibling_[u], sw)) return false;
+    pairTarget_[u] = sw;
+    return isValidCollapse(u, w);
+  }
+
+  // After isValidMove(u, w) (the pair's target is set).
+  double moveCost(std::uint32_t u, std::uint32_t w) const {
+    double cost = fullCost(u, w);
+    if (kind_[u] == VertexKind::kSeam) cost += fullCost(sibling_[u], pairTarget_[u]);
+    return cost;
   }
 
   // A live triangle on edge ab (precondition: there is one).
@@ -401,7 +533,8 @@ class Collapser {
     // (their weight scales with edge length squared): a tiny ear on a hole
     // of the bunny went first at almost no cost and stayed its 50% max.
     // Fans above kLargeFan skip it: the neighbour search is quadratic.
-    if (kind_[u] == VertexKind::kBoundary && listSize_[u] <= kLargeFan) {
+    if ((kind_[u] == VertexKind::kBoundary || kind_[u] == VertexKind::kSeam) &&
+        listSize_[u] <= kLargeFan) {
       const std::uint32_t y = otherBorderNeighbor(u, w);
       if (y != kNone) farthest = std::max(farthest, squaredDistanceToSegment(pu, pw, point_[y].p));
     }
@@ -468,8 +601,9 @@ class Collapser {
       kind_[u] = classify(neighborsU_);
     }
     const VertexKind kind = kind_[u];
-    if (kind == VertexKind::kLocked) return kInfinity;
+    if (kind == VertexKind::kLocked || isSeamFollower(u)) return kInfinity;
     candidateVertices_.clear();
+    if (kind == VertexKind::kSeam) return chooseSeamTarget(u, exact);
     if (kind == VertexKind::kBoundary) {
       gather(u, neighborsU_);
       for (const Neighbor& nb : neighborsU_) {
@@ -517,6 +651,32 @@ class Collapser {
         target_[u] = c.vertex;
       }
     }
+    return best;
+  }
+
+  // chooseTarget for a seam leader: along the seam edges only, the pair's
+  // cost is the sum of both sides' costs.
+  double chooseSeamTarget(std::uint32_t u, bool exact) {
+    gather(u, neighborsU_);
+    for (const Neighbor& nb : neighborsU_) {
+      if (nb.triangles == 1 && mayTarget(nb.vertex)) candidateVertices_.push_back(nb.vertex);
+    }
+    const std::uint32_t s = sibling_[u];
+    double best = kInfinity;
+    std::uint32_t bestPair = kNone;
+    for (std::uint32_t w : candidateVertices_) {
+      const std::uint32_t sw = counterpart(u, w);
+      if (sw == kNone) continue;
+      double cost = quadricCost(u, w) + quadricCost(s, sw);
+      if (cost >= best) continue;
+      cost += fanCost(u, w) + fanCost(s, sw);
+      if (cost >= best) continue;
+      if (exact && !(isValidCollapse(s, sw) && isValidCollapse(u, w))) continue;
+      best = cost;
+      target_[u] = w;
+      bestPair = sw;
+    }
+    pairTarget_[u] = bestPair;
     return best;
   }
 
@@ -615,9 +775,27 @@ class Collapser {
     heap_.remove(v);
   }
 
-  // u's list is compacted (every caller gathered u since the last change).
+  // One step: u -> w, and u's sibling onto pairTarget_[u] when u leads a
+  // seam pair. u's list (and the sibling's) is compacted: every caller
+  // gathered them since the last change.
   void collapse(std::uint32_t u, std::uint32_t w, double cost) {
     const std::uint32_t step = static_cast<std::uint32_t>(record_.costOfStep.size()) + 1;
+    const bool pair = kind_[u] == VertexKind::kSeam;
+    const std::uint32_t s = pair ? sibling_[u] : kNone;
+    const std::uint32_t sw = pair ? pairTarget_[u] : kNone;
+    collapseEdge(u, w, step);
+    // The sides share no triangle (a triangle with two corners at one
+    // place is dropped by the cleanup), so the first half left s's list
+    // compact and its checks true.
+    if (pair) collapseEdge(s, sw, step);
+    record_.removalsAfterStep.push_back(static_cast<std::uint32_t>(record_.removedVertex.size()));
+    record_.trianglesAfterStep.push_back(static_cast<std::uint32_t>(liveTriangles_));
+    record_.costOfStep.push_back(static_cast<float>(cost));
+    if (!removed_[w]) rekeyAround(u, w);
+    if (pair && !removed_[sw]) rekeyAround(s, sw);
+  }
+
+  void collapseEdge(std::uint32_t u, std::uint32_t w, std::uint32_t step) {
     // Kill the triangles on edge uw first so that w's new list skips them.
     opposite_.clear();
     const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
@@ -678,10 +856,6 @@ class Collapser {
     for (std::uint32_t x : opposite_) {
       if (!removed_[x] && liveCount_[x] == 0) removeVertex(x, kNone);
     }
-    record_.removalsAfterStep.push_back(static_cast<std::uint32_t>(record_.removedVertex.size()));
-    record_.trianglesAfterStep.push_back(static_cast<std::uint32_t>(liveTriangles_));
-    record_.costOfStep.push_back(static_cast<float>(cost));
-    if (!removed_[w]) rekeyAround(u, w);
   }
 
   // After u -> w only w's quadric and w's fan changed. Re-choose w and the
@@ -689,17 +863,22 @@ class Collapser {
   // (its target's quadric cost is unchanged; a changed fan term is caught
   // when x reaches the top) unless its new option x -> w is cheaper.
   void rekeyAround(std::uint32_t u, std::uint32_t w) {
-    rekey(w, chooseTarget(w, /*exact=*/false));  // also compacts w's list
+    const std::uint32_t lead = heapVertex(w);
+    rekey(lead, chooseTarget(lead, /*exact=*/false));
+    compact(w);
     const bool wMayTarget = mayTarget(w);
     const std::uint32_t seen = ++stamp_;
     for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
-      for (std::uint32_t x :
+      for (std::uint32_t corner :
            {t.v[kNextCorner[cornerOf(entry)]], t.v[kPrevCorner[cornerOf(entry)]]}) {
+        const std::uint32_t x = heapVertex(corner);
         if (mark_[x] == seen) continue;
         mark_[x] = seen;
-        if (target_[x] == u || target_[x] == w || target_[x] == kNone || !heap_.contains(x)) {
+        // A seam pair's cost spans both sides: always re-chosen.
+        if (target_[x] == u || target_[x] == w || target_[x] == kNone || !heap_.contains(x) ||
+            kind_[x] == VertexKind::kSeam) {
           rekey(x, chooseTarget(x, /*exact=*/false));
           continue;
         }
@@ -757,12 +936,20 @@ class Collapser {
   std::vector<std::uint32_t> pool_;
   std::vector<std::uint8_t> removed_;
   std::vector<VertexKind> kind_;
+  // Seams: place of each vertex, vertices at that place, the other vertex
+  // of a two-vertex place (kNone otherwise), and where a seam leader's
+  // sibling goes when the leader moves onto target_.
+  std::vector<std::uint32_t> group_;
+  std::vector<std::uint32_t> groupSize_;
+  std::vector<std::uint32_t> sibling_;
+  std::vector<std::uint32_t> pairTarget_;
   std::vector<std::uint32_t> target_;
   std::vector<std::uint8_t> exact_;  // heap key is the exact, validated cost of target_
   IndexedMinHeap heap_;
   CollapseRecord record_;
   // Scratch, reused to avoid allocation per collapse.
   std::vector<Neighbor> neighborsU_;
+  std::vector<Neighbor> neighborsS_;
   std::vector<std::uint32_t> opposite_;
   struct Candidate {
     double cost;

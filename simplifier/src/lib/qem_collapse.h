@@ -22,7 +22,9 @@ inline constexpr std::uint32_t kNone = 0xffffffffu;
 // collapses of some input. Cached measured curves (mesh_curve_cache.cpp) are
 // keyed by it, so a curve measured on another order is never reused.
 // 2: border term in the cost (distance of a border vertex to its new border).
-inline constexpr std::uint32_t kCollapseOrderVersion = 2;
+// 3: uv / colour seams kept (BuildOptions::preserveSeams): vertices at one
+//    place with other attributes are no longer welded, seam pairs move together.
+inline constexpr std::uint32_t kCollapseOrderVersion = 3;
 
 // The collapse order, in CleanMesh numbering. Steps are 1-based: step s is
 // the s-th collapse; "step 0" is the input.

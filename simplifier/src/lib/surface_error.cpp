@@ -4,6 +4,8 @@
 #include <cmath>
 #include <functional>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <limits>
 #include <glm/vec3.hpp>
 #include <random>
 #include <string>
@@ -279,6 +281,148 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
   error.meanBackward = backward.mean;
   error.pointsBackward = backward.points;
   error.diagonal = original.diameter();
+  return error;
+}
+
+}  // namespace thinlod::simplifier
+
+namespace thinlod::simplifier {
+
+double uvArea(const IndexedMesh& mesh) {
+  if (mesh.uvs.size() != mesh.positions.size()) return 0.0;
+  double area = 0.0;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const glm::dvec2 a(mesh.uvs[mesh.indices[t]]);
+    const glm::dvec2 e1 = glm::dvec2(mesh.uvs[mesh.indices[t + 1]]) - a;
+    const glm::dvec2 e2 = glm::dvec2(mesh.uvs[mesh.indices[t + 2]]) - a;
+    area += 0.5 * std::abs(e1.x * e2.y - e1.y * e2.x);
+  }
+  return area;
+}
+
+namespace {
+
+// Barycentrics (of corners b and c) of point p on the plane of tri; false
+// for a zero-area triangle.
+bool barycentrics(const detail::Triangle& tri, const dvec3& p, double& wb, double& wc) {
+  const dvec3 n = glm::cross(tri.b - tri.a, tri.c - tri.a);
+  const double n2 = glm::dot(n, n);
+  if (!(n2 > 0.0)) return false;
+  wb = glm::dot(glm::cross(p - tri.a, tri.c - tri.a), n) / n2;
+  wc = glm::dot(glm::cross(tri.b - tri.a, p - tri.a), n) / n2;
+  return true;
+}
+
+double percentile95(std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  const std::size_t k = (values.size() * 95) / 100;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(k, values.size() - 1)), values.end());
+  return values[std::min(k, values.size() - 1)];
+}
+
+}  // namespace
+
+Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& simplified,
+                               const UvErrorOptions& options) {
+  if (options.samples == 0) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: samples is 0");
+  }
+  if (!(options.tieTolerance >= 0.0) || !std::isfinite(options.tieTolerance) ||
+      !(options.tieFactor >= 0.0) || !std::isfinite(options.tieFactor) ||
+      !(options.texelTolerance >= 0.0) || !std::isfinite(options.texelTolerance)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "measureUvError: tieFactor, tieTolerance and texelTolerance must be finite "
+                  "and >= 0");
+  }
+  const MeshGeometry originalGeometry(original);
+  const MeshGeometry simplifiedGeometry(simplified);
+  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
+  if (!originalAreas.ok()) return originalAreas.status();
+  Result<std::vector<double>> simplifiedAreas =
+      cumulativeAreas(simplifiedGeometry, "simplified mesh");
+  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  if (original.uvs.empty() || simplified.uvs.empty()) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: both meshes need uvs");
+  }
+  if (!(uvArea(original) > 0.0)) {
+    return Status(ErrorCode::kInvalidArgument, "measureUvError: the original's uv area is zero");
+  }
+  auto uvOf = [](const IndexedMesh& mesh, std::size_t triangle, int k) {
+    return glm::dvec2(mesh.uvs[mesh.indices[3 * triangle + k]]);
+  };
+  auto pointOf = [&](std::size_t triangle, double wb, double wc) {
+    const dvec3 a = originalGeometry.corner(triangle, 0);
+    return a + wb * (originalGeometry.corner(triangle, 1) - a) +
+           wc * (originalGeometry.corner(triangle, 2) - a);
+  };
+
+  UvError error;
+  error.diagonal = original.diameter();
+  const double tie = options.tieTolerance * error.diagonal;
+  SurfaceErrorOptions sampling;
+  sampling.samplesPerMesh = options.samples;
+  sampling.seed = options.seed;
+  sampling.includeVerticesAndEdges = false;
+  const SamplePoints points = samplePoints(simplifiedGeometry, *simplifiedAreas, sampling);
+  const TriangleBvh bvh(original);
+  // The original laid out in uv space (z = 0), for the texel's preimage.
+  IndexedMesh uvLayout;
+  uvLayout.positions.reserve(original.vertexCount());
+  for (const glm::vec2& uv : original.uvs) uvLayout.positions.emplace_back(uv.x, uv.y, 0.0f);
+  uvLayout.indices = original.indices;
+  const TriangleBvh uvBvh(uvLayout);
+  std::uint32_t hint = 0, uvHint = 0;
+  std::vector<double> uvErrors, displacements;
+  uvErrors.reserve(points.random.size());
+  displacements.reserve(points.random.size());
+  for (const SurfacePoint& sp : points.random) {
+    const dvec3 q = simplifiedGeometry.at(sp);
+    const glm::dvec2 a = uvOf(simplified, sp.triangle, 0);
+    const glm::dvec2 s = a + sp.u * (uvOf(simplified, sp.triangle, 1) - a) +
+                         sp.v * (uvOf(simplified, sp.triangle, 2) - a);
+    // uv distance at the closest point, ties by distance taken at the best uv.
+    const double nearest = std::sqrt(bvh.squaredDistance(q, hint));
+    const double radius = (1.0 + options.tieFactor) * nearest + tie;
+    double bestUv = std::numeric_limits<double>::infinity();
+    bvh.forEachWithin(q, radius * radius, [&](std::uint32_t i, const detail::Triangle& tri) {
+      const std::uint32_t t = bvh.sourceTriangle(i);
+      double wb = 0.0, wc = 0.0;
+      glm::dvec2 o = uvOf(original, t, 0);  // zero area: no interpolation to speak of
+      if (barycentrics(tri, detail::closestPointOnTriangle(q, tri), wb, wc)) {
+        o += wb * (uvOf(original, t, 1) - o) + wc * (uvOf(original, t, 2) - o);
+      }
+      bestUv = std::min(bestUv, glm::length(s - o));
+    });
+    // Texture displacement: where the texel s is on the original.
+    const dvec3 su(s.x, s.y, 0.0);
+    const double uvNearest = std::sqrt(uvBvh.squaredDistance(su, uvHint));
+    const double uvRadius = uvNearest + options.texelTolerance;
+    double bestDisplacement = std::numeric_limits<double>::infinity();
+    uvBvh.forEachWithin(su, uvRadius * uvRadius, [&](std::uint32_t i, const detail::Triangle& tri) {
+      const std::uint32_t t = uvBvh.sourceTriangle(i);
+      double wb = 0.0, wc = 0.0;
+      const dvec3 p = barycentrics(tri, detail::closestPointOnTriangle(su, tri), wb, wc)
+                          ? pointOf(t, wb, wc)
+                          : originalGeometry.corner(t, 0);
+      bestDisplacement = std::min(bestDisplacement, glm::length(p - q));
+    });
+    // Both are finite: the nearest triangle is always within its radius.
+    if (!std::isfinite(bestUv) || !std::isfinite(bestDisplacement)) continue;
+    uvErrors.push_back(bestUv);
+    displacements.push_back(bestDisplacement);
+  }
+  error.samples = uvErrors.size();
+  if (error.samples > 0) {
+    const double n = static_cast<double>(error.samples);
+    for (std::size_t k = 0; k < error.samples; ++k) {
+      error.meanUv += uvErrors[k] / n;
+      error.meanDisplacement += displacements[k] / n;
+      error.maxUv = std::max(error.maxUv, uvErrors[k]);
+      error.maxDisplacement = std::max(error.maxDisplacement, displacements[k]);
+    }
+    error.p95Uv = percentile95(uvErrors);
+    error.p95Displacement = percentile95(displacements);
+  }
   return error;
 }
 

@@ -62,16 +62,20 @@ inline double squaredDistanceToBox(const dvec3& p, const Box& b) {
 // Closest point on a triangle (Voronoi-region walk, Ericson, Real-Time
 // Collision Detection 5.1.5), with a fallback for degenerate triangles whose
 // barycentric denominator vanishes.
-inline double squaredDistanceToSegment(const dvec3& p, const dvec3& a, const dvec3& b) {
+inline dvec3 closestPointOnSegment(const dvec3& p, const dvec3& a, const dvec3& b) {
   const dvec3 ab = b - a;
   const double len2 = glm::dot(ab, ab);
   double t = len2 > 0.0 ? glm::dot(p - a, ab) / len2 : 0.0;
   t = std::clamp(t, 0.0, 1.0);
-  const dvec3 d = p - (a + t * ab);
+  return a + t * ab;
+}
+
+inline double squaredDistanceToSegment(const dvec3& p, const dvec3& a, const dvec3& b) {
+  const dvec3 d = p - closestPointOnSegment(p, a, b);
   return glm::dot(d, d);
 }
 
-inline double squaredDistanceToTriangle(const dvec3& p, const Triangle& tri) {
+inline dvec3 closestPointOnTriangle(const dvec3& p, const Triangle& tri) {
   const dvec3& a = tri.a;
   const dvec3& b = tri.b;
   const dvec3& c = tri.c;
@@ -80,42 +84,54 @@ inline double squaredDistanceToTriangle(const dvec3& p, const Triangle& tri) {
   const dvec3 ap = p - a;
   const double d1 = glm::dot(ab, ap);
   const double d2 = glm::dot(ac, ap);
-  auto sq = [&p](const dvec3& q) {
-    const dvec3 d = p - q;
-    return glm::dot(d, d);
-  };
-  if (d1 <= 0.0 && d2 <= 0.0) return sq(a);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
   const dvec3 bp = p - b;
   const double d3 = glm::dot(ab, bp);
   const double d4 = glm::dot(ac, bp);
-  if (d3 >= 0.0 && d4 <= d3) return sq(b);
+  if (d3 >= 0.0 && d4 <= d3) return b;
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
     const double v = d1 / (d1 - d3);
-    return sq(a + v * ab);
+    return a + v * ab;
   }
   const dvec3 cp = p - c;
   const double d5 = glm::dot(ab, cp);
   const double d6 = glm::dot(ac, cp);
-  if (d6 >= 0.0 && d5 <= d6) return sq(c);
+  if (d6 >= 0.0 && d5 <= d6) return c;
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
     const double w = d2 / (d2 - d6);
-    return sq(a + w * ac);
+    return a + w * ac;
   }
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
     const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return sq(b + w * (c - b));
+    return b + w * (c - b);
   }
   const double denom = va + vb + vc;
   if (!(denom > 0.0)) {
-    return std::min({squaredDistanceToSegment(p, a, b), squaredDistanceToSegment(p, b, c),
-                     squaredDistanceToSegment(p, c, a)});
+    // Degenerate: the closest of the three edges' closest points.
+    const dvec3 candidates[3] = {closestPointOnSegment(p, a, b), closestPointOnSegment(p, b, c),
+                                 closestPointOnSegment(p, c, a)};
+    dvec3 best = candidates[0];
+    double bestDistance = glm::dot(p - best, p - best);
+    for (const dvec3& q : candidates) {
+      const double d = glm::dot(p - q, p - q);
+      if (d < bestDistance) {
+        bestDistance = d;
+        best = q;
+      }
+    }
+    return best;
   }
   const double v = vb / denom;
   const double w = vc / denom;
-  return sq(a + ab * v + ac * w);
+  return a + ab * v + ac * w;
+}
+
+inline double squaredDistanceToTriangle(const dvec3& p, const Triangle& tri) {
+  const dvec3 d = p - closestPointOnTriangle(p, tri);
+  return glm::dot(d, d);
 }
 
 inline dvec3 toDouble(const glm::vec3& v) { return dvec3(v.x, v.y, v.z); }
@@ -147,6 +163,30 @@ class TriangleBvh {
     triangles_.resize(n);
     for (std::size_t i = 0; i < n; ++i) triangles_[i] = source[order_[i]];
   }
+
+  // Calls visit(i, triangle) for every triangle (BVH order index i) within
+  // squared distance radius2 of p.
+  template <typename Visit>
+  void forEachWithin(const dvec3& p, double radius2, Visit visit) const {
+    std::array<std::uint32_t, kTraversalStack> stack;
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const BvhNode& node = nodes_[stack[--top]];
+      if (squaredDistanceToBox(p, node.box) > radius2) continue;
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          if (squaredDistanceToTriangle(p, triangles_[i]) <= radius2) visit(i, triangles_[i]);
+        }
+        continue;
+      }
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+    }
+  }
+
+  // The mesh's triangle number of BVH-order triangle i.
+  std::uint32_t sourceTriangle(std::uint32_t i) const { return order_[i]; }
 
   // Squared distance from p to the closest triangle. `hint` is a triangle
   // index (in BVH order) whose distance seeds the search bound; it is

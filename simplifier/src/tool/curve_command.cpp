@@ -69,6 +69,8 @@ void runCurve(const CurveArgs& args) {
   for (const CurveLevel& level : curves->levels) {
     levels.push_back({{"triangles", level.triangles},
                       {"relative_max_error", level.relativeMaxError},
+                      {"relative_hausdorff_error", level.relativeHausdorffError},
+                      {"relative_texture_error", level.relativeTextureError},
                       {"relative_mean_error", level.relativeMeanError},
                       {"accuracy", level.accuracy},
                       {"encoded_bytes", level.encodedBytes},

@@ -8,6 +8,15 @@
 //   (core/relative_accuracy.h: the one reference length), floored at
 //   minRelativeError because the full mesh has d = 0 and a curve needs a
 //   finite domain; a = 1/d.
+// - Textured meshes (uvs with a non-zero uv area, textureCredit): d is
+//   max(Hausdorff max, texel displacement p95) / L, the texel displacement
+//   of measureUvError (how far from its place on the original a texel is
+//   drawn; surface_error.h). The 95th percentile, not the max: the max is
+//   set by a few samples where a simplified chart border cuts a corner of
+//   its chart and a texel comes from the neighbouring chart of the atlas
+//   (duck.dae at 50%: p95 0.64%, max 4.9% of the diagonal; meshopt_simplify
+//   0.18 the same p95, max 44%), which an atlas' gutter hides and no
+//   collapse order avoids entirely. docs/simplifier.md "UV error".
 // - triangles curve: resources = extracted triangle count against a.
 //   bytes curve: resources = Draco-encoded frame size (encodeMesh, position
 //   bits from positionBitsForAccuracy(a)) against the accuracy of what the
@@ -46,7 +55,9 @@ namespace thinlod::simplifier {
 
 // 2: relative errors refer to the reference sphere's diameter (version 1
 // files used the bbox diagonal; they are rejected and measured again).
-inline constexpr int kMeshCurveFormatVersion = 2;
+// 3: levels carry the Hausdorff and texture errors apart; d of a textured
+// mesh includes the texture term.
+inline constexpr int kMeshCurveFormatVersion = 3;
 
 struct MeshCurveOptions {
   int levels = 12;                 // ladder rungs (duplicates after rounding merge)
@@ -54,6 +65,9 @@ struct MeshCurveOptions {
   double minRelativeError = 1e-4;  // floor on d: accuracy at most 10^4
   SurfaceErrorOptions error{};
   bool measureEncodedBytes = true;
+  // Textured meshes: d includes the texel displacement (above); its samples
+  // and seed are error's.
+  bool textureCredit = true;
   double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
   codec::MeshEncodeOptions encode{};        // positionBits is chosen per level
 };
@@ -61,8 +75,11 @@ struct MeshCurveOptions {
 struct CurveLevel {
   std::size_t requestedTriangles = 0;
   std::size_t triangles = 0;      // what the extraction returned
-  double relativeMaxError = 0.0;  // measured d = Hausdorff max / L, before the floor
-  double relativeMeanError = 0.0;
+  double relativeMaxError = 0.0;  // measured d, before the floor: max of the next two
+  double relativeHausdorffError = 0.0;  // Hausdorff max / L
+  double relativeTextureError = 0.0;    // texel displacement p95 / L (0: untextured)
+  double relativeTextureMaxError = 0.0;  // its max / L, reported only
+  double relativeMeanError = 0.0;        // Hausdorff mean / L
   double accuracy = 0.0;         // 1 / max(d, floor)
   std::size_t encodedBytes = 0;  // 0 when not measured
   int positionBits = 0;

@@ -7,7 +7,9 @@
 //   element), welds vertices closer than weldEpsilon * bbox diagonal, drops
 //   degenerate and duplicate triangles and unreferenced vertices (error when no
 //   triangle is left), then collapses down to stopAtTriangles (0: as far as the
-//   topology rules allow) and stores the collapse order.
+//   topology rules allow) and stores the collapse order. With preserveSeams
+//   (the default) vertices at one place with other uvs / colours stay apart
+//   (a seam) and keep their pairing and their places through every collapse.
 // - Greedy by cost: QEM (Garland-Heckbert, area-weighted planes) plus a fan
 //   term (distance of the removed vertex to its new fan) that keeps thin
 //   tips, and for a border vertex a border term (its distance to the border
@@ -59,6 +61,13 @@ struct BuildOptions {
   // attribute error weighing like a distance of sqrt(weight) * bbox diagonal.
   float attributeWeight = 0.0f;
   float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
+  // Keep uv and colour seams: vertices within the weld distance are welded
+  // only when their uv (within 1e-6) and colour agree too; the two sides of
+  // a seam (two vertices at one place) collapse together along the seam, so
+  // they never part and the seam stays on itself; places where three or more
+  // sides meet, and seam ends, never move. false: weld by position only
+  // (one side's attributes win, as before). Normals never split a vertex.
+  bool preserveSeams = true;
   std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
   // Empty (every vertex kFree) or one per input vertex; a welded group takes
   // the constraint of its first input vertex. Another size: kInvalidArgument.

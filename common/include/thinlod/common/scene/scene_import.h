@@ -16,7 +16,12 @@
 //   before any mesh is copied. glTF is pre-checked before Assimp runs: a
 //   .glb header and chunks must fit the file, the JSON's declared triangles
 //   must fit maxTriangles, and a file whose triangles Assimp silently drops
-//   (out-of-range indices) is refused.
+//   (out-of-range indices) is refused; JSON nesting deeper than 4096 and a
+//   node graph with a cycle, deeper than maxDepth or expanding to more than
+//   maxNodes instances are refused. Collada is pre-scanned too (element
+//   nesting, truncation, accessors reading past their arrays, the node graph
+//   with instance_node: src/scene/import_precheck.h): Assimp recursed over
+//   cyclic and deep node graphs until the stack overflowed.
 // - Result: node hierarchy -> TransformNode (identity transforms -> Group),
 //   each Assimp mesh -> one ShapeNode with kMeshFile geometry (resolvedPath =
 //   the file, urls = {file name}) holding an IndexedMesh with positions,

@@ -1,0 +1,38 @@
+// Private to the scene module: checks of an imported file's bytes before
+// Assimp parses them (scene_import.h's contract: validate before handing
+// bytes to a third-party library). Assimp's Collada and glTF importers
+// recurse over the node graph without a depth limit and follow
+// instance_node references without cycle detection, so a cyclic or very
+// deep node graph overflowed the stack (a crash, found by
+// tests/scene/scene_hostile_test.cpp); instancing also multiplies nodes
+// before any limit of ours could count them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "thinlod/common/core/status.h"
+#include "thinlod/common/scene/scene_import.h"
+
+namespace thinlod::scene::detail {
+
+// A node graph as the file declares it: children[n] are the nodes n holds
+// (nested or instanced); roots are the nodes a scene shows. Refuses (the
+// message starts with `path`) a cycle (kParseError), a path from a root
+// deeper than limits.maxDepth nodes or more than limits.maxNodes node
+// instances once every reference is expanded (kResourceExhausted).
+// Iterative: any graph size is safe. Children indices must be < the count.
+Status checkNodeGraph(const std::string& path, const std::vector<std::vector<std::uint32_t>>& children,
+                      const std::vector<std::uint32_t>& roots, const ImportLimits& limits);
+
+// Collada: a light scan of the XML (tags, quotes, comments, CDATA; no DTD)
+// before Assimp parses it. Refuses unterminated markup and a file whose
+// elements are left open (truncated), element nesting deeper than
+// limits.maxDepth + 64, an accessor reading past the array it names
+// (count * stride > the array's count), and node graphs (nesting plus
+// instance_node) that checkNodeGraph refuses.
+Status precheckCollada(const std::string& path, std::string_view xml, const ImportLimits& limits);
+
+}  // namespace thinlod::scene::detail
