@@ -290,8 +290,9 @@ int main(int argc, char** argv) {
           "vertex_moved_max=%.3e p99=%.3e mean=%.3e matched=%zu/%zu radius=%.3e\n",
           name, file, levelTriangles, ml.median, ml.min, ml.p90, ml.cpu, meshedLevel.coverage,
           tl.renderMs, tl.meshMs, tl.gridMs, tl.simplifyMs, tl.checkMs,
-          meshedLevel.mesh.triangleCount(), differenceText(meshed.texture, meshedLevel.texture).c_str(),
-          moved.max, moved.p99, moved.mean, moved.matched, moved.vertices, sphere.radius);
+          meshedLevel.mesh.triangleCount(),
+          differenceText(meshed.texture, meshedLevel.texture).c_str(), moved.max, moved.p99,
+          moved.mean, moved.matched, moved.vertices, sphere.radius);
     }
     (*impostors).reset();
   }
