@@ -285,20 +285,22 @@ Result<RgbaImage> decodeTextureDelta(const RgbaImage& reference, const std::uint
     RgbaImage out(reference.width, reference.height);
     const std::size_t n = expected / 4;
     const int s = static_cast<int>(step);
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t c = 0; c < 4; ++c) {
-        const std::uint8_t code = planes[c * n + i];
-        const std::uint8_t ref = reference.pixels[4 * i + c];
-        std::uint8_t value;
-        if (!isResidual(mode)) {
-          value = code;
-        } else if (c == 3 || s == 1) {
-          value = static_cast<std::uint8_t>(ref + code);  // mod 256
-        } else {
-          const int q = static_cast<std::int8_t>(code);
-          value = static_cast<std::uint8_t>(std::clamp(int{ref} + q * s, 0, 255));
+    // One branch-free loop per channel (the decode is on the client's frame path).
+    for (std::size_t c = 0; c < 4; ++c) {
+      const std::uint8_t* code = planes.data() + c * n;
+      const std::uint8_t* ref = reference.pixels.data() + c;
+      std::uint8_t* dst = out.pixels.data() + c;
+      if (!isResidual(mode)) {
+        for (std::size_t i = 0; i < n; ++i) dst[4 * i] = code[i];
+      } else if (c == 3 || s == 1) {
+        for (std::size_t i = 0; i < n; ++i) {
+          dst[4 * i] = static_cast<std::uint8_t>(ref[4 * i] + code[i]);  // mod 256
         }
-        out.pixels[4 * i + c] = value;
+      } else {
+        for (std::size_t i = 0; i < n; ++i) {
+          const int q = static_cast<std::int8_t>(code[i]);
+          dst[4 * i] = static_cast<std::uint8_t>(std::clamp(int{ref[4 * i]} + q * s, 0, 255));
+        }
       }
     }
     return out;
