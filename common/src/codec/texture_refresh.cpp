@@ -257,14 +257,7 @@ Result<RgbaImage> decodeTextureDelta(const RgbaImage& reference, const std::uint
   const std::uint8_t* z = payload + kFingerprintBytes;
   const std::size_t zSize = h.payloadBytes - kFingerprintBytes;
   const std::size_t expected = reference.pixels.size();
-  const unsigned long long content = ZSTD_getFrameContentSize(z, zSize);
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN ||
-      content != expected) {
-    return refreshError(ErrorCode::kParseError, "zstd frame size does not match the image");
-  }
-  if (ZSTD_findFrameCompressedSize(z, zSize) != zSize) {
-    return refreshError(ErrorCode::kParseError, "zstd payload is not exactly one frame");
-  }
+  THINLOD_RETURN_IF_ERROR(detail::checkOneZstdFrame(z, zSize, expected, "texture refresh: "));
   try {
     std::vector<std::uint8_t> planes(expected);
     std::vector<std::uint8_t> referencePlanes;
