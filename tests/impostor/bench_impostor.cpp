@@ -1,5 +1,5 @@
-// bench_impostor: times 256x256 simple and meshed impostors of the shared cow
-// and bunny on each offscreen back-end, with an empty-frame baseline measured
+// bench_impostor: times 256x256 simple and meshed impostors of shared models
+// on each offscreen back-end, with an empty-frame baseline measured
 // in the same run. Not a test. Usage: bench_impostor [repetitions] [models dir]
 // Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra
 // Models: the cow, the bunny (69k triangles) and two other large meshes

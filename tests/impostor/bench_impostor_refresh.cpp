@@ -16,9 +16,10 @@
 // client's decode time of each (median of --decode-repeats, thread CPU ms).
 // A summary per scene and kind goes to stderr: sums, ratios, medians.
 // Usage: bench_impostor_refresh [--models DIR] [--case SCENE TRACE]...
-//          [--step N] [--substeps K] [--frames N] [--texture N] [--tolerance T] [--decode-repeats
-//          R]
-//          [--all-distances]
+//   [--step N] [--substeps K] [--frames N (first N trace poses)] [--texture N]
+//   [--tolerance T] [--decode-repeats R] [--all-distances]
+// Default cases: the paper room with the paper flight, the gallery with its
+// tour and the city with its walk (deploy/data, the workbench suite).
 #include <time.h>
 
 #include <algorithm>
