@@ -1,7 +1,9 @@
 // Writes the seed corpora of the codec fuzzers: valid link frames
 // (encoding.h) covering each Draco encoding method (speeds 0, 5, 10 select
 // edgebreaker-valence, edgebreaker and sequential coding), each attribute
-// combination, and each texture codec. Run after a frame format change and
+// combination, each texture codec and each texture refresh mode (inputs of
+// fuzz/codec_texture_refresh.cpp: two size bytes, the reference, the frame).
+// Run after a frame format change and
 // commit the result as a reviewed change:
 //   build/fuzz/thinlod_fuzz_write_codec_corpus fuzz/corpus
 #include <cstdio>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/codec/texture_refresh.h"
 
 namespace {
 
@@ -63,16 +66,17 @@ bool write(const std::filesystem::path& path, const std::vector<std::uint8_t>& b
 
 int main(int argc, char** argv) {
   if (argc != 2) {
-    std::fprintf(
-        stderr,
-        "usage: %s CORPUS_DIR (writes CORPUS_DIR/codec_mesh, codec_texture, codec_hybrid)\n",
-        argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s CORPUS_DIR (writes CORPUS_DIR/codec_mesh, codec_texture, codec_hybrid, "
+                 "codec_texture_refresh)\n",
+                 argv[0]);
     return 2;
   }
   const std::filesystem::path root = argv[1];
   std::filesystem::create_directories(root / "codec_mesh");
   std::filesystem::create_directories(root / "codec_texture");
   std::filesystem::create_directories(root / "codec_hybrid");
+  std::filesystem::create_directories(root / "codec_texture_refresh");
   bool ok = true;
   struct MeshSeed {
     const char* name;
@@ -153,6 +157,46 @@ int main(int argc, char** argv) {
       return 1;
     }
     ok &= write(root / "codec_texture" / (std::string(seed.name) + ".bin"), *frame);
+  }
+  // Texture refreshes: the reference shifted by a texel and brightened.
+  struct RefreshSeed {
+    const char* name;
+    codec::TextureDeltaMode mode;
+    int width, height, tolerance;
+  };
+  const RefreshSeed refreshes[] = {
+      {"residual_8x8", codec::TextureDeltaMode::kResidual, 8, 8, 0},
+      {"residual_lossy_9x5", codec::TextureDeltaMode::kResidual, 9, 5, 2},
+      {"prefix_8x8", codec::TextureDeltaMode::kReferencePrefix, 8, 8, 0},
+      {"prefix_16x3", codec::TextureDeltaMode::kReferencePrefix, 16, 3, 0},
+      {"residual_left_8x8", codec::TextureDeltaMode::kResidualLeft, 8, 8, 0},
+      {"residual_left_lossy_7x9", codec::TextureDeltaMode::kResidualLeft, 7, 9, 3},
+      {"intra_left_12x4", codec::TextureDeltaMode::kIntraLeft, 12, 4, 0},
+  };
+  for (const RefreshSeed& seed : refreshes) {
+    const RgbaImage reference = image(seed.width, seed.height, false);
+    RgbaImage next = reference;
+    for (int y = 0; y < seed.height; ++y) {
+      for (int x = seed.width - 1; x > 0; --x) {
+        for (int c = 0; c < 4; ++c) {
+          const int v = reference.at(x - 1, y)[c] + (c == 3 ? 0 : 3);
+          next.at(x, y)[c] = static_cast<std::uint8_t>(v > 255 ? 255 : v);
+        }
+      }
+    }
+    codec::TextureDeltaOptions options;
+    options.mode = seed.mode;
+    options.colorTolerance = seed.tolerance;
+    const auto delta = codec::encodeTextureDelta(reference, next, options);
+    if (!delta.ok()) {
+      std::fprintf(stderr, "%s: %s\n", seed.name, delta.status().toString().c_str());
+      return 1;
+    }
+    std::vector<std::uint8_t> input = {static_cast<std::uint8_t>(seed.width - 1),
+                                       static_cast<std::uint8_t>(seed.height - 1)};
+    input.insert(input.end(), reference.pixels.begin(), reference.pixels.end());
+    input.insert(input.end(), delta->bytes.begin(), delta->bytes.end());
+    ok &= write(root / "codec_texture_refresh" / (std::string(seed.name) + ".bin"), input);
   }
   return ok ? 0 : 1;
 }

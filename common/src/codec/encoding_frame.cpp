@@ -1,5 +1,7 @@
 #include "encoding_frame.h"
 
+#include <zstd.h>
+
 #include <algorithm>
 #include <string>
 
@@ -92,6 +94,21 @@ Result<FrameHeader> parseFrame(const std::uint8_t* data, std::size_t size,
     return Status(ErrorCode::kParseError, name + ": payload checksum mismatch");
   }
   return h;
+}
+
+Status checkOneZstdFrame(const std::uint8_t* data, std::size_t size, std::size_t expected,
+                         const char* what) {
+  const unsigned long long content = ZSTD_getFrameContentSize(data, size);
+  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN ||
+      content != expected) {
+    return Status(ErrorCode::kParseError,
+                  std::string(what) + "zstd frame size does not match the image");
+  }
+  if (ZSTD_findFrameCompressedSize(data, size) != size) {
+    return Status(ErrorCode::kParseError,
+                  std::string(what) + "zstd payload is not exactly one frame");
+  }
+  return Status();
 }
 
 }  // namespace detail

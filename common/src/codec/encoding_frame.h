@@ -38,4 +38,10 @@ Result<FrameHeader> parseFrame(const std::uint8_t* data, std::size_t size,
                                const std::array<char, 4>& magic, const DecodeLimits& limits,
                                const char* what);
 
+// Checks that `size` bytes are exactly one zstd frame stating a content
+// size of `expected` bytes (before anything is decompressed). The error is
+// kParseError, its message prefixed with `what` ("texture: ").
+Status checkOneZstdFrame(const std::uint8_t* data, std::size_t size, std::size_t expected,
+                         const char* what);
+
 }  // namespace thinlod::codec::detail

@@ -121,14 +121,7 @@ Result<std::vector<std::uint8_t>> payloadFor(const RgbaImage& texture, TextureCo
 
 Status decodeZstd(const std::uint8_t* payload, std::size_t size, RgbaImage& out) {
   const std::size_t expected = out.pixels.size();
-  const unsigned long long content = ZSTD_getFrameContentSize(payload, size);
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN ||
-      content != expected) {
-    return textureError(ErrorCode::kParseError, "zstd frame size does not match the image");
-  }
-  if (ZSTD_findFrameCompressedSize(payload, size) != size) {
-    return textureError(ErrorCode::kParseError, "zstd payload is not exactly one frame");
-  }
+  THINLOD_RETURN_IF_ERROR(detail::checkOneZstdFrame(payload, size, expected, "texture: "));
   const std::size_t written = ZSTD_decompress(out.pixels.data(), expected, payload, size);
   if (ZSTD_isError(written) || written != expected) {
     return textureError(ErrorCode::kParseError, "zstd payload is corrupt");

@@ -260,6 +260,8 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   auto mesh = buildDepthMesh(depthScratch_, f, options, &impostor.depthMesh);
   if (!mesh.ok()) return mesh.status();
   impostor.mesh = std::move(mesh).value();
+  timings_.gridMs = millisecondsSince(meshStart);
+  const auto simplifyStart = Clock::now();
   if (options.targetTriangles > 0 && options.targetTriangles < impostor.mesh.triangleCount()) {
     BuildOptions simplify;
     simplify.stopAtTriangles = options.targetTriangles;
@@ -267,6 +269,8 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     if (!progressive.ok()) return progressive.status();
     impostor.mesh = progressive->extract(options.targetTriangles);
   }
+  timings_.simplifyMs = millisecondsSince(simplifyStart);
+  const auto checkStart = Clock::now();
 
   // Measure what the depth mesh gets wrong: draw it with the capture camera
   // and compare its depth with the object's, pixel by pixel, as distances
@@ -334,6 +338,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   impostor.errorModel.silhouetteRadius = f.objectRadius;
   impostor.validity = impostorValidity(f, impostor.errorModel, options.maxAngularError);
   impostor.coverage = coverageOf(impostor.texture);
+  timings_.checkMs = millisecondsSince(checkStart);
   timings_.meshMs = millisecondsSince(meshStart);
   return impostor;
 }

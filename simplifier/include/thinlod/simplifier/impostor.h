@@ -181,6 +181,12 @@ struct ImpostorTimings {
   double uploadMs = 0.0;  // meshes uploaded this call (cache misses)
   double renderMs = 0.0;  // draw + colour (and depth) readback
   double meshMs = 0.0;    // meshed only: depth mesh, simplification, error measurement
+  // meshMs in parts (meshed only): the grid mesh from the z-buffer, its QEM
+  // simplification, and the check (draw the final mesh, depth readback,
+  // silhouette loss, per-pixel depth error).
+  double gridMs = 0.0;
+  double simplifyMs = 0.0;
+  double checkMs = 0.0;
 };
 
 class ImpostorRenderer {
