@@ -16,6 +16,7 @@
 #include "scene_conversion.h"
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/common/scene/scene_parser.h"
+#include "thinlod/protocol/codec.h"
 
 namespace thinlod::backbone_daemon {
 namespace {
@@ -216,6 +217,37 @@ TEST(ImposterNodes, Figure10BudgetHoldsAtTheFrontendOverARandomFlight) {
   EXPECT_GE(shownKinds.size(), 2u);
 }
 
+// The workbench gallery's bunny and horse are Figure 10 LODs whose imposter
+// levels USE the placed model: each is one object with three kinds.
+TEST(ImposterNodes, TheGalleryStatuesAreOneObjectEach) {
+  const std::string path = std::string(THINLOD_SOURCE_DIR) + "/deploy/data/gallery.wrl";
+  scene::SceneLoadOptions load;
+  load.meshSearchPaths = {modelsDir()};
+  Result<scene::Scene> loaded = scene::loadSceneFile(path, load);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().toString();
+  auto objects = scene::collectSceneObjects(*loaded);
+  ASSERT_TRUE(objects.ok()) << objects.status().toString();
+  ASSERT_EQ(objects->size(), 31u);
+  Result<ConvertedScene> converted = convertScene(*loaded, *objects);
+  ASSERT_TRUE(converted.ok()) << converted.status().toString();
+  EXPECT_EQ(converted->collapsedLods, 2u);
+  EXPECT_EQ(converted->lodNodes, 0u);
+  // 31 Shape instances, two LODs of three levels each: 27 scheduled objects.
+  ASSERT_EQ(converted->records.size(), 27u);
+  std::size_t statues = 0;
+  for (const ObjectRecord& record : converted->records) {
+    if (record.object->shape->defName != "Bunny" && record.object->shape->defName != "Horse")
+      continue;
+    ++statues;
+    EXPECT_TRUE(record.mesh.offered);
+    EXPECT_TRUE(record.meshedImpostor.offered);
+    ASSERT_TRUE(record.simpleImpostor.offered);
+    ASSERT_TRUE(record.simpleImpostor.range.has_value());
+    EXPECT_NEAR(record.simpleImpostor.range->minDistance(), 6.0, 1e-6);  // float transforms
+  }
+  EXPECT_EQ(statues, 2u);
+}
+
 // ------------------------------------------------ single-object imposter nodes
 
 TEST(ImposterNodes, AnImposterNodeOverOneObjectOffersItsMeshAndItsKindOnly) {
@@ -270,6 +302,49 @@ LOD { range [ 20 ] level [
   ASSERT_EQ(s.objects.size(), 2u);
   EXPECT_EQ(optionKinds(s, 1),
             (std::vector<OptionKind>{OptionKind::kSimplifiedMesh, OptionKind::kSimpleImpostor}));
+}
+
+// Figure 9's size / center with autosize / autocenter FALSE reach the
+// simplifier as the request's fixed frame (world: the node's frame mapped).
+TEST(ImposterNodes, FixedSizeAndCentreOfTheNodeAreTheRequestsFrame) {
+  const std::string text = R"(#VRML V2.0 utf8
+Transform { translation 10 0 0 scale 2 2 2 children [
+  SimpleImposter { size 3 4 autosize FALSE center 0.5 1 0 autocenter FALSE
+    children [ Shape { geometry Sphere {} } Transform { translation 1 0 0 children Shape { geometry Box {} } } ] }
+  SimpleImposter { children [ Transform { translation 0 5 0 children Shape { geometry Sphere {} } } ] }
+] }
+)";
+  auto created = coreFromText(text, "frame.wrl", polygonBudget(10));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  ASSERT_EQ(core.objects().size(), 4u);  // two objects + their cluster, one alone
+  const ObjectRecord& cluster = core.objects()[2];
+  ASSERT_TRUE(cluster.cluster);
+  ASSERT_TRUE(cluster.simpleImpostor.frameCenter.has_value());
+  EXPECT_NEAR(glm::length(*cluster.simpleImpostor.frameCenter - glm::vec3(11.0f, 2.0f, 0.0f)), 0.0f,
+              1e-5f);
+  EXPECT_NEAR(cluster.simpleImpostor.frameSize.x, 6.0f, 1e-5f);
+  EXPECT_NEAR(cluster.simpleImpostor.frameSize.y, 8.0f, 1e-5f);
+  // The defaults (autosize / autocenter TRUE) leave the framing to the simplifier.
+  EXPECT_FALSE(core.objects()[3].simpleImpostor.frameCenter.has_value());
+  EXPECT_EQ(core.objects()[3].simpleImpostor.frameSize, glm::vec2(0.0f));
+
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+  const glm::vec3 target(11.0f, 2.0f, 0.0f);
+  ASSERT_TRUE(core.beginPose(poseAt(0, 0.0, target + glm::vec3(0, 0, 60), target)).ok());
+  bool sawFramed = false;
+  for (const OutgoingRequest& r : submitAll(core)) {
+    const auto* impostor = std::get_if<protocol::ImpostorRequest>(&r.message);
+    if (impostor == nullptr || impostor->objectIds.size() != 2) continue;
+    sawFramed = true;
+    ASSERT_TRUE(impostor->frameCenter.has_value());
+    EXPECT_NEAR(glm::length(*impostor->frameCenter - glm::vec3(11.0f, 2.0f, 0.0f)), 0.0f, 1e-5f);
+    EXPECT_NEAR(impostor->frameWidth, 6.0f, 1e-5f);
+    EXPECT_NEAR(impostor->frameHeight, 8.0f, 1e-5f);
+    EXPECT_TRUE(protocol::validate(protocol::Message(*impostor)).ok());
+  }
+  EXPECT_TRUE(sawFramed);
 }
 
 // ------------------------------------------------------------ clusters

@@ -535,6 +535,11 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     impostor.kind = state.wireKind;
     impostor.accuracyBound = std::clamp(1.0 / absolute, 1e-7, 1.0);
     impostor.textureCodec = options_.textureCodec;
+    const KindOffer& offer =
+        option.kind == OptionKind::kSimpleImpostor ? record.simpleImpostor : record.meshedImpostor;
+    impostor.frameCenter = offer.frameCenter;
+    impostor.frameWidth = offer.frameSize.x;
+    impostor.frameHeight = offer.frameSize.y;
     message = std::move(impostor);
   }
   // The scheduler asks again for an option whose request is open (the same

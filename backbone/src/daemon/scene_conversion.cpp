@@ -128,10 +128,17 @@ KindOffer notOffered() {
   return offer;
 }
 
-KindOffer explicitKind(const ConicRange& range) {
+// `node` (may be null) and the map of its frame to world give the fixed
+// frame of autocenter / autosize FALSE.
+KindOffer explicitKind(const ConicRange& range, const scene::ImposterNode* node = nullptr,
+                       const glm::mat4& nodeToWorld = glm::mat4(1.0f)) {
   KindOffer offer;
   offer.explicitNode = true;
   if (!range.isEverywhere()) offer.range = range;
+  if (node != nullptr) {
+    if (!node->autocenter) offer.frameCenter = glm::vec3(nodeToWorld * glm::vec4(node->center, 1.0f));
+    if (!node->autosize) offer.frameSize = node->size * float(scene::maxScale(nodeToWorld));
+  }
   return offer;
 }
 
@@ -143,11 +150,13 @@ bool impostorKindOf(scene::NodeKind kind, bool& simple) {
 
 // Options of one object shown through an imposter node of `kind` (alone, not
 // an LOD level): its full representation and the node's kind.
-void offerFromImposterNode(ObjectRecord& record, scene::NodeKind kind) {
+void offerFromImposterNode(ObjectRecord& record, const scene::NodeInstance& instance) {
   bool simple = false;
-  const bool impostor = impostorKindOf(kind, simple);
-  record.meshedImpostor = impostor && !simple ? explicitKind(ConicRange()) : notOffered();
-  record.simpleImpostor = impostor && simple ? explicitKind(ConicRange()) : notOffered();
+  const bool impostor = impostorKindOf(instance.node->kind, simple);
+  const auto* node = static_cast<const scene::ImposterNode*>(instance.node);
+  const KindOffer offer = explicitKind(ConicRange(), node, instance.contentToWorld);
+  record.meshedImpostor = impostor && !simple ? offer : notOffered();
+  record.simpleImpostor = impostor && simple ? offer : notOffered();
 }
 
 }  // namespace
@@ -221,7 +230,7 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
   };
 
   // Figure 10: every level of the LOD at `i` is the same Shape under the
-  // same transform (itself, or the one object of an imposter node). Fills
+  // same transform (itself, a Transform / Group nest around it, or the one object of an imposter node). Fills
   // `record` (the first level's object, one option kind per level).
   auto collapseLod = [&](std::size_t i, ObjectRecord& record) -> bool {
     std::vector<std::size_t> levels;
@@ -231,13 +240,15 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
     glm::mat4 transform(1.0f);
     int first = -1;
     for (std::size_t j : levels) {
-      int object = objectOfInstance[j];
-      if (object < 0) {
-        if (!scene::isImposterKind(instances[j].node->kind)) return false;
-        const std::vector<std::uint32_t> below = objectsBelow(j);
-        if (below.size() != 1) return false;
-        object = static_cast<int>(below[0]);
+      // A level is one object: the Shape itself, a Transform / Group nest
+      // around it (the full representation), or an imposter node over it.
+      const std::vector<std::uint32_t> below = objectsBelow(j);
+      if (below.size() != 1) return false;
+      for (std::size_t k = j + 1; k < subtreeEnd[j]; ++k) {
+        const scene::NodeKind kind = instances[k].node->kind;
+        if (kind == scene::NodeKind::kLod || scene::isImposterKind(kind)) return false;
       }
+      const int object = static_cast<int>(below[0]);
       const scene::SceneObject& o = objects[static_cast<std::size_t>(object)];
       if (shape == nullptr) {
         shape = o.shape;
@@ -259,7 +270,11 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
                          : kind == scene::NodeKind::kMeshedImposter ? &record.meshedImpostor
                                                                     : &record.mesh;
       if (offer->offered) continue;
-      *offer = explicitKind(range);
+      *offer = explicitKind(range,
+                            scene::isImposterKind(kind)
+                                ? static_cast<const scene::ImposterNode*>(instances[j].node)
+                                : nullptr,
+                            instances[j].contentToWorld);
       if (offer == &record.mesh) offer->explicitNode = false;
     }
     return true;
@@ -303,7 +318,7 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
       const bool impostor = impostorKindOf(inst.node->kind, simple);
       if (below.size() == 1) {
         ObjectRecord record = plainRecord(below[0]);
-        offerFromImposterNode(record, inst.node->kind);
+        offerFromImposterNode(record, inst);
         record.imposterNode = imposter;
         const BoundingSphere sphere = record.object->worldSphere;
         addLeaf(container, std::move(record), sphere);
@@ -341,7 +356,7 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
         cluster.imposterNode = imposter;
         cluster.worldBoxDiagonal = box.diagonal();
         cluster.mesh = notOffered();
-        offerFromImposterNode(cluster, inst.node->kind);
+        offerFromImposterNode(cluster, inst);
         addLeaf(lodNode, std::move(cluster), enclosingSphere(spheres));
         ++out.clusters;
         markSubtree();

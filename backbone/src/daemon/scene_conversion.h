@@ -42,6 +42,8 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <optional>
 #include <vector>
 
@@ -62,6 +64,11 @@ struct KindOffer {
   // The scene names this kind explicitly (an imposter node): offered even
   // when CoreOptions switches the kind's default off.
   bool explicitNode = false;
+  // The node's autocenter / autosize FALSE (paper Figure 9): the impostor's
+  // fixed centre (world) and width x height (world metres; 0 0: automatic),
+  // sent in the ImpostorRequest.
+  std::optional<glm::vec3> frameCenter;
+  glm::vec2 frameSize{0.0f};
 };
 
 struct ObjectRecord {
