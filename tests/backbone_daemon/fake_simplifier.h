@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <glm/geometric.hpp>
 #include <map>
 #include <string>
@@ -153,6 +154,29 @@ inline void answer(BackboneCore& core, const FakeSimplifier& fake,
       EXPECT_TRUE(core.onImpostorResult(fake.impostor(wire)).ok());
     }
   }
+}
+
+// Requests on their way to a simulated simplifier: (due pose, request).
+using InFlightRequests = std::deque<std::pair<int, OutgoingRequest>>;
+
+// Drops the requests the core cancelled, then answers those due by `step`.
+inline void answerDue(BackboneCore& core, const FakeSimplifier& fake, InFlightRequests& inFlight,
+                      int step) {
+  for (std::uint64_t wire : core.takeCancellations()) {
+    inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
+                                  [&](const auto& f) { return wireIdOf(f.second) == wire; }),
+                   inFlight.end());
+  }
+  std::vector<OutgoingRequest> due;
+  for (auto it = inFlight.begin(); it != inFlight.end();) {
+    if (it->first <= step) {
+      due.push_back(std::move(it->second));
+      it = inFlight.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  answer(core, fake, due);
 }
 
 inline protocol::ViewerPose poseAt(std::uint64_t sequence, double seconds, glm::vec3 position,

@@ -175,7 +175,7 @@ TEST(ImposterNodes, Figure10BudgetHoldsAtTheFrontendOverARandomFlight) {
   FrontendModel frontend;
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::deque<std::pair<int, OutgoingRequest>> inFlight;
+  InFlightRequests inFlight;
   std::set<protocol::RepresentationKind> shownKinds;
   double distance = 2.5;
   for (int step = 0; step < 200; ++step) {
@@ -185,21 +185,7 @@ TEST(ImposterNodes, Figure10BudgetHoldsAtTheFrontendOverARandomFlight) {
     ASSERT_TRUE(core.beginPose(poseAt(step, step * 0.25, eye, glm::vec3(0.0f))).ok());
     for (OutgoingRequest& r : submitAll(core))
       inFlight.emplace_back(step + static_cast<int>(unit(random) * 3.0), std::move(r));
-    for (std::uint64_t wire : core.takeCancellations()) {
-      inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
-                                    [&](const auto& f) { return wireIdOf(f.second) == wire; }),
-                     inFlight.end());
-    }
-    std::vector<OutgoingRequest> due;
-    for (auto it = inFlight.begin(); it != inFlight.end();) {
-      if (it->first <= step) {
-        due.push_back(std::move(it->second));
-        it = inFlight.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    answer(core, fake, due);
+    answerDue(core, fake, inFlight, step);
     PoseOutcome outcome = core.finishPose();
     ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
     for (const protocol::SceneOperation& op : outcome.update.operations) {
