@@ -433,6 +433,22 @@ TEST(ImposterNodes, AClusterResultMustNameEveryObjectOfTheCluster) {
   EXPECT_FALSE(core.onImpostorResult(result).ok());
 }
 
+// Levels of an LOD are alternatives: an impostor node over an LOD (and
+// something else) is no cluster; the LOD stays an LOD.
+TEST(ImposterNodes, AnImposterNodeOverAnLodStaysTransparent) {
+  const std::string text = R"(#VRML V2.0 utf8
+SimpleImposter { children [
+  LOD { range [ 5 ] level [ Shape { geometry Sphere {} } Shape { geometry Box {} } ] }
+  Transform { translation 3 0 0 children Shape { geometry Cone {} } }
+] }
+)";
+  auto core = coreFromText(text, "lodinside.wrl", polygonBudget(100));
+  ASSERT_TRUE(core.ok()) << core.status().toString();
+  EXPECT_EQ((*core)->lodNodes(), 1u);
+  ASSERT_EQ((*core)->objects().size(), 3u);
+  for (const ObjectRecord& record : (*core)->objects()) EXPECT_FALSE(record.cluster);
+}
+
 TEST(ImposterNodes, ASimplifiedPolygonOfSeveralObjectsOffersThemMeshesOnly) {
   const std::string text = R"(#VRML V2.0 utf8
 SimplifiedPolygon { children [

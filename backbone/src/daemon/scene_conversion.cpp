@@ -330,7 +330,12 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
         meshOnly[i] = true;  // SimplifiedPolygon: transparent, mesh kinds only
         continue;
       }
-      if (below.size() > 1) {
+      // An LOD inside: its levels are alternatives, not objects to show
+      // together, so the node stays transparent (no cluster of them yet).
+      bool lodInside = false;
+      for (std::size_t j = i + 1; j < subtreeEnd[i]; ++j)
+        lodInside = lodInside || instances[j].node->kind == scene::NodeKind::kLod;
+      if (below.size() > 1 && !lodInside) {
         // LOD { Group { the objects, mesh kinds only }, cluster impostor }.
         const int lodNode = addChild(tree, container, SceneNodeKind::kLod, ConicRange());
         const int full = addChild(tree, lodNode, SceneNodeKind::kGroup, ConicRange());

@@ -22,6 +22,8 @@
 //     level 1 is one *cluster* leaf with the node's impostor of all of them
 //     (ObjectRecord::members; its wire id is numbered above every object id,
 //     objects.size() + 1 + k for the k-th cluster in pre-order);
+//   * an LOD below a SimpleImposter / MeshedImposter of several objects:
+//     the node is transparent (an LOD's levels are alternatives);
 //   * several objects below a SimplifiedPolygon: its objects keep their own
 //     leaves with the mesh kinds only (no merged mesh yet: every one is
 //     simplified to the same target);
