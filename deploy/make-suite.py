@@ -136,14 +136,19 @@ class Gallery:
 
     def lod_statue(self, name, base, yaw_deg, far):
         """The paper's Figure 10: level 0 the Shape, level 1 a SimpleImposter of it (only
-        beyond `far` metres), level 2 a MeshedImposter of it, everywhere."""
+        beyond `far` metres), level 2 a MeshedImposter of it, everywhere. The imposter levels
+        USE the placed model (its whole Transform nest), so all three levels are the same
+        geometry in the same place and the backbone schedules them as one object
+        (docs/backbone.md "Imposter nodes"); a USE of the bare Shape would put an unscaled
+        model at the LOD's origin."""
         statue, shape = self.fitted(name, (0, 0, 0), 0)
+        placed = f"{shape}Placed"
         self.add(f"{name}: LOD with imposter levels (Figure 10 pattern)",
                  f"Transform {{ translation {fmt(*base)} rotation 0 1 0 {math.radians(yaw_deg):.6g}\n"
                  f"  children LOD {{\n"
-                 f"    level [\n      {statue}\n"
-                 f"      SimpleImposter {{ children [ USE {shape} ] }}\n"
-                 f"      MeshedImposter {{ children [ USE {shape} ] }}\n    ]\n"
+                 f"    level [\n      DEF {placed} {statue}\n"
+                 f"      SimpleImposter {{ children [ USE {placed} ] }}\n"
+                 f"      MeshedImposter {{ children [ USE {placed} ] }}\n    ]\n"
                  f"    range [ ConicRange {{}}, ConicRange {{ distance {far:g} 1000 }}, ConicRange {{}} ]\n"
                  f"  }} }}", 3)
 

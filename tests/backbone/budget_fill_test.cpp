@@ -261,6 +261,7 @@ TEST(BudgetFillProperty, UsesNearlyAllTheBudgetWhenThereIsMoreDetail) {
 struct FlightCheck {
   int plans = 0;
   int filledPlans = 0;
+  int usageRaised = 0;  // polygon budget: plans where the fill moved something
 };
 
 FlightCheck checkRandomScenes(bool link) {
@@ -305,6 +306,12 @@ FlightCheck checkRandomScenes(bool link) {
         EXPECT_GE(d.absoluteAccuracy, plan->targetAccuracy * (1.0 - 1e-9))
             << "seed " << seed << " object " << d.object;
       }
+      // The fill never gives back triangles the target's picks used.
+      if (!link) {
+        EXPECT_GE(plan->predictedTriangles, plan->stats.trianglesBeforeFill * (1.0 - 1e-12))
+            << "seed " << seed << " step " << step;
+        if (plan->stats.budgetFillUpgrades > 0) ++check.usageRaised;
+      }
       if (step == 0) {
         // Nothing displayed yet: first representations stay the cheapest
         // (no fill), so the plan is the no-fill plan.
@@ -332,6 +339,7 @@ TEST(BudgetFillProperty, SchedulerKeepsThePolygonBudgetAndTheTarget) {
   EXPECT_GE(check.plans, 200);
   EXPECT_GT(check.filledPlans,
             check.plans / 4);  // the fill really runs (later steps often keep its copies)
+  EXPECT_GT(check.usageRaised, 0);
 }
 
 TEST(BudgetFillProperty, SchedulerKeepsBothBudgetsAndTheTarget) {

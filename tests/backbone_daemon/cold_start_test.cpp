@@ -223,7 +223,7 @@ void flyOnEstimates(double inflation, std::uint64_t seed, bool deliverCurves) {
   FrontendModel frontend;
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::deque<std::pair<int, OutgoingRequest>> inFlight;  // (due pose, request)
+  InFlightRequests inFlight;
   glm::dvec3 position(2.0, 1.1, 3.4);
   glm::dvec3 velocity(0.0);
   const double dt = 0.25;
@@ -247,21 +247,7 @@ void flyOnEstimates(double inflation, std::uint64_t seed, bool deliverCurves) {
         inFlight.emplace_back(step + static_cast<int>(unit(random) * 4.0), std::move(r));
       }
     }
-    for (std::uint64_t wire : core->takeCancellations()) {
-      inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
-                                    [&](const auto& f) { return wireIdOf(f.second) == wire; }),
-                     inFlight.end());
-    }
-    std::vector<OutgoingRequest> due;
-    for (auto it = inFlight.begin(); it != inFlight.end();) {
-      if (it->first <= step) {
-        due.push_back(std::move(it->second));
-        it = inFlight.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    answer(*core, fake, due);
+    answerDue(*core, fake, inFlight, step);
     PoseOutcome outcome = core->finishPose();
     ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
     ASSERT_LE(outcome.row.predictedTriangles, budget * (1.0 + 1e-9)) << "step " << step;

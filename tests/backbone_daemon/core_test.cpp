@@ -391,7 +391,7 @@ void flyAndCheckCap(double inflation, std::uint64_t seed) {
   FrontendModel frontend;
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::deque<std::pair<int, OutgoingRequest>> inFlight;  // (due pose, request)
+  InFlightRequests inFlight;
   glm::dvec3 position(2.0, 1.1, 3.4);
   glm::dvec3 velocity(0.0);
   const double dt = 0.25;
@@ -407,21 +407,7 @@ void flyAndCheckCap(double inflation, std::uint64_t seed) {
     ASSERT_TRUE(core->beginPose(poseAt(step, step * dt, glm::vec3(position), target)).ok());
     for (OutgoingRequest& r : submitAll(*core))
       inFlight.emplace_back(step + static_cast<int>(unit(random) * 4.0), std::move(r));
-    for (std::uint64_t wire : core->takeCancellations()) {
-      inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
-                                    [&](const auto& f) { return wireIdOf(f.second) == wire; }),
-                     inFlight.end());
-    }
-    std::vector<OutgoingRequest> due;
-    for (auto it = inFlight.begin(); it != inFlight.end();) {
-      if (it->first <= step) {
-        due.push_back(std::move(it->second));
-        it = inFlight.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    answer(*core, fake, due);
+    answerDue(*core, fake, inFlight, step);
     PoseOutcome outcome = core->finishPose();
     ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
     frontend.apply(outcome.update);

@@ -8,12 +8,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <glm/geometric.hpp>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "backbone_core.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/scene/scene_parser.h"
 
@@ -86,7 +88,16 @@ class FakeSimplifier {
     protocol::ImpostorResult result;
     result.requestId = request.requestId;
     result.objectIds = request.objectIds;
-    const scene::SceneObject& o = object(request.objectIds.at(0));
+    // The reference sphere of a group is enclosingSphere of its objects'
+    // world spheres (relative_accuracy.h), its box their union.
+    std::vector<BoundingSphere> spheres;
+    Bounds box;
+    for (std::uint64_t id : request.objectIds) {
+      spheres.push_back(object(id).worldSphere);
+      box.extend(object(id).worldBounds.min);
+      box.extend(object(id).worldBounds.max);
+    }
+    const BoundingSphere sphere = enclosingSphere(spheres);
     protocol::Representation& rep = result.representation;
     rep.kind = request.kind;
     rep.triangleCount = request.kind == protocol::RepresentationKind::kSimpleImpostor ? 2 : 48;
@@ -98,13 +109,13 @@ class FakeSimplifier {
     // size / 2.8 of the world box diagonal, in the reference length L = 2r
     // (relative_accuracy.h) as the real simplifier reports it.
     rep.accuracy = double(request.textureWidth) / 2.8 *
-                   (2.0 * double(o.worldSphere.radius) / double(o.worldBounds.diagonal()));
+                   (2.0 * double(sphere.radius) / double(box.diagonal()));
     // Parallax: a viewer at distance D turned by phi sees an error of about
     // diameter * sin(phi) / D.
-    const glm::vec3 center = o.worldSphere.center;
+    const glm::vec3 center = sphere.center;
     const glm::vec3 toEye = request.eye - center;
     const float distance = glm::length(toEye);
-    const double diameter = 2.0 * o.worldSphere.radius;
+    const double diameter = 2.0 * sphere.radius;
     const double sine = std::min(1.0, request.accuracyBound * distance / diameter);
     rep.validity.center = center;
     rep.validity.distanceMin = 0.5f * distance;
@@ -143,6 +154,29 @@ inline void answer(BackboneCore& core, const FakeSimplifier& fake,
       EXPECT_TRUE(core.onImpostorResult(fake.impostor(wire)).ok());
     }
   }
+}
+
+// Requests on their way to a simulated simplifier: (due pose, request).
+using InFlightRequests = std::deque<std::pair<int, OutgoingRequest>>;
+
+// Drops the requests the core cancelled, then answers those due by `step`.
+inline void answerDue(BackboneCore& core, const FakeSimplifier& fake, InFlightRequests& inFlight,
+                      int step) {
+  for (std::uint64_t wire : core.takeCancellations()) {
+    inFlight.erase(std::remove_if(inFlight.begin(), inFlight.end(),
+                                  [&](const auto& f) { return wireIdOf(f.second) == wire; }),
+                   inFlight.end());
+  }
+  std::vector<OutgoingRequest> due;
+  for (auto it = inFlight.begin(); it != inFlight.end();) {
+    if (it->first <= step) {
+      due.push_back(std::move(it->second));
+      it = inFlight.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  answer(core, fake, due);
 }
 
 inline protocol::ViewerPose poseAt(std::uint64_t sequence, double seconds, glm::vec3 position,

@@ -64,6 +64,63 @@ TEST(ImpostorFraming, RejectsViewpointInsideAndBadInput) {
             ErrorCode::kInvalidArgument);
 }
 
+// Paper Figure 9, autocenter FALSE: the quad is centred where the fixed
+// centre projects and still covers every point (it grows, symmetric).
+TEST(ImpostorFraming, AFixedCentreCentresTheQuadAndStillCoversThePoints) {
+  std::mt19937 rng(11);
+  const auto points = randomBall(rng, 300, 1.0f);
+  const glm::vec3 eye(0.0f, 0.0f, 10.0f);
+  auto automatic = frameImpostor(points, eye, ImpostorOptions());
+  ImpostorOptions fixed;
+  fixed.fixedCenter = glm::vec3(0.6f, -0.3f, 0.0f);
+  auto framing = frameImpostor(points, eye, fixed);
+  ASSERT_TRUE(automatic.ok() && framing.ok()) << framing.status().toString();
+  const ImpostorQuad& q = framing->quad;
+  // The quad centre lies on the ray from the eye through the fixed centre.
+  const glm::vec3 ray = glm::normalize(*fixed.fixedCenter - eye);
+  EXPECT_NEAR(glm::length(glm::cross(glm::normalize(q.center - eye), ray)), 0.0f, 1e-5f);
+  EXPECT_GT(q.width, automatic->quad.width);
+  EXPECT_EQ(framing->clippedExtent, 0.0f);
+  for (const glm::vec3& p : points) {
+    const glm::vec3 local = drawnAt(*framing, p) - q.center;
+    EXPECT_LE(std::fabs(glm::dot(local, q.right)), 0.5f * q.width + 1e-4f);
+    EXPECT_LE(std::fabs(glm::dot(local, q.up)), 0.5f * q.height + 1e-4f);
+  }
+}
+
+// autosize FALSE: the quad has the fixed size; what does not fit is reported
+// (a quad larger than the objects clips nothing).
+TEST(ImpostorFraming, AFixedSizeIsTheQuadsSizeAndReportsWhatItCutsOff) {
+  std::mt19937 rng(12);
+  const auto points = randomBall(rng, 300, 1.0f);
+  const glm::vec3 eye(0.0f, 0.0f, 10.0f);
+  auto automatic = frameImpostor(points, eye, ImpostorOptions());
+  ASSERT_TRUE(automatic.ok());
+  ImpostorOptions small;
+  small.fixedSize = glm::vec2(1.0f, 0.5f);
+  auto framing = frameImpostor(points, eye, small);
+  ASSERT_TRUE(framing.ok()) << framing.status().toString();
+  // Padding grows the quad by one texel each side of 256.
+  const float grow = 256.0f / 254.0f;
+  EXPECT_NEAR(framing->quad.width, 1.0f * grow, 1e-4f);
+  EXPECT_NEAR(framing->quad.height, 0.5f * grow, 1e-4f);
+  // The ball's half extent on the plane is about 1 m: 0.75 m cut off vertically.
+  const float halfHeight = 0.5f * automatic->quad.height / grow;
+  EXPECT_NEAR(framing->clippedExtent, halfHeight - 0.25f, 1e-4f);
+  ImpostorOptions large;
+  large.fixedSize = glm::vec2(5.0f, 5.0f);
+  auto roomy = frameImpostor(points, eye, large);
+  ASSERT_TRUE(roomy.ok());
+  EXPECT_EQ(roomy->clippedExtent, 0.0f);
+  EXPECT_NEAR(roomy->quad.width, 5.0f * grow, 1e-3f);
+  ImpostorOptions bad;
+  bad.fixedSize = glm::vec2(std::nanf(""), 1.0f);
+  EXPECT_EQ(frameImpostor(points, eye, bad).status().code(), ErrorCode::kInvalidArgument);
+  ImpostorOptions behind;
+  behind.fixedCenter = glm::vec3(0.0f, 0.0f, 20.0f);
+  EXPECT_EQ(frameImpostor(points, eye, behind).status().code(), ErrorCode::kInvalidArgument);
+}
+
 TEST(ImpostorFraming, LookingAlongUpStillFrames) {
   const std::vector<glm::vec3> cube = {{-1, -1, -1}, {1, 1, 1}};
   auto framing = frameImpostor(cube, glm::vec3(0, 20, 0), {});

@@ -1,6 +1,7 @@
 // SimplifierService: ImpostorRequests on the paper room (offscreen GL).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 
@@ -105,6 +106,44 @@ TEST(SimplifierServiceImpostor, SimpleImpostorOfTheCow) {
   // About (cow size) / (2 texels): the quad is ~0.8 m over 128 texels.
   EXPECT_GT(rep.accuracy, 30.0);
   EXPECT_LT(rep.accuracy, 128.0);
+}
+
+// An imposter node's fixed size (paper Figure 9, autosize FALSE): the quad
+// has that size; one that cuts the cow off credits the cut (a lower
+// accuracy), one larger than the cow spreads it over fewer texels.
+TEST(SimplifierServiceImpostor, AFixedFrameSizesTheQuadAndCreditsWhatItCutsOff) {
+  SimplifierService service(withDefaultScene());
+  const protocol::ImpostorRequest automatic =
+      impostorOf(kCow, protocol::RepresentationKind::kSimpleImpostor);
+  protocol::ImpostorRequest small = automatic;
+  small.frameWidth = 0.4f;
+  small.frameHeight = 0.25f;
+  protocol::ImpostorRequest large = automatic;
+  large.frameCenter = glm::vec3(2.06f, 0.25f, 0.55f);
+  large.frameWidth = 2.0f;
+  large.frameHeight = 2.0f;
+  const protocol::ImpostorResult a = service.renderImpostor(automatic);
+  const protocol::ImpostorResult s = service.renderImpostor(small);
+  const protocol::ImpostorResult l = service.renderImpostor(large);
+  ASSERT_TRUE(a.status.ok() && s.status.ok() && l.status.ok())
+      << s.status.toString() << l.status.toString();
+  auto width = [](const protocol::Representation& rep) {
+    const IndexedMesh quad = decode(rep.mesh);
+    float lo = 1e9f, hi = -1e9f;
+    for (const glm::vec3& p : quad.positions) {
+      lo = std::min(lo, p.x);
+      hi = std::max(hi, p.x);
+    }
+    return hi - lo;  // the cow is seen from +z: the quad's width lies along x
+  };
+  EXPECT_NEAR(width(s.representation), 0.4f, 0.02f);
+  EXPECT_NEAR(width(l.representation), 2.0f, 0.05f);
+  // Cut off: about (0.8 - 0.4) / 2 m of the cow is missing from each side.
+  EXPECT_LT(s.representation.accuracy, 0.5 * a.representation.accuracy);
+  // Larger than the cow: no cut, coarser texels.
+  EXPECT_LT(l.representation.accuracy, a.representation.accuracy);
+  EXPECT_GT(l.representation.accuracy, 0.1 * a.representation.accuracy);
+  EXPECT_LT(coverage(l.representation.texture), coverage(a.representation.texture));
 }
 
 // The daemon renders the cow from a coarser level (impostor_level.h): the

@@ -221,8 +221,10 @@ Status BackboneCore::initialize() {
     backbone::SceneObject& object = scene_.objects[k];
     object.firstOption = static_cast<std::uint32_t>(scene_.options.size());
 
-    // Simplified mesh.
-    {
+    // Simplified mesh (unless the scene's imposter nodes leave only impostors:
+    // a cluster of several objects, an LOD level of one kind; docs/backbone.md
+    // "Imposter nodes").
+    if (record.mesh.offered) {
       OptionState state;
       state.object = k;
       state.wireKind = protocol::RepresentationKind::kMesh;
@@ -247,6 +249,7 @@ Status BackboneCore::initialize() {
         state.estimatedCurve = true;
         queueStartupRequest(k, static_cast<std::uint32_t>(scene_.options.size()), false);
       }
+      if (record.mesh.range) option.validity = *record.mesh.range;
       scene_.options.push_back(std::move(option));
       optionStates_.push_back(std::move(state));
       rebuildCurves(static_cast<std::uint32_t>(scene_.options.size() - 1));
@@ -254,7 +257,7 @@ Status BackboneCore::initialize() {
 
     // Hybrid (behind CoreOptions::hybridKappa): like the simplified mesh, in
     // primitive units, exact full mesh until its own curve arrives.
-    if (options_.hybridKappa > 0.0 && !record.primitive) {
+    if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered) {
       OptionState state;
       state.object = k;
       state.wireKind = protocol::RepresentationKind::kHybrid;
@@ -268,12 +271,21 @@ Status BackboneCore::initialize() {
       queueStartupRequest(k, index, false);
     }
 
-    // Impostors: usable from `radii` bounding radii on, every direction.
+    // Impostors: usable from `radii` bounding radii on, every direction; a
+    // kind the scene names in an LOD level with a range: in that range; one
+    // an imposter node names: even when `radii` switches the default off
+    // (then everywhere: its copies' own validity cones still bound them).
     auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind, double radii,
-                           double triangles) -> Status {
-      if (!(radii > 0.0)) return Status();
-      Result<ConicRange> validity = ConicRange::make(
-          record.bounds.center, radii * record.bounds.radius, kInf, {0.0, 0.0, 1.0}, kPi);
+                           double triangles, const KindOffer& offer) -> Status {
+      if (!offer.offered) return Status();
+      if (!(radii > 0.0) && !offer.explicitNode) return Status();
+      Result<ConicRange> validity = ConicRange();
+      if (offer.range) {
+        validity = *offer.range;
+      } else if (radii > 0.0) {
+        validity = ConicRange::make(record.bounds.center, radii * record.bounds.radius, kInf,
+                                    {0.0, 0.0, 1.0}, kPi);
+      }
       if (!validity.ok()) return validity.status();
       OptionState state;
       state.object = k;
@@ -295,15 +307,26 @@ Status BackboneCore::initialize() {
     };
     THINLOD_RETURN_IF_ERROR(
         addImpostor(OptionKind::kMeshedImpostor, protocol::RepresentationKind::kMeshedImpostor,
-                    options_.meshedImpostorRadii, options_.meshedImpostorTriangles));
+                    options_.meshedImpostorRadii, options_.meshedImpostorTriangles,
+                    record.meshedImpostor));
     THINLOD_RETURN_IF_ERROR(addImpostor(OptionKind::kSimpleImpostor,
                                         protocol::RepresentationKind::kSimpleImpostor,
-                                        options_.simpleImpostorRadii, 2.0));
+                                        options_.simpleImpostorRadii, 2.0, record.simpleImpostor));
     object.optionCount = static_cast<std::uint32_t>(scene_.options.size()) - object.firstOption;
+    if (object.optionCount == 0)
+      return invalid("object " + idText(record.id) +
+                     ": the scene and the options leave it no representation kind");
   }
   // ImpostorRequests carry no scene path: the simplifier renders from the
   // scene it loaded last. Without a mesh curve request, make it load ours.
-  if (ledger_.openCount() == 0 && !scene_.objects.empty()) queueStartupRequest(0, 0, true);
+  if (ledger_.openCount() == 0 && !scene_.objects.empty()) {
+    // The warm-up names a scene object (a cluster's id is the backbone's).
+    for (std::uint32_t k = 0; k < count; ++k) {
+      if (converted_.records[k].cluster) continue;
+      queueStartupRequest(k, 0, true);
+      break;
+    }
+  }
   backbone::updateSubtreeVersions(scene_);
   dirty_ = false;
   return backbone::validateScene(scene_);
@@ -503,7 +526,7 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     request.requestedAccuracy = absolute * record.diameter / distance;
     protocol::ImpostorRequest impostor;
     impostor.sceneFingerprint = sceneGraph_.fingerprint;
-    impostor.objectIds = {record.id};
+    impostor.objectIds = record.members;
     impostor.eye = glm::vec3(r.viewRegion.center);
     impostor.orientation = pose_.orientation;
     impostor.fovY = pose_.fovY;
@@ -512,6 +535,11 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
     impostor.kind = state.wireKind;
     impostor.accuracyBound = std::clamp(1.0 / absolute, 1e-7, 1.0);
     impostor.textureCodec = options_.textureCodec;
+    const KindOffer& offer =
+        option.kind == OptionKind::kSimpleImpostor ? record.simpleImpostor : record.meshedImpostor;
+    impostor.frameCenter = offer.frameCenter;
+    impostor.frameWidth = offer.frameSize.x;
+    impostor.frameHeight = offer.frameSize.y;
     message = std::move(impostor);
   }
   // The scheduler asks again for an option whose request is open (the same
@@ -664,7 +692,7 @@ Status BackboneCore::useImpostorResult(const LedgerRequest& request,
   const std::string where =
       "ImpostorResult " + idText(result.requestId) + " (object " + idText(record.id) + ")";
   if (!request.impostor) return invalid(where + ": answers a SimplifyRequest");
-  if (result.objectIds.size() != 1 || result.objectIds[0] != record.id)
+  if (result.objectIds != record.members)
     return invalid(where + ": object ids do not match the request");
   if (!result.status.ok())
     return Status(result.status.code(), where + ": simplifier error: " + result.status.message());

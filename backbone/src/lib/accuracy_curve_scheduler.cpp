@@ -114,9 +114,34 @@ Result<Selection> AccuracyCurveMethod::select(const SelectionStep& step) const {
   // budget goes where the image gains most; no leaf drops below its need. A
   // fixed accuracy spends only what it needs. After the hysteresis pass, which
   // would otherwise swap the fill's upgrades back to cheaper displayed copies.
-  if (config.fillBudget && !budget.fixedAccuracy)
-    stats.budgetFillUpgrades +=
-        fillRemainingBudget(scene, config, step.viewer, region, state, hard, selections).upgraded;
+  if (config.fillBudget && !budget.fixedAccuracy) {
+    stats.trianglesBeforeFill = renderedCost(selections).triangles;
+    // Each round starts from the picks the previous one raised (a round
+    // lifts a leaf at most kMaxFillRungs rungs); a leaf raised in several
+    // rounds counts once.
+    struct Pick {
+      std::int32_t option;
+      std::uint64_t copy;
+      double triangles;
+    };
+    std::vector<Pick> before;
+    before.reserve(selections.size());
+    for (const LeafSelection& s : selections)
+      before.push_back({s.rendered ? std::int32_t(s.candidate.option) : -1, s.candidate.copyId,
+                        s.cost.triangles});
+    for (int round = 0; round < config.fillRounds; ++round) {
+      if (fillRemainingBudget(scene, config, step.viewer, region, state, hard, selections)
+              .upgraded == 0)
+        break;
+    }
+    for (std::size_t i = 0; i < selections.size(); ++i) {
+      const LeafSelection& s = selections[i];
+      const std::int32_t option = s.rendered ? std::int32_t(s.candidate.option) : -1;
+      if (option != before[i].option || s.candidate.copyId != before[i].copy ||
+          s.cost.triangles != before[i].triangles)
+        ++stats.budgetFillUpgrades;
+    }
+  }
   state.stepCandidates.reset();  // valid for this step's selections only
   state.previousTarget = target;
   state.lastSelectionCount = selections.size();

@@ -45,6 +45,8 @@ SchedulerConfig withoutApproximations(SchedulerConfig c) {
 
 Status validateConfig(const SchedulerConfig& c) {
   const char* o = "SchedulerConfig";
+  if (c.fillRounds < 1 || c.fillRounds > 16)
+    return invalidField(o, "fillRounds", "must be in 1..16");
   auto nonNegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!nonNegative(c.maxSpeed)) return invalidField(o, "maxSpeed", "must be finite and >= 0");
   if (!nonNegative(c.maxAngularSpeed))

@@ -151,10 +151,12 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Impos
   auto ids = idsOrNull(b, m.objectIds);
   const w::Vec3 eye = toWire(m.eye);
   const w::Quat orientation = toWire(m.orientation);
+  const w::Vec3 frameCenter = toWire(m.frameCenter.value_or(glm::vec3(0.0f)));
   auto t = w::CreateImpostorRequest(b, m.requestId, ids, &eye, &orientation, m.fovY, m.textureWidth,
                                     m.textureHeight, static_cast<w::RepresentationKind>(m.kind),
                                     m.accuracyBound, static_cast<w::TextureCodec>(m.textureCodec),
-                                    m.sceneFingerprint);
+                                    m.sceneFingerprint, m.frameCenter ? &frameCenter : nullptr,
+                                    m.frameWidth, m.frameHeight);
   return {w::Body::ImpostorRequest, t.Union()};
 }
 
@@ -471,6 +473,9 @@ Result<Message> fromWire(const FieldPath& path, const w::ImpostorRequest* m) {
   out.accuracyBound = m->accuracy_bound();
   out.textureCodec = static_cast<TextureCodec>(m->texture_codec());
   out.sceneFingerprint = m->scene_fingerprint();
+  if (m->frame_center() != nullptr) out.frameCenter = fromWire(*m->frame_center());
+  out.frameWidth = m->frame_width();
+  out.frameHeight = m->frame_height();
   return Message(std::move(out));
 }
 

@@ -110,7 +110,8 @@ bool operator==(const ImpostorRequest& a, const ImpostorRequest& b) {
          a.orientation == b.orientation && a.fovY == b.fovY && a.textureWidth == b.textureWidth &&
          a.textureHeight == b.textureHeight && a.kind == b.kind &&
          a.accuracyBound == b.accuracyBound && a.textureCodec == b.textureCodec &&
-         a.sceneFingerprint == b.sceneFingerprint;
+         a.sceneFingerprint == b.sceneFingerprint && a.frameCenter == b.frameCenter &&
+         a.frameWidth == b.frameWidth && a.frameHeight == b.frameHeight;
 }
 bool operator==(const ImpostorResult& a, const ImpostorResult& b) {
   return a.requestId == b.requestId && a.objectIds == b.objectIds &&

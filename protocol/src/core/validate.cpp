@@ -415,6 +415,12 @@ Status check(const FieldPath& path, const ImpostorRequest& m) {
   if (!validCodec(m.textureCodec) || m.textureCodec == TextureCodec::kNone) {
     return invalidField(path.child("texture_codec"), "must be a known codec other than None");
   }
+  if (m.frameCenter) THINLOD_RETURN_IF_ERROR(checkVec3(path.child("frame_center"), *m.frameCenter));
+  if (!std::isfinite(m.frameWidth) || !std::isfinite(m.frameHeight) || m.frameWidth < 0.0f ||
+      m.frameHeight < 0.0f || ((m.frameWidth > 0.0f) != (m.frameHeight > 0.0f))) {
+    return invalidField(path.child("frame_size"),
+                        "must be two finite positive sizes or 0 0 (framed from the objects)");
+  }
   return Status();
 }
 

@@ -127,6 +127,46 @@ Result<ImpostorFraming> frameImpostor(const std::vector<glm::vec3>& points,
     y0 = mid - 0.5f * minExtent;
     y1 = mid + 0.5f * minExtent;
   }
+  // A fixed frame (paper Figure 9, autocenter / autosize FALSE): the centre
+  // projected onto the plane; with it alone the half extents reach the
+  // farthest point from it, with a fixed size they are the size's halves.
+  if (options.fixedCenter || options.fixedSize.x > 0.0f || options.fixedSize.y > 0.0f) {
+    if (options.fixedCenter && !finite(*options.fixedCenter)) {
+      return Status(ErrorCode::kInvalidArgument, "impostor: fixed centre is not finite");
+    }
+    if (!(options.fixedSize.x >= 0.0f) || !(options.fixedSize.y >= 0.0f) ||
+        !std::isfinite(options.fixedSize.x) || !std::isfinite(options.fixedSize.y)) {
+      return Status(ErrorCode::kInvalidArgument, "impostor: fixed size must be finite, >= 0");
+    }
+    float cx = 0.5f * (x0 + x1);
+    float cy = 0.5f * (y0 + y1);
+    if (options.fixedCenter) {
+      const glm::vec3 d = *options.fixedCenter - viewpoint;
+      const float along = glm::dot(d, f.forward);
+      if (!(along > 0.0f)) {
+        return Status(ErrorCode::kInvalidArgument,
+                      "impostor: fixed centre is behind the viewpoint");
+      }
+      const float scale = f.planeDistance / along;
+      cx = glm::dot(d, right) * scale;
+      cy = glm::dot(d, imageUp) * scale;
+    }
+    float hx = std::max(cx - x0, x1 - cx);
+    float hy = std::max(cy - y0, y1 - cy);
+    float clipped = 0.0f;
+    if (options.fixedSize.x > 0.0f && options.fixedSize.y > 0.0f) {
+      const float fx = 0.5f * options.fixedSize.x;
+      const float fy = 0.5f * options.fixedSize.y;
+      clipped = std::max(0.0f, std::max(hx - fx, hy - fy));
+      hx = fx;
+      hy = fy;
+    }
+    f.clippedExtent = clipped;
+    x0 = cx - hx;
+    x1 = cx + hx;
+    y0 = cy - hy;
+    y1 = cy + hy;
+  }
   // Padding: p empty pixels each side of N means the object spans N - 2p pixels.
   const float grow =
       static_cast<float>(size) / (static_cast<float>(size) - 2.0f * options.paddingPixels);

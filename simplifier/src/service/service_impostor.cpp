@@ -160,6 +160,8 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   base.textureSize = static_cast<int>(size);
   base.maxAngularError = request.accuracyBound;
   base.up = request.orientation * glm::vec3(0.0f, 1.0f, 0.0f);
+  base.fixedCenter = request.frameCenter;
+  base.fixedSize = glm::vec2(request.frameWidth, request.frameHeight);
   std::vector<glm::vec3> points;
   std::vector<BoundingSphere> spheres;
   for (const scene::SceneObject* object : objects) {
@@ -308,7 +310,10 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   // lost leg is that far from the nearest texel still shown).
   const BoundingSphere reference = enclosingSphere(spheres);
   const double length = referenceLength(reference);
-  const double textureError = (2.0 + lossTexels) * texel + levelError;
+  // A fixed frame that cuts part of the objects off (paper Figure 9, autosize
+  // FALSE): a point outside the image is about that far from its edge.
+  const double textureError =
+      (2.0 + lossTexels) * texel + levelError + double(rendered.clippedExtent);
   if (!options.impostorGuaranteeCredit) {
     representation.accuracy = length / textureError;  // parallax not in the credit
     return representation;

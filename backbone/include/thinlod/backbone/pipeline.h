@@ -86,6 +86,10 @@ struct SchedulerConfig {
   // Accuracy-curve method: after the uniform target, spend the rest of the
   // hard budget where the image gains most (docs/scheduling.md "Budget fill").
   bool fillBudget = true;
+  // A fill round raises a leaf at most kMaxFillRungs rungs of its ladder
+  // (about 3.2x its triangles); further rounds start from the raised picks
+  // while the previous one moved something, up to this many (1..16).
+  int fillRounds = 3;
 };
 
 Status validateConfig(const SchedulerConfig& config);

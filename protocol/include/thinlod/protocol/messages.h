@@ -227,6 +227,13 @@ struct ImpostorRequest {
   // The backbone's scene fingerprint: the worker renders from the loaded
   // scene with this fingerprint (0: the scene it loaded last).
   std::uint64_t sceneFingerprint = 0;
+  // An imposter node with autocenter / autosize FALSE (Pasman & Jansen 2002,
+  // Figure 9): the quad's fixed centre (world; unset: framed from the
+  // objects) and its fixed width and height (world metres, both > 0, or both
+  // 0: framed from the objects). What falls outside is not in the image.
+  std::optional<glm::vec3> frameCenter;
+  float frameWidth = 0.0f;
+  float frameHeight = 0.0f;
 };
 
 struct ImpostorResult {

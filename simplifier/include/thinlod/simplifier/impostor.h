@@ -28,9 +28,11 @@
 
 #include <cstddef>
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <memory>
 #include <unordered_map>
+#include <optional>
 #include <vector>
 
 #include "thinlod/common/core/conic_range.h"
@@ -64,6 +66,15 @@ struct ImpostorOptions {
   // of their covered neighbours (alpha stays 0), so bilinear filtering at the
   // silhouette does not darken it towards the black background.
   int bleedPixels = 2;
+  // An imposter node with autocenter / autosize FALSE (Pasman & Jansen 2002,
+  // Figure 9): the quad's centre is `fixedCenter` (projected onto the quad
+  // plane along the view ray) and / or its width x height is `fixedSize`
+  // (metres in the quad plane; 0 0: from the points). The quad still faces
+  // the viewpoint. Points outside the fixed quad are not in the image
+  // ("If the imposter is too small, the image will hold only part of the
+  // objects it replaces"); ImpostorFraming::clippedExtent says how much.
+  std::optional<glm::vec3> fixedCenter;
+  glm::vec2 fixedSize{0.0f};
 };
 
 struct MeshedImpostorOptions : ImpostorOptions {
@@ -97,6 +108,10 @@ struct ImpostorFraming {
   int textureSize = 0;
   render::Camera camera;  // off-axis perspective camera that rendered the texture
   ImpostorQuad quad;
+  // A fixed frame (ImpostorOptions::fixedCenter / fixedSize) that cuts points
+  // off: the largest distance (metres in the quad plane) by which a point's
+  // projection lies outside the quad; 0 when everything is inside.
+  float clippedExtent = 0.0f;
 };
 
 // Frames `points` (object space) for a capture from `viewpoint`.
