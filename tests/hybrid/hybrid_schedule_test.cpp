@@ -116,7 +116,8 @@ Status serve(BackboneCore& core, simplifier::SimplifierService& service, double 
 struct RunResult {
   std::size_t hybridsShown = 0;  // objects shown as hybrids in the last update's state
   std::size_t meshesShown = 0;
-  double maxFrontendUnits = 0.0;
+  double maxFrontendUnits = 0.0;  // the core's count after each update
+  double maxHeldUnits = 0.0;      // summed from the operations sent
   double lastPlanAccuracy = 0.0;
 };
 
@@ -148,8 +149,10 @@ RunResult runRow(double budget, double kappa) {
   EXPECT_TRUE(status.ok()) << status.toString();
   EXPECT_EQ(core.curvesPending(), 0u);
 
-  // objectId -> kind the frontend holds (from the updates' operations).
+  // objectId -> kind and primitive units the frontend holds (from the
+  // updates' operations alone, not from the core's own count).
   std::map<std::uint64_t, protocol::RepresentationKind> held;
+  std::map<std::uint64_t, double> heldUnits;
   for (std::uint64_t step = 0; step < 4; ++step) {
     EXPECT_TRUE(core.beginPose(poseLookingDownZ(step)).ok());
     status = serve(core, service, kappa, served);
@@ -159,13 +162,22 @@ RunResult runRow(double budget, double kappa) {
     for (const auto& op : outcome.update.operations) {
       if (op.type == protocol::SceneOperation::Type::kAddOrReplace) {
         held[op.objectId] = op.representation.kind;
+        heldUnits[op.objectId] =
+            op.representation.triangleCount +
+            (op.representation.kind == protocol::RepresentationKind::kHybrid
+                 ? op.representation.pointCount / kappa
+                 : 0.0);
         if (op.representation.kind == protocol::RepresentationKind::kHybrid) {
           EXPECT_GT(op.representation.pointCount + op.representation.triangleCount, 0u);
         }
       } else if (op.type == protocol::SceneOperation::Type::kRemove) {
         held.erase(op.objectId);
+        heldUnits.erase(op.objectId);
       }
     }
+    double units = 0.0;
+    for (const auto& [id, u] : heldUnits) units += u;
+    out.maxHeldUnits = std::max(out.maxHeldUnits, units);
     out.maxFrontendUnits = std::max(out.maxFrontendUnits, outcome.frontendTriangles);
     out.lastPlanAccuracy = outcome.row.targetAccuracy;
   }
@@ -185,15 +197,18 @@ TEST(HybridSchedule, CoarseBudgetOnTheMultiManifoldRowPicksHybridsWithinTheBudge
   const RunResult hybrid = runRow(kBudget, kKappa);
   EXPECT_GT(hybrid.hybridsShown, 0u) << "the scheduler chose no hybrid";
   EXPECT_LE(hybrid.maxFrontendUnits, kBudget + 1e-6);
+  EXPECT_LE(hybrid.maxHeldUnits, kBudget + 1e-6);
+  EXPECT_GT(hybrid.maxHeldUnits, 0.5 * kBudget) << "the budget is used, not avoided";
   // The same row without hybrids reaches a lower planned accuracy.
   const RunResult meshes = runRow(kBudget, 0.0);
-  std::printf("hybrid run: %zu hybrids, %zu meshes shown, max units %.1f, accuracy %.2f; mesh run: "
-              "%zu meshes, max units %.1f, accuracy %.2f\n",
+  std::printf("hybrid run: %zu hybrids, %zu meshes shown, max units %.1f (held %.1f), accuracy "
+              "%.2f; mesh run: %zu meshes, max units %.1f, accuracy %.2f\n",
               hybrid.hybridsShown, hybrid.meshesShown, hybrid.maxFrontendUnits,
-              hybrid.lastPlanAccuracy, meshes.meshesShown, meshes.maxFrontendUnits,
-              meshes.lastPlanAccuracy);
+              hybrid.maxHeldUnits, hybrid.lastPlanAccuracy, meshes.meshesShown,
+              meshes.maxFrontendUnits, meshes.lastPlanAccuracy);
   EXPECT_EQ(meshes.hybridsShown, 0u);
   EXPECT_LE(meshes.maxFrontendUnits, kBudget + 1e-6);
+  EXPECT_LE(meshes.maxHeldUnits, kBudget + 1e-6);
   EXPECT_GT(hybrid.lastPlanAccuracy, meshes.lastPlanAccuracy);
 }
 
