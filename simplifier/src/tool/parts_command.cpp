@@ -1,6 +1,7 @@
 // parts: writes the generated multi-manifold model of the hybrid experiments
 // (generateScatteredParts: separate closed bumpy icospheres in a unit box) to
-// a mesh file, so scenes (the workbench's parts-fly case) can name it.
+// a mesh file, so scenes (the workbench's parts-fly case) can name it;
+// positions only (no per-part colours, see below).
 #include <CLI/CLI.hpp>
 #include <memory>
 #include <string>
@@ -28,7 +29,11 @@ void runParts(const PartsArgs& args) {
                 args.output + ": unknown mesh file extension (expected obj, ply, off, stl)"),
          false);
   }
-  const IndexedMesh mesh = generateScatteredParts(args.parts, args.level, args.seed);
+  IndexedMesh mesh = generateScatteredParts(args.parts, args.level, args.seed);
+  // Without the per-part colours: a scene colours the model with its
+  // Material, and the frontend's reference (full meshes) and its simplified
+  // copies would otherwise disagree on whether vertex colours apply.
+  mesh.colors.clear();
   const Status saved = saveMeshFile(mesh, args.output, true);
   if (!saved.ok()) fail(command, saved, false);
   progressLine(command, "wrote " + std::to_string(mesh.triangleCount()) + " triangles (" +
