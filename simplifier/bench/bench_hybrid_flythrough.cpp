@@ -10,8 +10,6 @@
 // Prints a markdown report (per-frame table and summary) to stdout.
 //   bench_hybrid_flythrough [--kappa K] [--tau T] [--frames N] [--instances N]
 //                           [--pixels P] [--backend egl|osmesa] [--size WxH]
-#include <time.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -34,12 +32,6 @@ using namespace thinlod;
 using namespace thinlod::simplifier;
 
 namespace {
-
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Instance {
   glm::dmat4 model{1.0};  // object -> world (rotation, uniform scale, translation)
@@ -179,17 +171,13 @@ int main(int argc, char** argv) {
 
   const IndexedMesh model = generateScatteredParts(parts, 2, 7);
   std::cerr << "building graphs of " << model.triangleCount() << " triangles\n";
-  double started = threadSeconds();
   HybridOptions hybridOptions;
   hybridOptions.kappa = kappa;
   hybridOptions.tau = tau;
   Result<HybridGraph> hybrid = buildHybridGraph(model, hybridOptions);
-  const double hybridSeconds = threadSeconds() - started;
-  started = threadSeconds();
   HybridOptions triangleOptions = hybridOptions;
   triangleOptions.enablePoints = false;
   Result<HybridGraph> trianglesOnly = buildHybridGraph(model, triangleOptions);
-  const double triangleSeconds = threadSeconds() - started;
   if (!hybrid.ok() || !trianglesOnly.ok()) {
     std::cerr << (hybrid.ok() ? trianglesOnly.status() : hybrid.status()).toString() << "\n";
     return 1;
@@ -233,10 +221,11 @@ int main(int argc, char** argv) {
   std::printf("### Fly-through: %d instances of scattered-%d (%zu triangles each), %d frames, "
               "%dx%d, fov 60 deg, %.3g-pixel tolerance, kappa %.3g, tau %.3g\n\n",
               instances, parts, model.triangleCount(), frames, width, height, pixels, kappa, tau);
-  std::printf("Graph build (thread CPU): hybrid %.2f s (%zu triangles, %zu points), triangles "
-              "only %.2f s (%zu triangles); renderer: %s %s\n\n",
-              hybridSeconds, hybrid->stats().graphTriangles, hybrid->stats().graphPoints,
-              triangleSeconds, trianglesOnly->stats().graphTriangles, backendName.c_str(),
+  // (Build times: bench_hybrid.)
+  std::printf("Graphs: hybrid %zu triangles, %zu points; triangles only %zu triangles; renderer: "
+              "%s %s\n\n",
+              hybrid->stats().graphTriangles, hybrid->stats().graphPoints,
+              trianglesOnly->stats().graphTriangles, backendName.c_str(),
               gl.context->rendererName().c_str());
   std::printf("| frame | in view | triangles-only units | hybrid triangles | hybrid points | "
               "hybrid units | reduction | full-res pixels | uncovered hybrid / tri-only | "
