@@ -8,11 +8,16 @@
                        (woody.obj, z = 0 for every vertex) and a 2 cm thin painting, primitives.
   city.wrl             a city grid: 1,024 buildings and 256 kiosks (1,280 Box instances, 8
                        DEF'd shapes USEd), 320 m across: culling and reuse matter.
+  parts-field.wrl      70 instances (one DEF'd Shape USEd) of the generated multi-manifold model
+                       of the hybrid experiments, scattered-parts-300.ply (300 separate closed
+                       parts, 96,000 triangles), which deploy/compare writes beside a copy of the
+                       scene with `thinlod-simplifier parts` (the case's "generate").
   paper-walk.trace     the paper's flight path through paper-room.wrl, 120 poses over 11.9 s
                        (0.1 s apart) instead of 72 s, so a live run takes 12 s.
   gallery-tour.trace   a walk down the hall at about 0.6 m/s, looking left and right, 12 s.
   gallery-fast.trace   a fast walk (1.3 m/s) with sudden turns (90-180 degrees in 0.2-0.3 s), 10 s.
   city-walk.trace      a walk along an avenue at 1.4 m/s with a turn at a crossing, 12 s.
+  parts-fly.trace      a flight into the parts field (the path of bench_hybrid_flythrough), 10 s.
 
 Model sizes are read from the model files in --models-dir (default ../shared/models), so the
 scale factors written into the scenes are exact; the scenes name the models by file name only
@@ -256,6 +261,52 @@ def write_city(path, seed=12):
     return count + kiosks
 
 
+PARTS_MODEL = "scattered-parts-300.ply"
+PARTS_PER_ROW, PARTS_SPACING = 10, 1.6
+
+
+def write_parts_field(path, count=70, seed=11):
+    """`count` instances of the generated multi-manifold model (a unit box) in rows of 10 along +x,
+    rows 1.6 apart along -z, random yaw and size 0.8-1.2: the layout of bench_hybrid_flythrough."""
+    rng = random.Random(seed)
+    lines = ["#VRML V2.0 utf8",
+             "# Workbench parts field (made by deploy/make-suite.py; do not edit by hand).",
+             f"# {count} instances of {PARTS_MODEL} (generateScatteredParts(300, 2, 7): 300 closed",
+             "# parts in a unit box), written beside a copy of this scene by deploy/compare.",
+             'Viewpoint { description "front" position -2 0.9 1.5 fieldOfView 1.047 }',
+             "DirectionalLight { direction 0.3 -1.0 -0.4 intensity 0.9 ambientIntensity 0.3 }"]
+    for i in range(count):
+        row, column = divmod(i, PARTS_PER_ROW)
+        scale = 0.8 + 0.4 * rng.random()
+        at = (PARTS_SPACING * column + 0.4 * (rng.random() - 0.5), 0.3 * (rng.random() - 0.5),
+              -PARTS_SPACING * row + 0.4 * (rng.random() - 0.5))
+        yaw = 2 * math.pi * rng.random()
+        shape = ("USE Parts" if i else
+                 f"DEF Parts Shape {{ {material((0.8, 0.6, 0.4))} "
+                 f"geometry Inline {{ url \"{PARTS_MODEL}\" }} }}")
+        lines.append(f"Transform {{ translation {fmt(*at)} rotation 0 1 0 {yaw:.6g} "
+                     f"scale {fmt(scale, scale, scale)}\n"
+                     f"  children Transform {{ translation -0.5 -0.5 -0.5 children {shape} }} }}")
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return count
+
+
+def parts_fly(count=70, frames=100, dt=0.1):
+    """bench_hybrid_flythrough's path: from the field's front-left corner, descending diagonally to
+    past its middle, always looking at its far corner."""
+    length = PARTS_SPACING * (min(count, PARTS_PER_ROW) - 1)
+    depth = PARTS_SPACING * ((count + PARTS_PER_ROW - 1) // PARTS_PER_ROW)
+    start, end = (-2.0, 1.2, 2.5), (0.7 * length, 0.5, -0.6 * depth)
+    poses = []
+    for k in range(frames):
+        u = k / (frames - 1)
+        eye = tuple(a + (b - a) * u for a, b in zip(start, end))
+        target = (length + 1.0, 0.0, -depth - 1.0 + 2.0 * math.sin(2 * math.pi * u))
+        poses.append((round(k * dt, 6), eye, target))
+    return poses
+
+
 def write_trace(path, title, poses, fov_deg):
     """poses: [(t, eye, target)]."""
     with open(path, "w") as f:
@@ -321,6 +372,7 @@ def main():
 
     objects = Gallery(args.models_dir).write(os.path.join(args.out, "gallery.wrl"))
     instances = write_city(os.path.join(args.out, "city.wrl"))
+    parts = write_parts_field(os.path.join(args.out, "parts-field.wrl"))
 
     # The paper's flight, same key frames and spline, 0.1 s per pose.
     spec = importlib.util.spec_from_file_location("paper", os.path.join(HERE, "make-paper-trace.py"))
@@ -356,7 +408,13 @@ def main():
     write_trace(os.path.join(args.out, "city-walk.trace"),
                 f"city walk at 1.4 m/s with a turn at a crossing, {len(city)} poses", city, 60)
 
-    print(f"make-suite: gallery {objects} objects, city {instances} instances; traces: "
+    fly = parts_fly(parts)
+    write_trace(os.path.join(args.out, "parts-fly.trace"),
+                f"flight into the parts field, {len(fly)} poses (max {max_speed(fly):.2f} m/s)",
+                fly, 60)
+
+    print(f"make-suite: gallery {objects} objects, city {instances} instances, parts field "
+          f"{parts} instances (parts-fly {len(fly)} poses, {max_speed(fly):.2f} m/s); traces: "
           f"paper-walk {len(walk)} ({max_speed(walk):.2f} m/s), gallery-tour {len(tour)} "
           f"({max_speed(tour):.2f} m/s), gallery-fast {len(fast)} ({max_speed(fast):.2f} m/s), "
           f"city-walk {len(city)} ({max_speed(city):.2f} m/s)")

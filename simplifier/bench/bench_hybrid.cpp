@@ -3,7 +3,9 @@
 // primitive units vs object-space error for kappa in {3, 10}, tau in {1, 5}
 // against triangles only, on the bunny and a generated multi-manifold model.
 // For every configuration the cut at each error is also measured
-// (measureHybridSurfaceError) so the table shows how tight the bounds are.
+// (measureHybridSurfaceError) so the table shows how tight the bounds are,
+// and every configuration's measured ladder (measureHybridLevels, what the
+// service's curves are made of) is set against the progressive mesh's.
 // Prints a markdown report to stdout; progress to stderr.
 //   bench_hybrid [--models-dir DIR] [--parts N] [--samples N]
 #include <time.h>
@@ -16,7 +18,10 @@
 #include <vector>
 
 #include "thinlod/common/mesh/mesh_io.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/simplifier/hybrid_graph.h"
+#include "thinlod/simplifier/mesh_curve.h"
+#include "thinlod/simplifier/progressive_mesh.h"
 
 using namespace thinlod;
 using namespace thinlod::simplifier;
@@ -155,6 +160,76 @@ int main(int argc, char** argv) {
         }
         std::printf(" %.3f / %.3f |", 100.0 * m->max() / diagonal,
                     100.0 * cut.errorBound() / diagonal);
+      }
+      std::printf("\n");
+    }
+    // The footing of the service's curves (docs/hybrid.md, "Measured
+    // curve"): every configuration's measured ladder, and the progressive
+    // mesh the scheduler offers beside it (its measured curve).
+    std::printf(
+        "\nPrimitive units to reach a *measured* error (%% of the diagonal): the fewest units "
+        "of a rung of the measured ladder (12 rungs, %zu samples per side) credited with at "
+        "most that error, a rung credited with the worst error measured at it or any finer "
+        "rung (the service's rule); last column the QEM progressive mesh's measured ladder "
+        "(the mesh option):\n\n| measured error %% |",
+        samples);
+    for (const Config& c : configs) std::printf(" %s |", c.name.c_str());
+    std::printf(" progressive mesh |\n|---|");
+    for (std::size_t i = 0; i <= configs.size(); ++i) std::printf("---|");
+    std::printf("\n");
+    // (units, credited error) per column, increasing units.
+    std::vector<std::vector<std::pair<double, double>>> ladders;
+    auto credit = [](std::vector<std::pair<double, double>> rungs) {
+      for (std::size_t i = rungs.size(); i-- > 1;)
+        rungs[i - 1].second = std::max(rungs[i - 1].second, rungs[i].second);
+      return rungs;
+    };
+    for (const HybridGraph& g : graphs) {
+      Result<std::vector<HybridMeasuredLevel>> levels = measureHybridLevels(model.mesh, g, 12, eo);
+      if (!levels.ok()) {
+        std::cerr << levels.status().toString() << "\n";
+        return 1;
+      }
+      std::vector<std::pair<double, double>> rungs;
+      for (const HybridMeasuredLevel& l : *levels) rungs.push_back({l.step.units, l.measuredError});
+      ladders.push_back(credit(rungs));
+    }
+    {
+      Result<ProgressiveMesh> pm = ProgressiveMesh::build(model.mesh);
+      if (!pm.ok()) {
+        std::cerr << pm.status().toString() << "\n";
+        return 1;
+      }
+      MeshCurveOptions mo;
+      mo.levels = 12;
+      mo.measureEncodedBytes = false;
+      mo.error = eo;
+      Result<MeshCurves> curves = measureMeshCurves(model.mesh, *pm, mo);
+      if (!curves.ok()) {
+        std::cerr << curves.status().toString() << "\n";
+        return 1;
+      }
+      std::vector<std::pair<double, double>> rungs;
+      for (const CurveLevel& l : curves->levels)
+        rungs.push_back({static_cast<double>(l.triangles),
+                         l.relativeMaxError * referenceLength(referenceSphere(model.mesh))});
+      ladders.push_back(credit(rungs));
+    }
+    for (double e : {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2}) {
+      std::printf("| %.1f |", 100.0 * e);
+      for (const auto& rungs : ladders) {
+        double units = -1.0;
+        for (const auto& [u, err] : rungs) {
+          if (err <= e * diagonal) {
+            units = u;
+            break;
+          }
+        }
+        if (units < 0.0) {
+          std::printf(" - |");
+        } else {
+          std::printf(" %.0f |", units);
+        }
       }
       std::printf("\n");
     }

@@ -331,6 +331,40 @@ TEST(HybridAccuracyCurve, IsConservativeAndMonotone) {
   EXPECT_EQ(hybridAccuracyCurve(*g, 0.0).status().code(), ErrorCode::kInvalidArgument);
 }
 
+// The measured ladder: increasing units ending at the input, each rung a
+// step of the graph's curve with its cut's own sampled error (measured again
+// here from scratch), never above the rung's stored bound.
+TEST(HybridMeasuredLevels, RungsAreStepsWithTheirCutsMeasuredError) {
+  const IndexedMesh parts = generateScatteredParts(30, 1, 8);
+  Result<HybridGraph> g = buildHybridGraph(parts, options(3.0, 1.0));
+  ASSERT_TRUE(g.ok());
+  SurfaceErrorOptions eo;
+  eo.samplesPerMesh = 5000;
+  Result<std::vector<HybridMeasuredLevel>> levels = measureHybridLevels(parts, *g, 6, eo);
+  ASSERT_TRUE(levels.ok()) << levels.status().toString();
+  ASSERT_GE(levels->size(), 3u);
+  EXPECT_LE(levels->size(), 7u) << "6 rungs and the input at most";
+  const std::vector<HybridCurveStep> steps = g->unitsVersusError();
+  EXPECT_EQ(levels->back().step.units, steps.front().units) << "the last rung is the input";
+  EXPECT_EQ(levels->front().step.units, steps.back().units) << "the first the coarsest cut";
+  HybridCut incremental(*g);  // adapted rung to rung, as measureHybridLevels does
+  for (std::size_t i = 0; i < levels->size(); ++i) {
+    const HybridMeasuredLevel& level = (*levels)[i];
+    if (i > 0) EXPECT_GT(level.step.units, (*levels)[i - 1].step.units);
+    HybridCut fresh(*g);
+    fresh.adaptToError(level.step.error);
+    incremental.adaptToError(level.step.error);
+    EXPECT_DOUBLE_EQ(fresh.units(), level.step.units);
+    EXPECT_EQ(cutSet(incremental), cutSet(fresh));
+    Result<SurfaceError> again = measureHybridSurfaceError(parts, incremental.triangleMesh(),
+                                                           incremental.pointList(), eo);
+    ASSERT_TRUE(again.ok());
+    EXPECT_DOUBLE_EQ(again->max(), level.measuredError);
+    EXPECT_LE(level.measuredError, fresh.errorBound() + 1e-6 * g->diagonal());
+  }
+  EXPECT_EQ(measureHybridLevels(parts, *g, 0, eo).status().code(), ErrorCode::kInvalidArgument);
+}
+
 // The verified bound: sampled Hausdorff of random cuts <= stored bound.
 void checkBoundsHold(const IndexedMesh& mesh, const HybridOptions& o, std::uint64_t seed,
                      int cuts) {

@@ -3,13 +3,16 @@
 // (surface_error_bvh.h) plus a small BVH over discs. See hybrid_graph.h.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "surface_error_bvh.h"
 #include "thinlod/simplifier/hybrid_graph.h"
+#include "thinlod/simplifier/mesh_curve.h"
 
 namespace thinlod::simplifier {
 namespace {
@@ -234,6 +237,42 @@ Result<SurfaceError> measureHybridSurfaceError(const IndexedMesh& original,
   }
   error.maxBackward = std::sqrt(backward2);
   return error;
+}
+
+Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& original,
+                                                             const HybridGraph& graph, int levels,
+                                                             const SurfaceErrorOptions& options) {
+  if (levels < 1) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "measureHybridLevels: levels " + std::to_string(levels) + " < 1");
+  }
+  const std::vector<HybridCurveStep> steps = graph.unitsVersusError();  // units decreasing
+  if (steps.empty()) return Status(ErrorCode::kInvalidArgument, "measureHybridLevels: empty graph");
+  const auto coarsest = static_cast<std::size_t>(std::max(1.0, std::ceil(steps.back().units)));
+  const auto finest = static_cast<std::size_t>(std::max(1.0, std::floor(steps.front().units)));
+  // Unit targets -> the finest step with at most that many units (steps are
+  // in decreasing units: the first one at or below the target).
+  std::vector<std::size_t> picked;
+  for (std::size_t target : geometricLadder(coarsest, std::max(coarsest, finest), levels)) {
+    std::size_t i = 0;
+    while (i + 1 < steps.size() && steps[i].units > static_cast<double>(target)) ++i;
+    if (picked.empty() || picked.back() != i) picked.push_back(i);
+  }
+  picked.push_back(0);  // the input, always (merged below if already there)
+  // Increasing units = decreasing step index.
+  std::sort(picked.begin(), picked.end(), std::greater<>());
+  picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+  std::vector<HybridMeasuredLevel> out;
+  out.reserve(picked.size());
+  HybridCut cut(graph);
+  for (std::size_t i : picked) {
+    cut.adaptToError(steps[i].error);
+    Result<SurfaceError> error =
+        measureHybridSurfaceError(original, cut.triangleMesh(), cut.pointList(), options);
+    if (!error.ok()) return error.status();
+    out.push_back(HybridMeasuredLevel{steps[i], error->max()});
+  }
+  return out;
 }
 
 }  // namespace thinlod::simplifier

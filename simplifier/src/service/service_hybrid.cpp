@@ -1,13 +1,16 @@
 // Hybrid (triangles + disc points) SimplifyRequests of SimplifierService
-// (service.h): one HybridGraph per (mesh, kappa), cuts by object-space error,
-// encodeHybrid frames, curves in primitive units (docs/hybrid.md, "Service").
+// (service.h): one HybridGraph per (mesh, kappa) with its measured ladder,
+// cuts at its rungs, encodeHybrid frames, curves in primitive units
+// (docs/hybrid.md, "Service" and "Measured curve").
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/simplifier/impostor_level.h"
 
 namespace thinlod::simplifier {
 
@@ -15,15 +18,28 @@ using namespace service_detail;
 
 namespace service_detail {
 
-std::vector<AccuracySample> hybridCurvePoints(const std::vector<HybridCurveStep>& steps,
-                                              double referenceLength, double minRelativeError) {
+std::vector<AccuracySample> hybridCurvePoints(const std::vector<HybridRung>& rungs) {
   std::vector<AccuracySample> points;
-  points.reserve(steps.size());
-  for (const HybridCurveStep& step : steps) {
-    const double d = std::max(step.error / referenceLength, minRelativeError);
-    points.push_back(AccuracySample{deliveredLevel(d).accuracy, step.units});
+  points.reserve(rungs.size());
+  for (const HybridRung& rung : rungs) {
+    points.push_back(AccuracySample{deliveredLevel(rung.relativeError).accuracy, rung.units});
   }
   return points;
+}
+
+std::vector<HybridRung> creditHybridLevels(const std::vector<HybridMeasuredLevel>& levels,
+                                           double referenceLength, double minRelativeError) {
+  // The mesh ladder's rule, on the same CurveLevel fields it reads.
+  std::vector<CurveLevel> asMesh(levels.size());
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    asMesh[i].relativeMaxError = levels[i].measuredError / referenceLength;
+  }
+  const std::vector<double> credits = creditedRelativeErrors(asMesh, minRelativeError);
+  std::vector<HybridRung> rungs(levels.size());
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    rungs[i] = HybridRung{levels[i].step.error, levels[i].step.units, credits[i]};
+  }
+  return rungs;
 }
 
 }  // namespace service_detail
@@ -41,37 +57,51 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyHybrid(
     HybridOptions hybridOptions;
     hybridOptions.kappa = kappa;
     hybridOptions.tau = options.hybridTau;
+    const auto started = std::chrono::steady_clock::now();
     Result<HybridGraph> graph = buildHybridGraph(*model.original, hybridOptions);
     if (!graph.ok()) return graph.status();
     ++stats.hybridGraphBuilds;
     auto hybrid = std::make_unique<MeshModel::Hybrid>();
     hybrid->graph = std::move(graph).value();
-    hybrid->steps = hybrid->graph.unitsVersusError();
+    // Measured like a mesh curve (same ladder length, same sampling): the
+    // scheduler compares the two kinds on measured error, not a measured
+    // error against a guaranteed bound (docs/hybrid.md, "Measured curve").
+    Result<std::vector<HybridMeasuredLevel>> levels = measureHybridLevels(
+        *model.original, hybrid->graph, options.curve.levels, options.curve.error);
+    if (!levels.ok()) return levels.status();
+    ++stats.hybridCurvesMeasured;
+    hybrid->rungs = creditHybridLevels(*levels, model.diameter, options.curve.minRelativeError);
+    progress("event=hybrid_curve_measured triangles=" +
+             std::to_string(model.original->triangleCount()) + " kappa=" + std::to_string(kappa) +
+             " rungs=" + std::to_string(hybrid->rungs.size()) + " ms=" +
+             std::to_string(std::llround(std::chrono::duration<double, std::milli>(
+                                             std::chrono::steady_clock::now() - started)
+                                             .count())));
     found = model.hybrids.emplace(kappa, std::move(hybrid)).first;
   }
   const MeshModel::Hybrid& hybrid = *found->second;
-  const double length = model.diameter;
-  const double floor = options.curve.minRelativeError;
-  auto relative = [&](double error) { return std::max(error / length, floor); };
-
-  // Steps: increasing error, decreasing units. Pick the coarsest step that
-  // still meets the target (the first step, the input, when none does).
-  double error = 0.0;
-  for (const HybridCurveStep& step : hybrid.steps) {
-    const bool meets =
-        request.target == protocol::SimplifyRequest::Target::kTriangles
-            ? true
-            : deliveredLevel(relative(step.error)).accuracy >= request.targetAccuracy;
-    if (!meets) break;
-    error = step.error;
-    if (request.target == protocol::SimplifyRequest::Target::kTriangles &&
-        step.units <= static_cast<double>(request.targetTriangles)) {
-      break;
+  // Rungs: increasing units (the last one the input). Accuracy target: the
+  // coarsest rung credited with at least it (the input when none is). Unit
+  // target: the finest rung with at most that many units (the coarsest when
+  // none has).
+  std::size_t pick = hybrid.rungs.size() - 1;
+  if (request.target == protocol::SimplifyRequest::Target::kTriangles) {
+    pick = 0;
+    for (std::size_t i = 0; i < hybrid.rungs.size(); ++i) {
+      if (hybrid.rungs[i].units <= static_cast<double>(request.targetTriangles)) pick = i;
+    }
+  } else {
+    for (std::size_t i = 0; i < hybrid.rungs.size(); ++i) {
+      if (deliveredLevel(hybrid.rungs[i].relativeError).accuracy >= request.targetAccuracy) {
+        pick = i;
+        break;
+      }
     }
   }
+  const HybridRung& rung = hybrid.rungs[pick];
   HybridCut cut(hybrid.graph);
-  cut.adaptToError(error);
-  const DeliveredLevel delivered = deliveredLevel(relative(cut.errorBound()));
+  cut.adaptToError(rung.error);
+  const DeliveredLevel delivered = deliveredLevel(rung.relativeError);
   codec::MeshEncodeOptions encode;
   encode.positionBits = delivered.positionBits;
   const HybridGeometry geometry = hybridGeometry(cut);
@@ -93,8 +123,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyHybrid(
   result.kappa = kappa;
   result.accuracy = delivered.accuracy;
   if (request.curvePoints > 0) {
-    result.curve =
-        curveSamples(hybridCurvePoints(hybrid.steps, length, floor), request.curvePoints);
+    result.curve = curveSamples(hybridCurvePoints(hybrid.rungs), request.curvePoints);
   }
   return result;
 }

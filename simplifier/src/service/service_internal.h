@@ -71,6 +71,14 @@ std::size_t creditFor(const std::vector<LevelCredit>& ladder, std::size_t triang
 // most `count` (first and last kept). count == 0: none.
 std::vector<AccuracySample> curveSamples(std::vector<AccuracySample> points, std::size_t count);
 
+// One rung of a hybrid object's measured ladder: the cut at `error` (graph
+// units) and the relative error it is credited with.
+struct HybridRung {
+  double error = 0.0;  // cut threshold (HybridCut::adaptToError)
+  double units = 0.0;  // triangles + points / kappa
+  double relativeError = 0.0;
+};
+
 // A mesh object's simplification state, shared by every object that uses
 // the same full mesh.
 struct MeshModel {
@@ -82,18 +90,22 @@ struct MeshModel {
   std::vector<LevelCredit> ladder;
   // Levels kept for impostor rendering (their GPU copies live as long as these).
   std::map<std::size_t, std::shared_ptr<const IndexedMesh>> renderLevels;
-  // Hybrid graphs by kappa, with their units-vs-error steps.
+  // Hybrid graphs by kappa, with their measured ladder (increasing units).
   struct Hybrid {
     HybridGraph graph;
-    std::vector<HybridCurveStep> steps;
+    std::vector<HybridRung> rungs;
   };
   std::map<double, std::unique_ptr<Hybrid>> hybrids;
 };
 
-// (accuracy, primitive units) of every step of a hybrid graph's curve, the
-// accuracy credited as deliveredLevel(max(error / L, minRelativeError)).
-std::vector<AccuracySample> hybridCurvePoints(const std::vector<HybridCurveStep>& steps,
-                                              double referenceLength, double minRelativeError);
+// (accuracy, primitive units) of every rung of a hybrid ladder, the accuracy
+// credited as deliveredLevel(rung.relativeError).
+std::vector<AccuracySample> hybridCurvePoints(const std::vector<HybridRung>& rungs);
+// A measured hybrid ladder (measureHybridLevels, increasing units) credited
+// like a mesh ladder: each rung the worst measured error / L at it or any
+// finer rung, floored (creditedRelativeErrors).
+std::vector<HybridRung> creditHybridLevels(const std::vector<HybridMeasuredLevel>& levels,
+                                           double referenceLength, double minRelativeError);
 
 struct LoadedScene {
   std::string path;  // canonical

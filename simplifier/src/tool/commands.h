@@ -22,5 +22,6 @@ void addSimplifyCommand(CLI::App& app);  // simplify IN (--ratio R | --triangles
 void addCurveCommand(CLI::App& app);     // curve IN [-o CURVES.json]: measured accuracy curves
 void addImpostorCommand(CLI::App& app);  // impostor IN [--meshed] [--size N]: render one impostor
 void addServeCommand(CLI::App& app);     // serve: the simplifier daemon (serve_command.cpp)
+void addPartsCommand(CLI::App& app);     // parts -o OUT: the generated multi-manifold model
 
 }  // namespace thinlod::simplifier::tool

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   thinlod::simplifier::tool::addCurveCommand(app);
   thinlod::simplifier::tool::addImpostorCommand(app);
   thinlod::simplifier::tool::addServeCommand(app);
+  thinlod::simplifier::tool::addPartsCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

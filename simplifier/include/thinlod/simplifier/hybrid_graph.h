@@ -262,6 +262,23 @@ Result<SurfaceError> measureHybridSurfaceError(const IndexedMesh& original,
                                                const std::vector<HybridPoint>& cutDiscs,
                                                const SurfaceErrorOptions& options = {});
 
+// The measured curve of a graph (the hybrid counterpart of mesh_curve.h's
+// measured ladder): `levels` unit targets spaced geometrically
+// (geometricLadder) from the coarsest step's units to the input's, each
+// mapped to the finest step of unitsVersusError() with at most that many
+// units (duplicates merged), and that step's cut measured against
+// `original` with measureHybridSurfaceError. Increasing units (like
+// CurveLevel: increasing triangles); the last level is the input. The cut is
+// adapted incrementally from rung to rung. Errors: levels < 1, and those of
+// measureHybridSurfaceError.
+struct HybridMeasuredLevel {
+  HybridCurveStep step;        // the cut: every node with error <= step.error
+  double measuredError = 0.0;  // sampled two-sided Hausdorff max, mesh units
+};
+Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& original,
+                                                             const HybridGraph& graph, int levels,
+                                                             const SurfaceErrorOptions& options);
+
 // Generated multi-manifold test model: `parts` separate closed bumpy
 // icospheres (subdivision `level`) of random sizes scattered in a unit box.
 IndexedMesh generateScatteredParts(int parts, int level, std::uint32_t seed);

@@ -28,9 +28,12 @@
 //   opaque texture: impostors have alpha, so a JPEG request gets PNG (the
 //   texture's codec says which).
 // - Hybrid requests (SimplifyRequest.representation = kHybrid): one hybrid
-//   graph per (mesh, kappa), cached; the cut at the requested accuracy (or
-//   at most targetTriangles primitive units) is an encodeHybrid frame, its
-//   accuracy 1 / (bound / L + quantization), the curve in primitive units.
+//   graph per (mesh, kappa), cached in memory with its measured ladder
+//   (measureHybridLevels with options.curve's levels and sampling, credited
+//   like a mesh ladder); the rung at the requested accuracy (or the finest
+//   with at most targetTriangles primitive units) is an encodeHybrid frame,
+//   its accuracy 1 / (credited error + quantization), the curve its rungs in
+//   primitive units.
 //   Analytic primitives have no hybrid form (kUnsupported).
 // - Impostors: world-space geometry, identity transform, world validity;
 //   representationId/generation stay 0 (the backbone numbers them).
@@ -103,7 +106,8 @@ struct ServiceStats {
   std::uint64_t impostorRequests = 0;
   std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
   std::uint64_t failedRequests = 0;
-  std::uint64_t hybridGraphBuilds = 0;  // one per (mesh, kappa)
+  std::uint64_t hybridGraphBuilds = 0;     // one per (mesh, kappa)
+  std::uint64_t hybridCurvesMeasured = 0;  // one per graph (measureHybridLevels)
 };
 
 class SimplifierService {
