@@ -13,6 +13,7 @@
 
 #include "encoding_frame.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/file_bytes.h"
 
 namespace thinlod::codec {
 namespace {
@@ -412,6 +413,15 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
   } catch (const std::exception& e) {
     return textureError(ErrorCode::kParseError, std::string("OpenImageIO threw: ") + e.what());
   }
+}
+
+Result<RgbaImage> readImageFile(const std::string& path, const DecodeLimits& limits) {
+  Result<std::string> bytes = readFileBounded(path, limits.maxPayloadBytes);
+  if (!bytes.ok()) return bytes.status();  // names the path already
+  Result<RgbaImage> decoded = decodeImageFile(
+      reinterpret_cast<const std::uint8_t*>(bytes->data()), bytes->size(), limits);
+  if (!decoded.ok()) return Status(decoded.status().code(), path + ": " + decoded.status().message());
+  return decoded;
 }
 
 }  // namespace thinlod::codec

@@ -145,6 +145,10 @@ Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
 // the limits kResourceExhausted. Rows top-down, as RgbaImage stores them.
 Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
                                   const DecodeLimits& limits = {});
+// The image file at `path` (a scene's texture): read with readFileBounded
+// (limits.maxPayloadBytes) and decoded as decodeImageFile; errors start with
+// the path. The one loader of texture files for the three daemons.
+Result<RgbaImage> readImageFile(const std::string& path, const DecodeLimits& limits = {});
 
 // FNV-1a 64 over bytes: the frame's payload checksum (catches corruption on
 // the link, not forgery).
