@@ -234,6 +234,7 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
       if (texture == textureCache_.end() || texture->second.source.lock() != partTexture) {
         render::TextureOptions textureOptions;
         textureOptions.linearFilter = true;
+        textureOptions.clampToEdge = false;  // base-colour textures tile, as the frontend draws them
         auto handle = renderer_->uploadTexture(*partTexture, textureOptions);
         if (!handle.ok()) return handle.status();
         textureCache_[partTexture.get()] = CachedTexture{partTexture, *handle};

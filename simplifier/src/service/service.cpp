@@ -292,7 +292,12 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
       }
     }
   }
-  const IndexedMesh mesh = pm.extract(target);
+  // A textured object's full resolution is its own mesh, uv seams intact:
+  // the progressive mesh welds the seam's split vertices (one uv each), which
+  // a texture shows. Only when cleanup dropped no triangle (same count).
+  const bool original = model.attributeWeight > 0.0f && target >= pm.maxTriangles() &&
+                        model.original->triangleCount() == pm.maxTriangles();
+  const IndexedMesh mesh = original ? *model.original : pm.extract(target);
   const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
   Result<protocol::SimplifyResult> encoded =
       encodedMeshResult(mesh, deliveredLevel(credit.relativeError));
