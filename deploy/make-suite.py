@@ -14,7 +14,7 @@
   gallery-fast.trace   a fast walk (1.3 m/s) with sudden turns (90-180 degrees in 0.2-0.3 s), 10 s.
   city-walk.trace      a walk along an avenue at 1.4 m/s with a turn at a crossing, 12 s.
   textured.wrl         textured objects from the Debian package assimp-testmodels: six Collada
-                       ducks (duckCM.tga) and six glTF boxes (CesiumLogoFlat.png) in two rows,
+                       ducks (duckCM.tga) and six glTF boxes (CesiumLogoFlat.png) in two rows 5 m apart,
                        Inline'd with their ImageTexture; the case runs with --models-dir
                        /usr/share/assimp/models (suite.json "models").
   textured-walk.trace  a walk past the two rows at 0.8 m/s, 10 s.
@@ -324,7 +324,7 @@ def write_textured(path):
              "# assimp-testmodels' Collada duck and glTF textured box, --models-dir /usr/share/assimp/models",
              "DirectionalLight { direction -0.3 -1 -0.5 }",
              "DEF DUCK Transform { translation 0 0 0 rotation 0 1 0 0.6 children [ " + duck + " ] }",
-             "DEF BOX Transform { translation 0 0.5 3 rotation 0 1 0 0.4 children [ " + box + " ] }"]
+             "DEF BOX Transform { translation 0 0.5 5 rotation 0 1 0 0.4 children [ " + box + " ] }"]
     for i in range(1, 6):
         lines.append(f"Transform {{ translation {2.5 * i:g} 0 0 rotation 0 1 0 {0.5 * i:g} children USE DUCK }}")
         lines.append(f"Transform {{ translation {2.5 * i:g} 0 {0.4 * (i % 2):g} children USE BOX }}")
@@ -378,10 +378,10 @@ def main():
     write_trace(os.path.join(args.out, "city-walk.trace"),
                 f"city walk at 1.4 m/s with a turn at a crossing, {len(city)} poses", city, 60)
 
-    # Textured walk: between the rows (ducks at z = 0, boxes at z = 3), looking at each side.
-    textured_points = [(-1.5, 1.5, 1.5), (13.5, 1.5, 1.5)]
+    # Textured walk: between the rows (ducks at z = 0, boxes at z = 5), looking at each side.
+    textured_points = [(-1.5, 1.5, 2.5), (13.5, 1.5, 2.5)]
     sides = yaw_schedule([(0, -30), (2.0, 1.0, 60), (5.0, 1.0, -60), (8.0, 1.0, 40)])
-    textured_walk = along(textured_points, 0.8, 0.1, lambda t, p, d: yaw_target(p, sides(t), 0.6))[:100]
+    textured_walk = along(textured_points, 0.8, 0.1, lambda t, p, d: yaw_target(p, sides(t), 0.2))[:100]
     write_trace(os.path.join(args.out, "textured-walk.trace"),
                 f"walk between the textured rows at 0.8 m/s, {len(textured_walk)} poses",
                 textured_walk, 60)

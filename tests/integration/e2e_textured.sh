@@ -24,39 +24,17 @@ THINLOD_BUILD_DIR=$build THINLOD_READY_TIMEOUT_S=300 "$root/deploy/run-local" "$
   --backbone "--scene $scene --max-speed 1.0 --lifetime 1.0 --sync-wait-ms 5000 --budget-polygons $budget" \
   --simplifier "--scene $scene --scene-root / --cache-dir $out/cache" \
   --frontend "--scene $scene --trace $trace --lockstep --lockstep-timeout-ms 20000 --rate -1 --frames 20 --width 320 --height 240 --csv $out/frames.csv --frames-dir $out/dump --dump-every 5"
-python3 - "$out" <<'PY'
-import csv, glob, math, os, struct, sys, zlib
+python3 - "$out" "$root" <<'PY'
+import csv, glob, math, os, sys
+
+sys.path.insert(0, os.path.join(sys.argv[2], "tests", "workbench"))
+from page_test import decode_png  # noqa: E402  (the project's one PNG reader for tests)
+
 
 def read_png(path):
-    """8-bit RGB/RGBA, non-interlaced (what the frontend writes) -> (w, h, channels, rows)."""
-    data = open(path, "rb").read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
-    pos, idat, w = 8, b"", None
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        if kind == b"IHDR":
-            w, h, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            assert depth == 8 and colour in (2, 6) and interlace == 0, (path, depth, colour)
-            ch = 3 if colour == 2 else 4
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + n
-    raw, stride, rows, prev = zlib.decompress(idat), w * ch, [], bytearray(w * ch)
-    for y in range(h):
-        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - ch] if i >= ch else 0
-            b, c = prev[i], prev[i - ch] if i >= ch else 0
-            if f == 1: line[i] = (line[i] + a) & 255
-            elif f == 2: line[i] = (line[i] + b) & 255
-            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(line); prev = line
-    return w, h, ch, rows
+    with open(path, "rb") as f:
+        return decode_png(f.read())
+
 
 out = sys.argv[1]
 errors = []

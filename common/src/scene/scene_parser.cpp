@@ -1140,7 +1140,11 @@ class Parser {
     return true;
   }
 
-  bool parseCoordinateField(std::vector<glm::vec3>* points) {
+  // `coord Coordinate { point [...] }` and `texCoord TextureCoordinate { point
+  // [...] }`: a point-list value node, or USE of one, or NULL.
+  template <typename Point, typename ParseOne>
+  bool parsePointNodeField(const char* nodeName, DefKind kind, std::vector<Point> DefEntry::*stored,
+                           std::vector<Point>* points, ParseOne parseOne) {
     if (tok_.kind == TokenKind::kWord && tok_.text == "NULL") {
       advance();
       points->clear();
@@ -1148,74 +1152,42 @@ class Parser {
     }
     const DefEntry* used = nullptr;
     bool isUse = false;
-    if (!parseUse(DefKind::kCoordinate, &used, &isUse)) return false;
+    if (!parseUse(kind, &used, &isUse)) return false;
     if (isUse) {
-      *points = used->points;
+      *points = used->*stored;
       return true;
     }
     std::string defName;
     if (!parseDefPrefix(&defName)) return false;
     if (!lexOk()) return false;
-    if (!(tok_.kind == TokenKind::kWord && tok_.text == "Coordinate")) {
-      return unexpected("Coordinate");
-    }
+    if (!(tok_.kind == TokenKind::kWord && tok_.text == nodeName)) return unexpected(nodeName);
     const Token type = tok_;
     advance();
     NodeScope scope(*this, type);
     if (!scope.ok) return false;
     bool ok = parseBody(type, [&](std::string_view f, const Token&) {
-      if (f == "point") {
-        return parseMF<glm::vec3>(points, [&](glm::vec3* v) { return parseVec3(v); });
-      }
+      if (f == "point") return parseMF<Point>(points, parseOne);
       return false;
     });
     if (!ok) return false;
     if (!defName.empty()) {
       DefEntry e;
-      e.kind = DefKind::kCoordinate;
-      e.points = *points;
+      e.kind = kind;
+      e.*stored = *points;
       defs_[defName] = e;
     }
     return true;
   }
 
+  bool parseCoordinateField(std::vector<glm::vec3>* points) {
+    return parsePointNodeField<glm::vec3>("Coordinate", DefKind::kCoordinate, &DefEntry::points,
+                                          points, [&](glm::vec3* v) { return parseVec3(v); });
+  }
+
   bool parseTextureCoordinateField(std::vector<glm::vec2>* points) {
-    if (tok_.kind == TokenKind::kWord && tok_.text == "NULL") {
-      advance();
-      points->clear();
-      return true;
-    }
-    const DefEntry* used = nullptr;
-    bool isUse = false;
-    if (!parseUse(DefKind::kTextureCoordinate, &used, &isUse)) return false;
-    if (isUse) {
-      *points = used->texturePoints;
-      return true;
-    }
-    std::string defName;
-    if (!parseDefPrefix(&defName)) return false;
-    if (!lexOk()) return false;
-    if (!(tok_.kind == TokenKind::kWord && tok_.text == "TextureCoordinate")) {
-      return unexpected("TextureCoordinate");
-    }
-    const Token type = tok_;
-    advance();
-    NodeScope scope(*this, type);
-    if (!scope.ok) return false;
-    bool ok = parseBody(type, [&](std::string_view f, const Token&) {
-      if (f == "point") {
-        return parseMF<glm::vec2>(points, [&](glm::vec2* v) { return parseVec2(v); });
-      }
-      return false;
-    });
-    if (!ok) return false;
-    if (!defName.empty()) {
-      DefEntry e;
-      e.kind = DefKind::kTextureCoordinate;
-      e.texturePoints = *points;
-      defs_[defName] = e;
-    }
-    return true;
+    return parsePointNodeField<glm::vec2>("TextureCoordinate", DefKind::kTextureCoordinate,
+                                          &DefEntry::texturePoints, points,
+                                          [&](glm::vec2* v) { return parseVec2(v); });
   }
 
   bool parseIndexedFaceSet(const Token& type, Geometry* g) {

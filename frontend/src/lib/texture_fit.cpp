@@ -42,6 +42,18 @@ RgbaImage shrinkImage(const RgbaImage& source, int width, int height) {
   return out;
 }
 
+namespace {
+
+// `source`, or `storage` holding it shrunk so that no side exceeds the layer.
+const RgbaImage* shrunkToLayer(const RgbaImage& source, int layerSize, RgbaImage& storage) {
+  if (source.width <= layerSize && source.height <= layerSize) return &source;
+  storage =
+      shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
+  return &storage;
+}
+
+}  // namespace
+
 FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
   assert(layerSize >= 1 && source.consistent() && !source.empty());
   FittedTexture fitted;
@@ -49,13 +61,8 @@ FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
     fitted.useSource = true;
     return fitted;
   }
-  const RgbaImage* image = &source;
   RgbaImage shrunk;
-  if (source.width > layerSize || source.height > layerSize) {
-    shrunk =
-        shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
-    image = &shrunk;
-  }
+  const RgbaImage* image = shrunkToLayer(source, layerSize, shrunk);
   const int w = image->width;
   const int h = image->height;
   fitted.uvScale = glm::vec2(static_cast<float>(w) / layerSize, static_cast<float>(h) / layerSize);
@@ -83,13 +90,8 @@ FittedTexture fitRepeatingTextureToLayer(const RgbaImage& source, int layerSize)
     fitted.useSource = true;
     return fitted;
   }
-  const RgbaImage* image = &source;
   RgbaImage shrunk;
-  if (source.width > layerSize || source.height > layerSize) {
-    shrunk =
-        shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
-    image = &shrunk;
-  }
+  const RgbaImage* image = shrunkToLayer(source, layerSize, shrunk);
   if (image->width == layerSize && image->height == layerSize) {
     fitted.image = std::move(shrunk);
     return fitted;
