@@ -18,6 +18,11 @@
   gallery-fast.trace   a fast walk (1.3 m/s) with sudden turns (90-180 degrees in 0.2-0.3 s), 10 s.
   city-walk.trace      a walk along an avenue at 1.4 m/s with a turn at a crossing, 12 s.
   parts-fly.trace      a flight into the parts field (the path of bench_hybrid_flythrough), 10 s.
+  textured.wrl         textured objects from the Debian package assimp-testmodels: six Collada
+                       ducks (duckCM.tga) and six glTF boxes (CesiumLogoFlat.png) in two rows 5 m apart,
+                       Inline'd with their ImageTexture; the case runs with --models-dir
+                       /usr/share/assimp/models (suite.json "models").
+  textured-walk.trace  a walk past the two rows at 0.8 m/s, 10 s.
 
 Model sizes are read from the model files in --models-dir (default ../shared/models), so the
 scale factors written into the scenes are exact; the scenes name the models by file name only
@@ -363,6 +368,27 @@ def yaw_schedule(keys):
     return yaw
 
 
+def write_textured(path):
+    """Two rows of textured objects from assimp-testmodels (urls under /usr/share/assimp/models;
+    each ImageTexture url is relative to the Inline file that names it)."""
+    duck = ('Shape { appearance Appearance { material Material { diffuseColor 1 1 1 } '
+            'texture ImageTexture { url "duckCM.tga" } } geometry Inline { url "Collada/duck.dae" } }')
+    box = ('Shape { appearance Appearance { material Material { diffuseColor 1 1 1 } '
+           'texture ImageTexture { url "CesiumLogoFlat.png" } } '
+           'geometry Inline { url "glTF2/BoxTextured-glTF/BoxTextured.gltf" } }')
+    lines = ["#VRML V2.0 utf8", "# Textured scene of the workbench (made by deploy/make-suite.py):",
+             "# assimp-testmodels' Collada duck and glTF textured box, --models-dir /usr/share/assimp/models",
+             "DirectionalLight { direction -0.3 -1 -0.5 }",
+             "DEF DUCK Transform { translation 0 0 0 rotation 0 1 0 0.6 children [ " + duck + " ] }",
+             "DEF BOX Transform { translation 0 0.5 5 rotation 0 1 0 0.4 children [ " + box + " ] }"]
+    for i in range(1, 6):
+        lines.append(f"Transform {{ translation {2.5 * i:g} 0 0 rotation 0 1 0 {0.5 * i:g} children USE DUCK }}")
+        lines.append(f"Transform {{ translation {2.5 * i:g} 0 {0.4 * (i % 2):g} children USE BOX }}")
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return 12
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models-dir", default=os.path.join(HERE, "..", "..", "shared", "models"))
@@ -373,6 +399,7 @@ def main():
     objects = Gallery(args.models_dir).write(os.path.join(args.out, "gallery.wrl"))
     instances = write_city(os.path.join(args.out, "city.wrl"))
     parts = write_parts_field(os.path.join(args.out, "parts-field.wrl"))
+    textured = write_textured(os.path.join(args.out, "textured.wrl"))
 
     # The paper's flight, same key frames and spline, 0.1 s per pose.
     spec = importlib.util.spec_from_file_location("paper", os.path.join(HERE, "make-paper-trace.py"))
@@ -413,7 +440,15 @@ def main():
                 f"flight into the parts field, {len(fly)} poses (max {max_speed(fly):.2f} m/s)",
                 fly, 60)
 
-    print(f"make-suite: gallery {objects} objects, city {instances} instances, parts field "
+    # Textured walk: between the rows (ducks at z = 0, boxes at z = 5), looking at each side.
+    textured_points = [(-1.5, 1.5, 2.5), (13.5, 1.5, 2.5)]
+    sides = yaw_schedule([(0, -30), (2.0, 1.0, 60), (5.0, 1.0, -60), (8.0, 1.0, 40)])
+    textured_walk = along(textured_points, 0.8, 0.1, lambda t, p, d: yaw_target(p, sides(t), 0.2))[:100]
+    write_trace(os.path.join(args.out, "textured-walk.trace"),
+                f"walk between the textured rows at 0.8 m/s, {len(textured_walk)} poses",
+                textured_walk, 60)
+
+    print(f"make-suite: textured {textured} objects; gallery {objects} objects, city {instances} instances, parts field "
           f"{parts} instances (parts-fly {len(fly)} poses, {max_speed(fly):.2f} m/s); traces: "
           f"paper-walk {len(walk)} ({max_speed(walk):.2f} m/s), gallery-tour {len(tour)} "
           f"({max_speed(tour):.2f} m/s), gallery-fast {len(fast)} ({max_speed(fast):.2f} m/s), "

@@ -113,7 +113,7 @@ std::vector<NamedMessage> seedMessages() {
   mixed.operations.push_back(std::move(remove));
   out.push_back({"scene_update_mixed", mixed});
 
-  out.push_back({"scene_update_empty", SceneUpdate{18, 341, 12.5, {}}});
+  out.push_back({"scene_update_empty", SceneUpdate{18, 341, 12.5, {}, {}}});
 
   SimplifyRequest byPath;
   byPath.requestId = 5;
@@ -236,6 +236,21 @@ std::vector<NamedMessage> seedMessages() {
   hybridOp.representation.pointCount = 90;
   hybridUpdate.operations.push_back(std::move(hybridOp));
   out.push_back({"scene_update_hybrid", hybridUpdate});
+  // Appended last: tests index the earlier seeds.
+  SceneUpdate shared;  // a textured mesh and the shared texture it names
+  shared.plan = 19;
+  shared.frame = 342;
+  shared.targetAccuracy = 12.5;
+  SceneOperation textured;
+  textured.objectId = 300;
+  textured.representation = sampleRepresentation(RepresentationKind::kMesh, 300, 0);
+  textured.representation.textureId = 1;
+  shared.operations.push_back(std::move(textured));
+  SharedTexture texture;
+  texture.textureId = 1;
+  texture.texture = sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 16).texture;
+  shared.textures.push_back(std::move(texture));
+  out.push_back({"scene_update_shared_texture", shared});
   return out;
 }
 

@@ -1,6 +1,7 @@
 // codec::decodeImageFile: scene texture files (PNG / JPEG without a frame).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -50,11 +51,65 @@ TEST(ImageFile, JpegDecodesOpaqueAtItsOwnSize) {
 }
 
 TEST(ImageFile, OtherFormatsAreUnsupported) {
-  const std::vector<std::uint8_t> tga = {0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 1, 0, 24, 0};
-  Result<RgbaImage> decoded = decodeImageFile(tga.data(), tga.size());
+  const std::vector<std::uint8_t> gif = {'G', 'I', 'F', '8', '9', 'a', 1, 0, 1, 0, 0, 0, 0};
+  Result<RgbaImage> decoded = decodeImageFile(gif.data(), gif.size());
   ASSERT_FALSE(decoded.ok());
   EXPECT_EQ(decoded.status().code(), ErrorCode::kUnsupported);
   EXPECT_EQ(decodeImageFile(nullptr, 0).status().code(), ErrorCode::kParseError);
+}
+
+// TGA (Collada's duck uses one): an 18-byte header, then the pixels (BGR, bottom row first
+// unless bit 5 of the descriptor says top-down).
+std::vector<std::uint8_t> tgaHeader(std::uint8_t type, int width, int height, std::uint8_t bits,
+                                    std::uint8_t colourMap = 0) {
+  return {0, colourMap, type, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+          static_cast<std::uint8_t>(width & 255), static_cast<std::uint8_t>(width >> 8),
+          static_cast<std::uint8_t>(height & 255), static_cast<std::uint8_t>(height >> 8), bits,
+          0x20};  // top-down
+}
+
+TEST(ImageFile, TgaDecodesToRgba) {
+  std::vector<std::uint8_t> tga = tgaHeader(2, 2, 1, 24);
+  tga.insert(tga.end(), {10, 20, 30, 40, 50, 60});  // BGR BGR
+  Result<RgbaImage> decoded = decodeImageFile(tga.data(), tga.size());
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  ASSERT_EQ(decoded->width, 2);
+  ASSERT_EQ(decoded->height, 1);
+  EXPECT_EQ(decoded->pixels, (std::vector<std::uint8_t>{30, 20, 10, 255, 60, 50, 40, 255}));
+}
+
+TEST(ImageFile, HostileTgaHeadersAreRefusedBeforeDecoding) {
+  // Raw pixels missing, a colour map, a colour-mapped type, zero sides, odd bit depths.
+  for (const std::vector<std::uint8_t>& bad :
+       {tgaHeader(2, 1, 1, 24), tgaHeader(2, 1, 1, 24, 1), tgaHeader(1, 1, 1, 8),
+        tgaHeader(2, 0, 1, 24), tgaHeader(2, 1, 1, 7), std::vector<std::uint8_t>(10, 0)}) {
+    std::vector<std::uint8_t> bytes = bad;
+    bytes.resize(std::max<std::size_t>(bytes.size(), 18) + (bytes.size() >= 18 ? 1 : 0), 0);
+    Result<RgbaImage> decoded = decodeImageFile(bytes.data(), bytes.size());
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), ErrorCode::kUnsupported) << decoded.status().toString();
+  }
+  // Sides over the limits: refused from the header, before any pixel.
+  std::vector<std::uint8_t> wide = tgaHeader(10, 60000, 2, 32);  // RLE: no size check up front
+  wide.resize(64, 0);
+  DecodeLimits limits;
+  limits.maxTextureDimension = 4096;
+  Result<RgbaImage> decoded = decodeImageFile(wide.data(), wide.size(), limits);
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted) << decoded.status().toString();
+}
+
+TEST(ImageFile, TheColladaDucksTgaDecodes) {
+  const std::string path = "/usr/share/assimp/models/Collada/duckCM.tga";
+  Result<RgbaImage> decoded = readImageFile(path);
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString()
+                            << " (install assimp-testmodels: deploy/setup does)";
+  EXPECT_GT(decoded->width, 0);
+  EXPECT_TRUE(decoded->consistent());
+  Result<RgbaImage> missing = readImageFile("/nonexistent/texture.png");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().message().rfind("/nonexistent/texture.png", 0), 0u)
+      << missing.status().message();
 }
 
 TEST(ImageFile, TruncatedFilesAreParseErrors) {

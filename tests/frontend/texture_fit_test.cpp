@@ -79,5 +79,32 @@ TEST(TextureFit, ShrinkOfFullyTransparentIsTransparentBlack) {
   EXPECT_EQ(small.at(1, 1)[3], 0);
 }
 
+// Repeating (mesh) textures fill the whole layer, so the layer's repeat wrap tiles them.
+TEST(TextureFit, RepeatingTextureFillsTheLayerAndWrapsAtItsEdges) {
+  EXPECT_TRUE(fitRepeatingTextureToLayer(*solidImage(16, 16, 1, 2, 3), 16).useSource);
+  RgbaImage stripes(2, 1);  // left texel red, right texel blue
+  stripes.at(0, 0)[0] = 200;
+  stripes.at(0, 0)[3] = 255;
+  stripes.at(1, 0)[2] = 200;
+  stripes.at(1, 0)[3] = 255;
+  const FittedTexture fitted = fitRepeatingTextureToLayer(stripes, 8);
+  EXPECT_FALSE(fitted.useSource);
+  EXPECT_EQ(fitted.uvScale, glm::vec2(1.0f));
+  ASSERT_EQ(fitted.image.width, 8);
+  ASSERT_EQ(fitted.image.height, 8);
+  // Texel centres of the source land at layer x = 1.5 and 5.5: pure there.
+  EXPECT_NEAR(fitted.image.at(1, 3)[0], 175, 1);  // 7/8 red, 1/8 wrapped-around blue
+  EXPECT_NEAR(fitted.image.at(5, 3)[2], 175, 1);
+  // The left edge blends with the right texel (wrap), not with itself (clamp).
+  EXPECT_NEAR(fitted.image.at(0, 3)[0], 125, 1);
+  EXPECT_NEAR(fitted.image.at(0, 3)[2], 75, 1);
+  // Larger textures shrink to the layer first (box filter), then fill it.
+  const FittedTexture big = fitRepeatingTextureToLayer(*solidImage(32, 8, 9, 8, 7), 16);
+  ASSERT_EQ(big.image.width, 16);
+  ASSERT_EQ(big.image.height, 16);
+  EXPECT_EQ(big.image.at(3, 11)[0], 9);
+  EXPECT_EQ(big.image.at(3, 11)[2], 7);
+}
+
 }  // namespace
 }  // namespace thinlod::frontend::detail

@@ -239,6 +239,82 @@ TEST(Codec, TextureLargerThanTheLimitIsResourceExhausted) {
       << decoded.status().message();
 }
 
+// Shared textures (docs/protocol.md, "Shared textures").
+SharedTexture pngShared(std::uint64_t id) {
+  SharedTexture t;
+  t.textureId = id;
+  t.texture = seeds::sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 8).texture;
+  return t;
+}
+
+TEST(Codec, SharedTexturesAndTextureIdsRoundTrip) {
+  SceneUpdate update = seeds::sceneUpdateOfSize(512, 4);
+  update.operations[0].representation.textureId = 7;
+  update.textures = {pngShared(7), pngShared(9)};
+  auto encoded = encode(update);
+  ASSERT_TRUE(encoded.ok()) << encoded.status().toString();
+  auto decoded = decode(*encoded);
+  ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+  const SceneUpdate& back = std::get<SceneUpdate>(*decoded);
+  EXPECT_TRUE(back == update);
+  ASSERT_EQ(back.textures.size(), 2u);
+  EXPECT_EQ(back.textures[1].textureId, 9u);
+  EXPECT_EQ(back.operations[0].representation.textureId, 7u);
+}
+
+TEST(Codec, SharedTextureRulesAreCheckedOnBothSides) {
+  SceneUpdate zero;
+  zero.textures = {pngShared(0)};
+  auto encoded = encode(zero);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_NE(encoded.status().message().find("textures[0].texture_id"), std::string::npos)
+      << encoded.status().message();
+
+  SceneUpdate twice;
+  twice.textures = {pngShared(3), pngShared(3)};
+  encoded = encode(twice);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_NE(encoded.status().message().find("texture id 3 twice"), std::string::npos);
+
+  SceneUpdate oversized;
+  oversized.textures = {pngShared(1)};
+  oversized.textures[0].texture.width = kMaxTextureDimension + 1;
+  EXPECT_EQ(encode(oversized).status().code(), ErrorCode::kResourceExhausted);
+
+  // An impostor carries its own texture: a texture id there is refused.
+  SceneUpdate impostor;
+  SceneOperation op;
+  op.objectId = 1;
+  op.representation = seeds::sampleRepresentation(RepresentationKind::kSimpleImpostor, 0, 4);
+  op.representation.textureId = 2;
+  impostor.operations.push_back(op);
+  encoded = encode(impostor);
+  ASSERT_FALSE(encoded.ok());
+  EXPECT_NE(encoded.status().message().find("texture_id"), std::string::npos);
+
+  // Decode refuses the same from the wire: a SharedTexture without its texture.
+  fb::FlatBufferBuilder b;
+  auto shared = b.CreateVector(std::vector<fb::Offset<w::SharedTexture>>{
+      w::CreateSharedTexture(b, 1, 0)});
+  auto body = w::CreateSceneUpdate(b, 1, 1, 1.0, 0, shared).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::SceneUpdate, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_NE(decoded.status().message().find("textures[0].texture"), std::string::npos)
+      << decoded.status().message();
+}
+
+TEST(Codec, TooManySharedTexturesIsResourceExhausted) {
+  fb::FlatBufferBuilder b;
+  std::vector<fb::Offset<w::SharedTexture>> textures;
+  for (std::size_t i = 0; i <= kMaxSharedTextures; ++i)
+    textures.push_back(w::CreateSharedTexture(b, i + 1, 0));
+  auto vector = b.CreateVector(textures);
+  auto body = w::CreateSceneUpdate(b, 1, 1, 1.0, 0, vector).Union();
+  auto decoded = decode(finish(b, kProtocolVersion, w::Body::SceneUpdate, body));
+  ASSERT_FALSE(decoded.ok());
+  EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted) << decoded.status().toString();
+}
+
 TEST(Codec, TooManyOperationsIsResourceExhausted) {
   fb::FlatBufferBuilder b;
   std::vector<fb::Offset<w::SceneOp>> ops;

@@ -109,9 +109,8 @@ TEST(SceneImport, GltfBoxTexturedHasUvsAndRecordsTheTexturePath) {
   const Bounds b = worldBounds(*r);
   expectNear(b.min, glm::vec3(-0.5f), 1e-5f);
   expectNear(b.max, glm::vec3(0.5f), 1e-5f);
-  bool noted = false;
-  for (const std::string& w : r->warnings) noted |= w.find("reference only") != std::string::npos;
-  EXPECT_TRUE(noted) << "the importer must say where textures are drawn";
+  // Textures travel on the link now (docs/protocol.md): no "reference only" note.
+  for (const std::string& w : r->warnings) EXPECT_EQ(w.find("reference only"), std::string::npos) << w;
 }
 
 TEST(SceneImport, GltfBinaryAndEmbeddedBoxesMatchTheSeparateFiles) {

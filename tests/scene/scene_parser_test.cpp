@@ -197,8 +197,9 @@ TEST(SceneParser, TruncatedFile) {
 
 TEST(SceneParser, UnsupportedVrmlFeatures) {
   expectError(kHeader + "PROTO Foo [] {}\n", ErrorCode::kParseError, 2, 1, "not supported");
-  expectError(kHeader + "Shape { appearance Appearance { texture ImageTexture {} } }\n",
-              ErrorCode::kParseError, 2, 33, "'texture' is not supported");
+  expectError(
+      kHeader + "Shape { appearance Appearance { textureTransform TextureTransform {} } }\n",
+      ErrorCode::kParseError, 2, 33, "'textureTransform' is not supported");
 }
 
 TEST(SceneParser, ValueLimits) {

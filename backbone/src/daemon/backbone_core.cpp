@@ -668,6 +668,9 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   rep.validity = everywhereOnWire();
   rep.accuracy = result.accuracy;
   rep.triangleCount = result.triangleCount;
+  // Hybrid triangles carry no uvs (docs/hybrid.md): only mesh copies are textured.
+  if (!hybrid && request.object < objectTexture_.size())
+    rep.textureId = objectTexture_[request.object];
   backbone::RepresentationCopy copy;
   copy.present = true;
   copy.id = request.id;
@@ -967,7 +970,14 @@ PoseOutcome BackboneCore::finishPose() {
       ++out.deferredByPolygonCap;
       continue;
     }
-    const auto bytes = static_cast<std::uint64_t>(std::llround(back.encodedBytes));
+    // A shared texture the frontend does not hold yet travels with this copy.
+    const protocol::Representation& payload = *mirror_.generatedPayload(add.option);
+    const protocol::SharedTexture* newTexture = nullptr;
+    if (payload.textureId != 0 && payload.textureId <= sharedTextures_.size() &&
+        texturesAtFrontend_.count(payload.textureId) == 0)
+      newTexture = &sharedTextures_[payload.textureId - 1];
+    const auto bytes = static_cast<std::uint64_t>(std::llround(back.encodedBytes)) +
+                       (newTexture ? newTexture->texture.data.size() : 0);
     if (shaper_) {
       if (bytes > shaper_->bucket().burstBytes()) {
         // Grow the bucket to hold this message, keeping the tokens it had.
@@ -994,8 +1004,12 @@ PoseOutcome BackboneCore::finishPose() {
     protocol::SceneOperation op;
     op.type = protocol::SceneOperation::Type::kAddOrReplace;
     op.objectId = converted_.records[add.object].id;
-    op.representation = *mirror_.generatedPayload(add.option);
+    op.representation = payload;
     out.update.operations.push_back(std::move(op));
+    if (newTexture) {
+      out.update.textures.push_back(*newTexture);
+      texturesAtFrontend_[newTexture->textureId] = out.update.plan;
+    }
     mirror_.send(add.object, add.option, out.update.plan);
     promised_.erase(scene_.options[add.option].atFrontend.id);  // delivered: await anew
     sentNow.push_back(add.object);
@@ -1017,8 +1031,38 @@ PoseOutcome BackboneCore::finishPose() {
   return out;
 }
 
+Status BackboneCore::setSharedTextures(SceneTextures textures) {
+  if (textures.objectTexture.size() != converted_.records.size())
+    return invalid("shared textures: " + std::to_string(textures.objectTexture.size()) +
+                   " object entries for " + std::to_string(converted_.records.size()) + " objects");
+  for (std::size_t i = 0; i < textures.textures.size(); ++i) {
+    if (textures.textures[i].textureId != i + 1)
+      return invalid("shared texture " + std::to_string(i) + " has id " +
+                     std::to_string(textures.textures[i].textureId) + ", expected " +
+                     std::to_string(i + 1));
+  }
+  for (std::uint64_t id : textures.objectTexture) {
+    if (id > textures.textures.size())
+      return invalid("shared textures: an object names texture " + std::to_string(id) + " of " +
+                     std::to_string(textures.textures.size()));
+  }
+  sharedTextures_ = std::move(textures.textures);
+  objectTexture_ = std::move(textures.objectTexture);
+  texturesAtFrontend_.clear();
+  return Status();
+}
+
 std::size_t BackboneCore::onFrameStats(const protocol::FrameStats& stats) {
   const std::vector<std::uint32_t> corrected = mirror_.acknowledge(stats.plan, stats.rejectedPlans);
+  // A refused update's shared textures may not be held: send them again.
+  for (auto it = texturesAtFrontend_.begin(); it != texturesAtFrontend_.end();) {
+    if (std::find(stats.rejectedPlans.begin(), stats.rejectedPlans.end(), it->second) !=
+        stats.rejectedPlans.end()) {
+      it = texturesAtFrontend_.erase(it);
+    } else {
+      ++it;
+    }
+  }
   // The scheduler still awaits the refused copies (they were on their way to
   // the frontend): promise them again so the next update delivers them.
   for (std::uint32_t object : corrected) {
@@ -1032,6 +1076,7 @@ std::size_t BackboneCore::onFrameStats(const protocol::FrameStats& stats) {
 
 void BackboneCore::resetFrontend() {
   mirror_.reset();
+  texturesAtFrontend_.clear();
   planner_.reset();
   promised_.clear();
   shaper_.reset();

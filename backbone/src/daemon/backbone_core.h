@@ -62,6 +62,7 @@
 #include "frontend_mirror.h"
 #include "request_ledger.h"
 #include "scene_conversion.h"
+#include "scene_textures.h"
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/protocol/link_shaper.h"
 #include "thinlod/protocol/messages.h"
@@ -161,6 +162,16 @@ class BackboneCore {
   ~BackboneCore();
   BackboneCore(const BackboneCore&) = delete;
   BackboneCore& operator=(const BackboneCore&) = delete;
+
+  // The scene's shared textures (scene_textures.h, loaded by the daemon):
+  // a mesh copy of a textured object names its texture id, and the first
+  // update of a frontend session that sends such a copy carries the texture
+  // (SceneUpdate::textures), its bytes counted on the link like the mesh's.
+  // A texture whose update the frontend refused is sent again. kInvalidArgument
+  // when `textures` does not fit the scene (objectTexture size, ids).
+  Status setSharedTextures(SceneTextures textures);
+  std::size_t sharedTextureCount() const { return sharedTextures_.size(); }
+  std::size_t texturesAtFrontend() const { return texturesAtFrontend_.size(); }
 
   // ---- requests to the simplifier ----
   std::vector<OutgoingRequest> takeRequests();
@@ -282,6 +293,9 @@ class BackboneCore {
   ConvertedScene converted_;
   backbone::SchedulingScene scene_;
   FrontendMirror mirror_{scene_, [this](std::uint32_t object) { touchObject(object); }};
+  std::vector<protocol::SharedTexture> sharedTextures_;  // id i + 1 at index i
+  std::vector<std::uint64_t> objectTexture_;             // per object, 0 = untextured
+  std::map<std::uint64_t, std::uint64_t> texturesAtFrontend_;  // texture id -> plan that sent it
   std::vector<OptionState> optionStates_;
   std::vector<double> meshBytesPerTriangle_;  // per object
   std::vector<bool> meshBytesLearned_;

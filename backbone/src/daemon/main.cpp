@@ -577,14 +577,26 @@ int main(int argc, char** argv) {
     return 1;
   }
   BackboneCore& backbone = **core;
+  {
+    thinlod::backbone_daemon::SceneTextures textures =
+        thinlod::backbone_daemon::loadSceneTextures(backbone.sceneObjects());
+    for (const std::string& warning : textures.warnings)
+      spdlog::warn("event=texture_warning message=\"{}\"", warning);
+    const thinlod::Status set = backbone.setSharedTextures(std::move(textures));
+    if (!set.ok()) {
+      spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, set.toString());
+      return 1;
+    }
+  }
   const auto msBetween = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
   spdlog::info(
       "event=scene path={} fingerprint={} objects={} lods={} options={} curves_wanted={} "
-      "start_ms={:.0f} load_ms={:.0f} convert_ms={:.0f}",
+      "textures={} start_ms={:.0f} load_ms={:.0f} convert_ms={:.0f}",
       scenePath, protocol::fingerprintText(backbone.sceneFingerprint()), backbone.objects().size(),
       backbone.lodNodes(), backbone.schedulingScene().options.size(), backbone.curvesPending(),
+      backbone.sharedTextureCount(),
       msBetween(processStart, loadStarted), msBetween(loadStarted, loaded),
       msBetween(loaded, Clock::now()));
 

@@ -13,6 +13,7 @@
 
 #include "encoding_frame.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/file_bytes.h"
 
 namespace thinlod::codec {
 namespace {
@@ -179,6 +180,46 @@ bool jpegHeaderSafe(const std::uint8_t* data, std::size_t size) {
 // PNG or JPEG bytes checked (whole chunks / segments, see above) and opened
 // by OpenImageIO through `proxy`, which must outlive the returned input.
 // `what` names the bytes in errors ("payload", "file").
+// OpenImageIO reading the bytes behind `proxy` as the format `fileName` names.
+Result<std::unique_ptr<OIIO::ImageInput>> openWithProxy(const char* fileName,
+                                                        OIIO::Filesystem::IOMemReader& proxy) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  // OpenImageIO 2.4 only honours the proxy next to other configuration
+  // hints when it arrives as the "oiio:ioproxy" hint itself.
+  void* proxyPointer = &proxy;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
+  std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(fileName, &config);
+  if (!input) {
+    return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + OIIO::geterror());
+  }
+  return input;
+}
+
+// A TGA file's 18-byte header, checked before OpenImageIO sees the bytes:
+// no colour map, true-colour or grey (raw 2/3, RLE 10/11), 8/16/24/32 bits,
+// sides >= 1, and a raw image's pixels all inside the file.
+bool tgaHeaderSafe(const std::uint8_t* data, std::size_t size) {
+  constexpr std::size_t kHeader = 18;
+  if (size < kHeader) return false;
+  const unsigned idLength = data[0];
+  const unsigned colorMapType = data[1];
+  const unsigned imageType = data[2];
+  const unsigned width = data[12] | (unsigned(data[13]) << 8);
+  const unsigned height = data[14] | (unsigned(data[15]) << 8);
+  const unsigned bits = data[16];
+  if (colorMapType != 0) return false;
+  if (imageType != 2 && imageType != 3 && imageType != 10 && imageType != 11) return false;
+  if (bits != 8 && bits != 16 && bits != 24 && bits != 32) return false;
+  if (width == 0 || height == 0) return false;
+  if (size < kHeader + idLength) return false;
+  if (imageType == 2 || imageType == 3) {
+    const std::uint64_t pixels = std::uint64_t(width) * height * (bits / 8);
+    if (size < kHeader + idLength + pixels) return false;
+  }
+  return true;
+}
+
 Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::uint8_t* data, std::size_t size,
                                                     TextureCodec codec, const char* what,
                                                     OIIO::Filesystem::IOMemReader& proxy) {
@@ -190,17 +231,7 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::uint8_t* data, st
     return textureError(ErrorCode::kParseError,
                         std::string("JPEG ") + what + " has a malformed header");
   }
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  // OpenImageIO 2.4 only honours the proxy next to other configuration
-  // hints when it arrives as the "oiio:ioproxy" hint itself.
-  void* proxyPointer = &proxy;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
-  std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(formatFileName(codec), &config);
-  if (!input) {
-    return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + OIIO::geterror());
-  }
-  return input;
+  return openWithProxy(formatFileName(codec), proxy);
 }
 
 // RGBA8 from an image's pixels (1 grey, 2 grey + alpha, 3 RGB, 4+ RGBA).
@@ -361,17 +392,20 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
                                                            std::to_string(limits.maxPayloadBytes));
   }
   static constexpr std::uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  TextureCodec codec;
+  TextureCodec codec = TextureCodec::kNone;  // kNone: TGA (no magic; header checked)
   if (size >= 8 && std::equal(kPngMagic, kPngMagic + 8, data)) {
     codec = TextureCodec::kPng;
   } else if (size >= 2 && data[0] == 0xFF && data[1] == 0xD8) {
     codec = TextureCodec::kJpeg;
-  } else {
-    return textureError(ErrorCode::kUnsupported, "not a PNG or JPEG file (only those are read)");
+  } else if (!tgaHeaderSafe(data, size)) {
+    return textureError(ErrorCode::kUnsupported,
+                        "not a PNG, JPEG or TGA file (only those are read)");
   }
   try {
     OIIO::Filesystem::IOMemReader proxy(data, size);
-    Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(data, size, codec, "file", proxy);
+    Result<std::unique_ptr<OIIO::ImageInput>> opened =
+        codec == TextureCodec::kNone ? openWithProxy("file.tga", proxy)
+                                     : openImage(data, size, codec, "file", proxy);
     if (!opened.ok()) return opened.status();
     std::unique_ptr<OIIO::ImageInput> input = std::move(opened).value();
     const OIIO::ImageSpec& spec = input->spec();
@@ -405,6 +439,15 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
   } catch (const std::exception& e) {
     return textureError(ErrorCode::kParseError, std::string("OpenImageIO threw: ") + e.what());
   }
+}
+
+Result<RgbaImage> readImageFile(const std::string& path, const DecodeLimits& limits) {
+  Result<std::string> bytes = readFileBounded(path, limits.maxPayloadBytes);
+  if (!bytes.ok()) return bytes.status();  // names the path already
+  Result<RgbaImage> decoded = decodeImageFile(
+      reinterpret_cast<const std::uint8_t*>(bytes->data()), bytes->size(), limits);
+  if (!decoded.ok()) return Status(decoded.status().code(), path + ": " + decoded.status().message());
+  return decoded;
 }
 
 }  // namespace thinlod::codec

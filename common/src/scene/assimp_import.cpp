@@ -326,11 +326,6 @@ class Converter {
     if (ai_.mNumCameras > 0) warn(std::to_string(ai_.mNumCameras) + " camera(s) ignored");
     if (ai_.mNumLights > 0) warn(std::to_string(ai_.mNumLights) + " light(s) ignored");
     if (ai_.mNumAnimations > 0) warn(std::to_string(ai_.mNumAnimations) + " animation(s) ignored");
-    if (texturesRecorded_) {
-      warn(
-          "base-colour textures: drawn in the frontend's reference only (the link does not carry "
-          "them yet)");
-    }
     return std::move(scene_);
   }
 
@@ -553,7 +548,6 @@ class Converter {
       if (src.GetTextureCount(type) > 0 && src.GetTexture(type, 0, &texture) == AI_SUCCESS &&
           texture.length > 0) {
         out.textureUrl = texture.C_Str();
-        texturesRecorded_ = true;
         break;
       }
     }
@@ -572,7 +566,6 @@ class Converter {
   Scene scene_;
   std::uint32_t nextId_ = 1;
   std::map<unsigned, NodePtr> shapes_;  // by Assimp mesh index: one Shape per mesh
-  bool texturesRecorded_ = false;
 };
 
 const char* formatName(const std::string& ext) {

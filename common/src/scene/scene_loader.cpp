@@ -12,6 +12,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+}  // namespace
+
 // Urls name files below a search directory: no scheme, no absolute path,
 // no "..".
 Status checkUrl(const std::string& url, const std::string& where) {
@@ -32,6 +34,8 @@ Status checkUrl(const std::string& url, const std::string& where) {
   }
   return Status();
 }
+
+namespace {
 
 void forEachShape(const Node& node, std::map<const Node*, bool>& seen,
                   std::vector<ShapeNode*>& out) {
@@ -77,27 +81,41 @@ void resolveTextures(Scene& scene, const std::string& sceneDirectory) {
   for (ShapeNode* shape : shapes) {
     Appearance& appearance = shape->appearance;
     if (appearance.textureUrl.empty() || !appearance.texturePath.empty()) continue;
-    const std::string where = "texture '" + appearance.textureUrl + "'";
-    if (appearance.textureUrl[0] == '*') {
-      scene.warnings.push_back(where + ": embedded textures are not read yet; drawn untextured");
-      continue;
-    }
-    const Status url = checkUrl(appearance.textureUrl, where);
-    if (!url.ok()) {
-      scene.warnings.push_back(url.message() + "; drawn untextured");
-      continue;
-    }
     // Relative to the file that names it: the imported mesh file, else the scene.
     const fs::path base = shape->geometry.resolvedPath.empty()
                               ? fs::path(sceneDirectory)
                               : fs::path(shape->geometry.resolvedPath).parent_path();
-    const fs::path candidate = (base.empty() ? fs::path(".") : base) / appearance.textureUrl;
-    std::error_code ec;
-    if (!fs::is_regular_file(candidate, ec)) {
-      scene.warnings.push_back(where + ": no file " + candidate.string() + "; drawn untextured");
-      continue;
+    // The url, then the alternatives an ImageTexture listed: the first file that exists wins.
+    std::vector<std::string> urls{appearance.textureUrl};
+    urls.insert(urls.end(), appearance.textureAlternatives.begin(),
+                appearance.textureAlternatives.end());
+    std::string missing;
+    for (const std::string& textureUrl : urls) {
+      const std::string where = "texture '" + textureUrl + "'";
+      if (textureUrl[0] == '*') {
+        scene.warnings.push_back(where + ": embedded textures are not read yet; drawn untextured");
+        missing.clear();
+        break;
+      }
+      const Status url = checkUrl(textureUrl, where);
+      if (!url.ok()) {
+        scene.warnings.push_back(url.message() + "; drawn untextured");
+        missing.clear();
+        break;
+      }
+      const fs::path candidate = (base.empty() ? fs::path(".") : base) / textureUrl;
+      std::error_code ec;
+      if (fs::is_regular_file(candidate, ec)) {
+        appearance.texturePath = candidate.string();
+        missing.clear();
+        break;
+      }
+      missing += (missing.empty() ? "" : ", ") + candidate.string();
     }
-    appearance.texturePath = candidate.string();
+    if (!missing.empty()) {
+      scene.warnings.push_back("texture '" + appearance.textureUrl + "': no file " + missing +
+                               "; drawn untextured");
+    }
   }
 }
 

@@ -47,7 +47,16 @@ const char* describe(TokenKind kind) {
 
 // What a DEF name stands for: scene-graph nodes are shared, value nodes
 // (Appearance, Material, geometry, Coordinate, ConicRange) are copied on USE.
-enum class DefKind { kSceneNode, kAppearance, kMaterial, kGeometry, kCoordinate, kConicRange };
+enum class DefKind {
+  kSceneNode,
+  kAppearance,
+  kMaterial,
+  kGeometry,
+  kCoordinate,
+  kConicRange,
+  kImageTexture,
+  kTextureCoordinate
+};
 
 const char* describe(DefKind kind) {
   switch (kind) {
@@ -63,6 +72,10 @@ const char* describe(DefKind kind) {
       return "a Coordinate";
     case DefKind::kConicRange:
       return "a ConicRange";
+    case DefKind::kImageTexture:
+      return "an ImageTexture";
+    case DefKind::kTextureCoordinate:
+      return "a TextureCoordinate";
   }
   return "?";
 }
@@ -75,6 +88,8 @@ struct DefEntry {
   Geometry geometry;
   std::vector<glm::vec3> points;
   ConicRange range;
+  std::vector<std::string> textureUrls;   // kImageTexture
+  std::vector<glm::vec2> texturePoints;   // kTextureCoordinate
 };
 
 class Parser {
@@ -729,7 +744,8 @@ class Parser {
 
   static bool isValueNodeName(std::string_view t) {
     return t == "Appearance" || t == "Material" || t == "Sphere" || t == "Cylinder" || t == "Box" ||
-           t == "Cone" || t == "IndexedFaceSet" || t == "Coordinate" || t == "ConicRange";
+           t == "Cone" || t == "IndexedFaceSet" || t == "Coordinate" || t == "ConicRange" ||
+           t == "ImageTexture" || t == "TextureCoordinate";
   }
 
   bool parseScale(glm::vec3* out) {
@@ -902,8 +918,9 @@ class Parser {
     Appearance a;
     bool ok = parseBody(type, [&](std::string_view f, const Token& at) {
       if (f == "material") return parseMaterialField(&a);
-      if (f == "texture" || f == "textureTransform") {
-        return fail(at, quoted(f) + " is not supported (no textures in scene files)");
+      if (f == "texture") return parseTextureField(&a);
+      if (f == "textureTransform") {
+        return fail(at, quoted(f) + " is not supported (texture coordinates are used as given)");
       }
       return false;
     });
@@ -915,6 +932,66 @@ class Parser {
       e.appearance = a;
       defs_[defName] = e;
     }
+    return true;
+  }
+
+  // texture ImageTexture { url [...] repeatS repeatT } | USE name | NULL.
+  // Every url must pass checkUrl (a relative file name): a parse error here.
+  bool parseTextureField(Appearance* appearance) {
+    std::vector<std::string> urls;
+    if (tok_.kind == TokenKind::kWord && tok_.text == "NULL") {
+      advance();
+      appearance->textureUrl.clear();
+      appearance->textureAlternatives.clear();
+      return true;
+    }
+    const DefEntry* used = nullptr;
+    bool isUse = false;
+    if (!parseUse(DefKind::kImageTexture, &used, &isUse)) return false;
+    if (isUse) {
+      urls = used->textureUrls;
+    } else {
+      std::string defName;
+      if (!parseDefPrefix(&defName)) return false;
+      if (!lexOk()) return false;
+      if (!(tok_.kind == TokenKind::kWord && tok_.text == "ImageTexture")) {
+        if (tok_.kind == TokenKind::kWord &&
+            (tok_.text == "PixelTexture" || tok_.text == "MovieTexture")) {
+          return fail(tok_, quoted(tok_.text) + " is not supported (only ImageTexture)");
+        }
+        return unexpected("ImageTexture");
+      }
+      const Token type = tok_;
+      advance();
+      NodeScope scope(*this, type);
+      if (!scope.ok) return false;
+      bool ignoredBool = false;
+      Token urlToken = type;
+      bool ok = parseBody(type, [&](std::string_view f, const Token& at) {
+        if (f == "url") {
+          urlToken = at;
+          return parseMFString(&urls);
+        }
+        if (f == "repeatS" || f == "repeatT") return parseBool(&ignoredBool);
+        return false;
+      });
+      if (!ok) return false;
+      if (urls.empty()) return fail(urlToken, "ImageTexture has no url");
+      for (const std::string& url : urls) {
+        const Status checked = checkUrl(url, "ImageTexture");
+        if (!checked.ok()) {
+          return fail(checked.code(), urlToken.line, urlToken.column, checked.message());
+        }
+      }
+      if (!defName.empty()) {
+        DefEntry e;
+        e.kind = DefKind::kImageTexture;
+        e.textureUrls = urls;
+        defs_[defName] = e;
+      }
+    }
+    appearance->textureUrl = urls.front();
+    appearance->textureAlternatives.assign(urls.begin() + 1, urls.end());
     return true;
   }
 
@@ -1063,7 +1140,11 @@ class Parser {
     return true;
   }
 
-  bool parseCoordinateField(std::vector<glm::vec3>* points) {
+  // `coord Coordinate { point [...] }` and `texCoord TextureCoordinate { point
+  // [...] }`: a point-list value node, or USE of one, or NULL.
+  template <typename Point, typename ParseOne>
+  bool parsePointNodeField(const char* nodeName, DefKind kind, std::vector<Point> DefEntry::*stored,
+                           std::vector<Point>* points, ParseOne parseOne) {
     if (tok_.kind == TokenKind::kWord && tok_.text == "NULL") {
       advance();
       points->clear();
@@ -1071,40 +1152,51 @@ class Parser {
     }
     const DefEntry* used = nullptr;
     bool isUse = false;
-    if (!parseUse(DefKind::kCoordinate, &used, &isUse)) return false;
+    if (!parseUse(kind, &used, &isUse)) return false;
     if (isUse) {
-      *points = used->points;
+      *points = used->*stored;
       return true;
     }
     std::string defName;
     if (!parseDefPrefix(&defName)) return false;
     if (!lexOk()) return false;
-    if (!(tok_.kind == TokenKind::kWord && tok_.text == "Coordinate")) {
-      return unexpected("Coordinate");
-    }
+    if (!(tok_.kind == TokenKind::kWord && tok_.text == nodeName)) return unexpected(nodeName);
     const Token type = tok_;
     advance();
     NodeScope scope(*this, type);
     if (!scope.ok) return false;
     bool ok = parseBody(type, [&](std::string_view f, const Token&) {
-      if (f == "point") {
-        return parseMF<glm::vec3>(points, [&](glm::vec3* v) { return parseVec3(v); });
-      }
+      if (f == "point") return parseMF<Point>(points, parseOne);
       return false;
     });
     if (!ok) return false;
     if (!defName.empty()) {
       DefEntry e;
-      e.kind = DefKind::kCoordinate;
-      e.points = *points;
+      e.kind = kind;
+      e.*stored = *points;
       defs_[defName] = e;
     }
     return true;
   }
 
+  bool parseCoordinateField(std::vector<glm::vec3>* points) {
+    return parsePointNodeField<glm::vec3>("Coordinate", DefKind::kCoordinate, &DefEntry::points,
+                                          points, [&](glm::vec3* v) { return parseVec3(v); });
+  }
+
+  bool parseTextureCoordinateField(std::vector<glm::vec2>* points) {
+    return parsePointNodeField<glm::vec2>("TextureCoordinate", DefKind::kTextureCoordinate,
+                                          &DefEntry::texturePoints, points,
+                                          [&](glm::vec2* v) { return parseVec2(v); });
+  }
+
   bool parseIndexedFaceSet(const Token& type, Geometry* g) {
     std::vector<glm::vec3> points;
     std::vector<std::int32_t> coordIndex;
+    std::vector<glm::vec2> texPoints;
+    std::vector<std::int32_t> texCoordIndex;
+    bool hasTexCoord = false;
+    Token texIndexToken = type;
     Token indexToken = type;
     bool ccw = true;
     bool ignoredBool = false;
@@ -1120,15 +1212,35 @@ class Parser {
         return parseBool(&ignoredBool);
       }
       if (f == "creaseAngle") return parseFloat(&ignoredFloat);
-      if (isField(f,
-                  {"color", "normal", "texCoord", "colorIndex", "normalIndex", "texCoordIndex"})) {
+      if (f == "texCoord") {
+        if (texCoordIndex.empty()) texIndexToken = at;
+        hasTexCoord = true;
+        return parseTextureCoordinateField(&texPoints);
+      }
+      if (f == "texCoordIndex") {
+        texIndexToken = at;
+        return parseMF<std::int32_t>(&texCoordIndex, [&](std::int32_t* v) { return parseInt(v); });
+      }
+      if (isField(f, {"color", "normal", "colorIndex", "normalIndex"})) {
         return fail(at, quoted(f) + " is not supported in IndexedFaceSet");
       }
       return false;
     });
     if (!ok) return false;
     auto mesh = std::make_shared<IndexedMesh>();
-    mesh->positions = std::move(points);
+    // With texture coordinates a vertex is a (coordIndex, texCoordIndex)
+    // pair (VRML97 6.23: texCoordIndex parallels coordIndex, or coordIndex
+    // indexes the TextureCoordinate too when it is empty).
+    const bool textured = hasTexCoord && !texPoints.empty();
+    if (!textured && !texCoordIndex.empty()) {
+      return fail(texIndexToken, "texCoordIndex without a TextureCoordinate");
+    }
+    if (textured && !texCoordIndex.empty() && texCoordIndex.size() != coordIndex.size()) {
+      return fail(texIndexToken, "texCoordIndex has " + std::to_string(texCoordIndex.size()) +
+                                     " entries, coordIndex " + std::to_string(coordIndex.size()));
+    }
+    std::map<std::pair<std::int32_t, std::int32_t>, std::uint32_t> pairVertex;
+    if (!textured) mesh->positions = points;
     std::vector<std::uint32_t> polygon;
     auto flush = [&]() -> bool {
       if (polygon.empty()) return true;
@@ -1149,15 +1261,38 @@ class Parser {
     for (std::size_t i = 0; i < coordIndex.size(); ++i) {
       const std::int32_t v = coordIndex[i];
       if (v == -1) {
+        if (textured && !texCoordIndex.empty() && texCoordIndex[i] != -1) {
+          return fail(texIndexToken, "texCoordIndex entry " + std::to_string(i) + " is " +
+                                         std::to_string(texCoordIndex[i]) +
+                                         " where coordIndex ends a face (-1)");
+        }
         if (!flush()) return false;
         continue;
       }
-      if (v < 0 || static_cast<std::size_t>(v) >= mesh->positions.size()) {
+      if (v < 0 || static_cast<std::size_t>(v) >= points.size()) {
         return fail(indexToken, "coordIndex entry " + std::to_string(i) + " is " +
                                     std::to_string(v) + " but Coordinate has " +
-                                    std::to_string(mesh->positions.size()) + " points");
+                                    std::to_string(points.size()) + " points");
       }
-      polygon.push_back(static_cast<std::uint32_t>(v));
+      if (!textured) {
+        polygon.push_back(static_cast<std::uint32_t>(v));
+        continue;
+      }
+      const std::int32_t t = texCoordIndex.empty() ? v : texCoordIndex[i];
+      if (t < 0 || static_cast<std::size_t>(t) >= texPoints.size()) {
+        const char* field = texCoordIndex.empty() ? "coordIndex" : "texCoordIndex";
+        return fail(texCoordIndex.empty() ? indexToken : texIndexToken,
+                    std::string(field) + " entry " + std::to_string(i) + " is " +
+                        std::to_string(t) + " but TextureCoordinate has " +
+                        std::to_string(texPoints.size()) + " points");
+      }
+      auto [slot, added] = pairVertex.emplace(std::make_pair(v, t),
+                                              static_cast<std::uint32_t>(mesh->positions.size()));
+      if (added) {
+        mesh->positions.push_back(points[static_cast<std::size_t>(v)]);
+        mesh->uvs.push_back(texPoints[static_cast<std::size_t>(t)]);
+      }
+      polygon.push_back(slot->second);
     }
     if (!flush()) return false;
     mesh->computeNormals();

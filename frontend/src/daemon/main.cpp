@@ -292,6 +292,9 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
 
   ReplayOptions replay = options.replay;
   if (scene) replay.conversion.meshColors = &scene->meshColors;
+  // Shared textures the backbone sent (docs/protocol.md, "Shared textures").
+  SharedTextureCache sharedTextures;
+  replay.conversion.sharedTextures = &sharedTextures;
 
   DaemonObserver observer(**log, **producer, options);
   (*producer)->setScoredSink(

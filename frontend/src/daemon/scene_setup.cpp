@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "thinlod/common/codec/encoding.h"
-#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
 
@@ -33,17 +32,12 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     const auto known = textures.find(path);
     if (known != textures.end()) return known->second;
     std::shared_ptr<const RgbaImage> image;
-    const codec::DecodeLimits limits;
-    Result<std::string> bytes = readFileBounded(path, limits.maxPayloadBytes);
-    Result<RgbaImage> decoded =
-        bytes.ok() ? codec::decodeImageFile(reinterpret_cast<const std::uint8_t*>(bytes->data()),
-                                            bytes->size(), limits)
-                   : Result<RgbaImage>(bytes.status());
+    Result<RgbaImage> decoded = codec::readImageFile(path);
     if (decoded.ok()) {
       image = std::make_shared<const RgbaImage>(std::move(decoded).value());
       ++loaded.textures;
     } else {
-      loaded.warnings.push_back(path + ": " + decoded.status().message() + "; drawn untextured");
+      loaded.warnings.push_back(decoded.status().message() + "; drawn untextured");
     }
     textures.emplace(path, image);
     return image;

@@ -90,12 +90,26 @@ Result<std::shared_ptr<const RgbaImage>> convertTexture(const protocol::Texture&
   return std::shared_ptr<const RgbaImage>(std::make_shared<RgbaImage>(std::move(decoded).value()));
 }
 
+using TextureMap = std::map<std::uint64_t, std::shared_ptr<const RgbaImage>>;
+
+Result<Representation> convertOne(const protocol::Representation& wire, std::uint64_t objectId,
+                                  const ConversionOptions& options, const TextureMap* updateTextures,
+                                  const std::string& what);
+
 }  // namespace
 
 Result<Representation> convertRepresentation(const protocol::Representation& wire,
                                              std::uint64_t objectId,
                                              const ConversionOptions& options,
                                              const std::string& what) {
+  return convertOne(wire, objectId, options, nullptr, what);
+}
+
+namespace {
+
+Result<Representation> convertOne(const protocol::Representation& wire, std::uint64_t objectId,
+                                  const ConversionOptions& options, const TextureMap* updateTextures,
+                                  const std::string& what) {
   if (!knownKind(wire.kind)) {
     return invalid(what,
                    "unknown representation kind " + std::to_string(static_cast<int>(wire.kind)));
@@ -156,6 +170,29 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
       convertTexture(wire.texture, options, what + ": texture");
   if (!texture.ok()) return texture.status();
   rep.texture = std::move(texture).value();
+  if (wire.textureId != 0) {
+    if (rep.kind != RepresentationKind::kMesh && rep.kind != RepresentationKind::kHybrid) {
+      return invalid(what, kindName + " names shared texture " + std::to_string(wire.textureId));
+    }
+    if (rep.texture != nullptr) {
+      return invalid(what, "names shared texture " + std::to_string(wire.textureId) +
+                               " and carries an inline texture");
+    }
+    std::shared_ptr<const RgbaImage> shared;
+    if (updateTextures != nullptr) {
+      auto found = updateTextures->find(wire.textureId);
+      if (found != updateTextures->end()) shared = found->second;
+    }
+    if (shared == nullptr && options.sharedTextures != nullptr) {
+      auto found = options.sharedTextures->textures.find(wire.textureId);
+      if (found != options.sharedTextures->textures.end()) shared = found->second;
+    }
+    if (shared == nullptr) {
+      return invalid(what, "names shared texture " + std::to_string(wire.textureId) +
+                               ", which neither this update nor an earlier one carried");
+    }
+    rep.texture = std::move(shared);
+  }
   if (rep.kind != RepresentationKind::kMesh && rep.kind != RepresentationKind::kHybrid &&
       rep.texture == nullptr) {
     return invalid(what, kindName + " has no texture (codec None)");
@@ -174,6 +211,8 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
   return rep;
 }
 
+}  // namespace
+
 Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
                                  const ConversionOptions& options) {
   SceneBatch batch;
@@ -181,6 +220,48 @@ Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
   batch.operations.reserve(update.operations.size());
   const std::string updateName =
       "SceneUpdate plan " + std::to_string(update.plan) + " frame " + std::to_string(update.frame);
+  // Shared textures first, all or none.
+  TextureMap updateTextures;
+  std::size_t addedBytes = 0;
+  std::size_t replacedBytes = 0;
+  std::size_t newIds = 0;
+  for (std::size_t i = 0; i < update.textures.size(); ++i) {
+    const protocol::SharedTexture& shared = update.textures[i];
+    const std::string what = updateName + ", shared texture " + std::to_string(i) + " (id " +
+                             std::to_string(shared.textureId) + ")";
+    if (shared.textureId == 0) return invalid(what, "texture id 0");
+    if (shared.texture.codec == protocol::TextureCodec::kNone) {
+      return invalid(what, "codec None");
+    }
+    Result<std::shared_ptr<const RgbaImage>> image = convertTexture(shared.texture, options, what);
+    if (!image.ok()) return image.status();
+    if (!updateTextures.emplace(shared.textureId, *image).second) {
+      return invalid(what, "id listed twice");
+    }
+    addedBytes += (*image)->pixels.size();
+    if (options.sharedTextures != nullptr) {
+      auto held = options.sharedTextures->textures.find(shared.textureId);
+      if (held != options.sharedTextures->textures.end()) {
+        replacedBytes += held->second->pixels.size();
+      } else {
+        ++newIds;
+      }
+    }
+  }
+  if (options.sharedTextures != nullptr && !updateTextures.empty()) {
+    SharedTextureCache& cache = *options.sharedTextures;
+    const std::size_t count = cache.textures.size() + newIds;
+    const std::size_t bytes = cache.decodedBytes - replacedBytes + addedBytes;
+    if (count > options.maxSharedTextures || bytes > options.maxSharedTextureBytes) {
+      return Status(ErrorCode::kResourceExhausted,
+                    updateName + ": shared textures would grow to " + std::to_string(count) +
+                        " textures / " + std::to_string(bytes) + " bytes, limit " +
+                        std::to_string(options.maxSharedTextures) + " / " +
+                        std::to_string(options.maxSharedTextureBytes));
+    }
+    for (auto& [id, image] : updateTextures) cache.textures[id] = image;
+    cache.decodedBytes = bytes;
+  }
   for (std::size_t i = 0; i < update.operations.size(); ++i) {
     const protocol::SceneOperation& wireOp = update.operations[i];
     const std::string what = updateName + ", operation " + std::to_string(i) + " (object " +
@@ -192,7 +273,7 @@ Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
     } else if (wireOp.type == protocol::SceneOperation::Type::kAddOrReplace) {
       op.type = SceneOperation::Type::kAddOrReplace;
       Result<Representation> rep =
-          convertRepresentation(wireOp.representation, wireOp.objectId, options, what);
+          convertOne(wireOp.representation, wireOp.objectId, options, &updateTextures, what);
       if (!rep.ok()) return rep.status();
       op.representation = std::move(rep).value();
     } else {
@@ -209,6 +290,7 @@ std::size_t payloadBytes(const protocol::SceneUpdate& update) {
   for (const protocol::SceneOperation& op : update.operations) {
     bytes += op.representation.mesh.size() + op.representation.texture.data.size();
   }
+  for (const protocol::SharedTexture& shared : update.textures) bytes += shared.texture.data.size();
   return bytes;
 }
 

@@ -16,6 +16,10 @@
 //   kZstd are codec frames (codec::decodeTexture) whose own codec byte
 //   and decoded size must match the wire's codec, width and height. kNone is
 //   "no texture": an error for impostors (their lighting lives in it).
+// - Shared textures (SceneUpdate::textures): see ConversionOptions; a mesh or
+//   hybrid naming a texture id gets that image (and needs uvs); an unknown id
+//   is an error naming it. Going past maxSharedTextures / maxSharedTextureBytes
+//   refuses the update (kResourceExhausted) and adds none of its textures.
 // - Colour: impostors are white (lighting baked in); meshes take the colour
 //   the scene file gives their object (`meshColors`, by object id), white
 //   when the id is not listed. Transform, generation and kind are copied.
@@ -27,6 +31,7 @@
 #include <cstdint>
 #include <glm/vec4.hpp>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "thinlod/common/codec/encoding.h"
@@ -39,9 +44,25 @@ namespace thinlod::frontend::daemon {
 
 using MeshColors = std::map<std::uint64_t, glm::vec4>;  // object id -> RGBA in [0,1]
 
+// Shared textures held for the session, by SharedTexture id (docs/protocol.md,
+// "Shared textures"). Held representations keep their own reference, so a
+// texture outlives the cache entry.
+struct SharedTextureCache {
+  std::map<std::uint64_t, std::shared_ptr<const RgbaImage>> textures;
+  std::size_t decodedBytes = 0;  // RGBA bytes of `textures`
+};
+
 struct ConversionOptions {
   const MeshColors* meshColors = nullptr;  // may be null: every mesh is white
   codec::DecodeLimits limits;
+  // Shared textures: an update's SharedTextures are decoded first (all or the
+  // update is refused) and added here before its operations are converted, so
+  // they stay held even when an operation is then refused; a later texture with
+  // a held id replaces it. A representation's textureId must name one of this
+  // update or one held here. Null: only the update's own textures resolve.
+  SharedTextureCache* sharedTextures = nullptr;
+  std::size_t maxSharedTextures = 4096;                  // held at once
+  std::size_t maxSharedTextureBytes = std::size_t{1} << 30;  // decoded RGBA bytes held
 };
 
 // One representation; `what` prefixes error messages.
@@ -50,7 +71,8 @@ Result<Representation> convertRepresentation(const protocol::Representation& wir
                                              const ConversionOptions& options,
                                              const std::string& what);
 
-// The whole update as one batch (plan copied), or the first error.
+// The whole update as one batch (plan copied), or the first error. Adds the
+// update's shared textures to options.sharedTextures (see ConversionOptions).
 Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
                                  const ConversionOptions& options);
 

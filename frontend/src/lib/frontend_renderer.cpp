@@ -108,7 +108,11 @@ struct FrontendRenderer::Impl {
     render::TextureOptions textureOptions;
     textureOptions.linearFilter = options.linearFilter;
     textureOptions.mipmaps = false;
-    textureOptions.clampToEdge = true;
+    // Repeat: a mesh's base-colour texture tiles (uvs may leave [0, 1]) and
+    // fills its whole layer (fitRepeatingTextureToLayer); impostor textures
+    // keep their uvs inside their own texels and transparent borders, so the
+    // wrap changes nothing for them, and one sampler keeps one draw call.
+    textureOptions.clampToEdge = false;
     auto texture = renderer->createTextureArray(options.layerSize, options.layerSize,
                                                 options.layersPerPage, textureOptions);
     if (!texture.ok()) return texture.status();
@@ -173,11 +177,15 @@ struct FrontendRenderer::Impl {
     if (rep.texture != nullptr) {
       int page = 0;
       int layer = 0;
+      // A mesh's base-colour texture tiles (uvs may leave [0, 1]); an
+      // impostor's is clamped.
+      const bool repeat = part.batch.lit;
       THINLOD_RETURN_IF_ERROR(acquireLayer(page, layer));
       part.batch.page = page;
       part.layer = layer;
       const detail::FittedTexture fitted =
-          detail::fitTextureToLayer(*rep.texture, options.layerSize);
+          repeat ? detail::fitRepeatingTextureToLayer(*rep.texture, options.layerSize)
+                 : detail::fitTextureToLayer(*rep.texture, options.layerSize);
       Status status = renderer->setTextureLayer(pages[page].texture, layer,
                                                 fitted.useSource ? *rep.texture : fitted.image);
       if (!status.ok()) {

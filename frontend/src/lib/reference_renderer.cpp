@@ -69,6 +69,7 @@ struct ReferenceRenderer::Impl {
     if (it != textures.end()) return it->second.handle;
     render::TextureOptions textureOptions;
     textureOptions.linearFilter = options.linearFilter;
+    textureOptions.clampToEdge = false;  // base-colour textures tile (glTF / VRML repeat)
     auto handle = renderer->uploadTexture(*image, textureOptions);
     if (!handle.ok()) return handle.status();
     textures.emplace(image.get(), CacheEntry<RgbaImage, render::TextureHandle>{image, *handle});

@@ -1,6 +1,7 @@
 #include "texture_fit.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cassert>
 #include <cstdint>
 #include <cstring>
@@ -41,6 +42,18 @@ RgbaImage shrinkImage(const RgbaImage& source, int width, int height) {
   return out;
 }
 
+namespace {
+
+// `source`, or `storage` holding it shrunk so that no side exceeds the layer.
+const RgbaImage* shrunkToLayer(const RgbaImage& source, int layerSize, RgbaImage& storage) {
+  if (source.width <= layerSize && source.height <= layerSize) return &source;
+  storage =
+      shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
+  return &storage;
+}
+
+}  // namespace
+
 FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
   assert(layerSize >= 1 && source.consistent() && !source.empty());
   FittedTexture fitted;
@@ -48,13 +61,8 @@ FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
     fitted.useSource = true;
     return fitted;
   }
-  const RgbaImage* image = &source;
   RgbaImage shrunk;
-  if (source.width > layerSize || source.height > layerSize) {
-    shrunk =
-        shrinkImage(source, std::min(source.width, layerSize), std::min(source.height, layerSize));
-    image = &shrunk;
-  }
+  const RgbaImage* image = shrunkToLayer(source, layerSize, shrunk);
   const int w = image->width;
   const int h = image->height;
   fitted.uvScale = glm::vec2(static_cast<float>(w) / layerSize, static_cast<float>(h) / layerSize);
@@ -72,6 +80,51 @@ FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize) {
     if (padRight != 0) std::memcpy(padded.at(w, y), image->at(w - 1, sourceRow), 4);
   }
   fitted.image = std::move(padded);
+  return fitted;
+}
+
+FittedTexture fitRepeatingTextureToLayer(const RgbaImage& source, int layerSize) {
+  assert(layerSize >= 1 && source.consistent() && !source.empty());
+  FittedTexture fitted;
+  if (source.width == layerSize && source.height == layerSize) {
+    fitted.useSource = true;
+    return fitted;
+  }
+  RgbaImage shrunk;
+  const RgbaImage* image = shrunkToLayer(source, layerSize, shrunk);
+  if (image->width == layerSize && image->height == layerSize) {
+    fitted.image = std::move(shrunk);
+    return fitted;
+  }
+  // Bilinear enlargement, texel centres aligned, neighbours wrapping around.
+  const int w = image->width;
+  const int h = image->height;
+  RgbaImage out(layerSize, layerSize);
+  for (int y = 0; y < layerSize; ++y) {
+    const float sy = (static_cast<float>(y) + 0.5f) * static_cast<float>(h) / layerSize - 0.5f;
+    const int y0 = static_cast<int>(std::floor(sy));
+    const float fy = sy - static_cast<float>(y0);
+    const int ya = (y0 % h + h) % h;
+    const int yb = ((y0 + 1) % h + h) % h;
+    for (int x = 0; x < layerSize; ++x) {
+      const float sx = (static_cast<float>(x) + 0.5f) * static_cast<float>(w) / layerSize - 0.5f;
+      const int x0 = static_cast<int>(std::floor(sx));
+      const float fx = sx - static_cast<float>(x0);
+      const int xa = (x0 % w + w) % w;
+      const int xb = ((x0 + 1) % w + w) % w;
+      const std::uint8_t* p00 = image->at(xa, ya);
+      const std::uint8_t* p10 = image->at(xb, ya);
+      const std::uint8_t* p01 = image->at(xa, yb);
+      const std::uint8_t* p11 = image->at(xb, yb);
+      std::uint8_t* o = out.at(x, y);
+      for (int c = 0; c < 4; ++c) {
+        const float top = p00[c] + (p10[c] - p00[c]) * fx;
+        const float bottom = p01[c] + (p11[c] - p01[c]) * fx;
+        o[c] = static_cast<std::uint8_t>(std::lround(std::clamp(top + (bottom - top) * fy, 0.0f, 255.0f)));
+      }
+    }
+  }
+  fitted.image = std::move(out);
   return fitted;
 }
 

@@ -24,6 +24,14 @@ struct FittedTexture {
 // Precondition: source consistent and non-empty, layerSize >= 1.
 FittedTexture fitTextureToLayer(const RgbaImage& source, int layerSize);
 
+// A texture that repeats (a mesh's base-colour texture: uvs may leave
+// [0, 1], glTF's and VRML's default wrap is repeat): resampled to fill the
+// whole layer (uvScale 1) so the layer's repeat wrap tiles it. Larger sides
+// shrink as fitTextureToLayer does; smaller ones are enlarged bilinearly with
+// wrap-around neighbours (the texture tiles).
+// Precondition: source consistent and non-empty, layerSize >= 1.
+FittedTexture fitRepeatingTextureToLayer(const RgbaImage& source, int layerSize);
+
 // Alpha-weighted box filter to width x height (each <= the source's edge).
 RgbaImage shrinkImage(const RgbaImage& source, int width, int height);
 

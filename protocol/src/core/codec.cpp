@@ -57,19 +57,21 @@ fb::Offset<w::Error> errorOrNull(fb::FlatBufferBuilder& b, const Status& status)
   return w::CreateError(b, static_cast<w::ErrorCode>(errorCodeToWire(status.code())), message);
 }
 
+fb::Offset<w::Texture> build(fb::FlatBufferBuilder& b, const Texture& t) {
+  if (t.codec == TextureCodec::kNone) return 0;
+  auto data = bytesOrNull(b, t.data);
+  return w::CreateTexture(b, static_cast<w::TextureCodec>(t.codec), t.width, t.height, data);
+}
+
 fb::Offset<w::Representation> build(fb::FlatBufferBuilder& b, const Representation& r) {
   auto mesh = bytesOrNull(b, r.mesh);
-  fb::Offset<w::Texture> texture = 0;
-  if (r.texture.codec != TextureCodec::kNone) {
-    auto data = bytesOrNull(b, r.texture.data);
-    texture = w::CreateTexture(b, static_cast<w::TextureCodec>(r.texture.codec), r.texture.width,
-                               r.texture.height, data);
-  }
+  fb::Offset<w::Texture> texture = build(b, r.texture);
   const w::Mat4 transform = toWire(r.transform);
   const w::ConicRange validity = toWire(r.validity);
   return w::CreateRepresentation(b, r.representationId, r.generation,
                                  static_cast<w::RepresentationKind>(r.kind), mesh, texture,
-                                 &transform, &validity, r.accuracy, r.triangleCount, r.pointCount);
+                                 &transform, &validity, r.accuracy, r.triangleCount, r.pointCount,
+                                 r.textureId);
 }
 
 fb::Offset<fb::Vector<std::uint64_t>> idsOrNull(fb::FlatBufferBuilder& b,
@@ -117,7 +119,12 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Scene
     ops.push_back(w::CreateSceneOp(b, static_cast<w::SceneOpType>(op.type), op.objectId, rep));
   }
   auto opsVector = ops.empty() ? 0 : b.CreateVector(ops);
-  auto t = w::CreateSceneUpdate(b, m.plan, m.frame, m.targetAccuracy, opsVector);
+  std::vector<fb::Offset<w::SharedTexture>> textures;
+  textures.reserve(m.textures.size());
+  for (const SharedTexture& t : m.textures)
+    textures.push_back(w::CreateSharedTexture(b, t.textureId, build(b, t.texture)));
+  auto texturesVector = textures.empty() ? 0 : b.CreateVector(textures);
+  auto t = w::CreateSceneUpdate(b, m.plan, m.frame, m.targetAccuracy, opsVector, texturesVector);
   return {w::Body::SceneUpdate, t.Union()};
 }
 
@@ -300,6 +307,19 @@ Result<std::vector<std::uint64_t>> fromWire(const FieldPath& path,
   return std::vector<std::uint64_t>(v->begin(), v->end());
 }
 
+// A present texture table into `out` (left kNone when absent).
+Status fromWire(const FieldPath& path, const w::Texture* t, Texture* out) {
+  if (t == nullptr) return Status();
+  if (t->codec() == w::TextureCodec::None) {
+    return invalidField(path.child("codec"), "is None in a present texture");
+  }
+  out->codec = static_cast<TextureCodec>(t->codec());
+  out->width = t->width();
+  out->height = t->height();
+  out->data = toBytes(t->data());
+  return Status();
+}
+
 Result<Representation> fromWire(const FieldPath& path, const w::Representation* r) {
   THINLOD_RETURN_IF_ERROR(requirePresent(path, r));
   Representation out;
@@ -307,15 +327,7 @@ Result<Representation> fromWire(const FieldPath& path, const w::Representation* 
   out.generation = r->generation();
   out.kind = static_cast<RepresentationKind>(r->kind());
   out.mesh = toBytes(r->mesh());
-  if (const w::Texture* t = r->texture()) {
-    if (t->codec() == w::TextureCodec::None) {
-      return invalidField(path.child("texture.codec"), "is None in a present texture");
-    }
-    out.texture.codec = static_cast<TextureCodec>(t->codec());
-    out.texture.width = t->width();
-    out.texture.height = t->height();
-    out.texture.data = toBytes(t->data());
-  }
+  THINLOD_RETURN_IF_ERROR(fromWire(path.child("texture"), r->texture(), &out.texture));
   THINLOD_RETURN_IF_ERROR(requirePresent(path.child("transform"), r->transform()));
   out.transform = fromWire(*r->transform());
   THINLOD_RETURN_IF_ERROR(requirePresent(path.child("validity"), r->validity()));
@@ -323,6 +335,7 @@ Result<Representation> fromWire(const FieldPath& path, const w::Representation* 
   out.accuracy = r->accuracy();
   out.triangleCount = r->triangle_count();
   out.pointCount = r->point_count();
+  out.textureId = r->texture_id();
   return out;
 }
 
@@ -414,6 +427,21 @@ Result<Message> fromWire(const FieldPath& path, const w::SceneUpdate* m) {
         converted.representation = std::move(*rep);
       }
       out.operations.push_back(std::move(converted));
+    }
+  }
+  const auto* textures = m->textures();
+  THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("textures"), textures, kMaxSharedTextures));
+  if (textures != nullptr) {
+    out.textures.reserve(textures->size());
+    for (fb::uoffset_t i = 0; i < textures->size(); ++i) {
+      const FieldPath texturePath = path.element("textures", i);
+      const w::SharedTexture* t = textures->Get(i);
+      SharedTexture converted;
+      converted.textureId = t->texture_id();
+      THINLOD_RETURN_IF_ERROR(requirePresent(texturePath.child("texture"), t->texture()));
+      THINLOD_RETURN_IF_ERROR(
+          fromWire(texturePath.child("texture"), t->texture(), &converted.texture));
+      out.textures.push_back(std::move(converted));
     }
   }
   return Message(std::move(out));

@@ -62,7 +62,11 @@ bool operator==(const Representation& a, const Representation& b) {
   return a.representationId == b.representationId && a.generation == b.generation &&
          a.kind == b.kind && a.mesh == b.mesh && a.texture == b.texture &&
          a.transform == b.transform && a.validity == b.validity && a.accuracy == b.accuracy &&
-         a.triangleCount == b.triangleCount && a.pointCount == b.pointCount;
+         a.triangleCount == b.triangleCount && a.pointCount == b.pointCount &&
+         a.textureId == b.textureId;
+}
+bool operator==(const SharedTexture& a, const SharedTexture& b) {
+  return a.textureId == b.textureId && a.texture == b.texture;
 }
 bool operator==(const Hello& a, const Hello& b) {
   return a.minVersion == b.minVersion && a.maxVersion == b.maxVersion && a.role == b.role &&
@@ -85,7 +89,7 @@ bool operator==(const SceneOperation& a, const SceneOperation& b) {
 }
 bool operator==(const SceneUpdate& a, const SceneUpdate& b) {
   return a.plan == b.plan && a.frame == b.frame && a.targetAccuracy == b.targetAccuracy &&
-         a.operations == b.operations;
+         a.operations == b.operations && a.textures == b.textures;
 }
 bool operator==(const FrameStats& a, const FrameStats& b) {
   return a.frame == b.frame && a.plan == b.plan && a.timestampNs == b.timestampNs &&

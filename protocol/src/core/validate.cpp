@@ -200,6 +200,14 @@ Status checkRepresentation(const FieldPath& path, const Representation& rep) {
     return invalidField(path.child("texture"), std::string("is missing, required for kind ") +
                                                    representationKindName(rep.kind));
   }
+  if (rep.textureId != 0 && needsTexture) {
+    return invalidField(path.child("texture_id"), std::string("is set for kind ") +
+                                                      representationKindName(rep.kind) +
+                                                      ", which carries its own texture");
+  }
+  if (rep.textureId != 0 && rep.texture.codec != TextureCodec::kNone) {
+    return invalidField(path.child("texture_id"), "is set together with an inline texture");
+  }
   const FieldPath transformPath = path.child("transform");
   for (int c = 0; c < 4; ++c) {
     for (int r = 0; r < 4; ++r)
@@ -282,6 +290,24 @@ Status check(const FieldPath& path, const ViewerPose& m) {
 
 Status check(const FieldPath& path, const SceneUpdate& m) {
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("target_accuracy"), m.targetAccuracy));
+  THINLOD_RETURN_IF_ERROR(checkCount(path.child("textures"), m.textures.size(), kMaxSharedTextures));
+  std::vector<std::uint64_t> textureIds;
+  textureIds.reserve(m.textures.size());
+  for (std::size_t i = 0; i < m.textures.size(); ++i) {
+    const SharedTexture& t = m.textures[i];
+    const FieldPath texturePath = path.element("textures", i);
+    if (t.textureId == 0) return invalidField(texturePath.child("texture_id"), "is 0");
+    THINLOD_RETURN_IF_ERROR(checkTexture(texturePath.child("texture"), t.texture));
+    if (t.texture.codec == TextureCodec::kNone)
+      return invalidField(texturePath.child("texture"), "is missing");
+    textureIds.push_back(t.textureId);
+  }
+  std::sort(textureIds.begin(), textureIds.end());
+  const auto duplicateTexture = std::adjacent_find(textureIds.begin(), textureIds.end());
+  if (duplicateTexture != textureIds.end()) {
+    return invalidField(path.child("textures"),
+                        "lists texture id " + std::to_string(*duplicateTexture) + " twice");
+  }
   THINLOD_RETURN_IF_ERROR(
       checkCount(path.child("operations"), m.operations.size(), kMaxSceneOperations));
   static const Representation kNoRepresentation;

@@ -158,6 +158,11 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
                   "impostor: maxAngularError must be positive and finite");
   }
   if (scene.parts.empty()) return Status(ErrorCode::kInvalidArgument, "impostor: no parts");
+  if (!scene.textures.empty() && scene.textures.size() != scene.parts.size()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "impostor: " + std::to_string(scene.textures.size()) + " textures for " +
+                      std::to_string(scene.parts.size()) + " parts");
+  }
   pointScratch_.clear();
   std::size_t triangles = 0;
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {
@@ -168,6 +173,16 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
       return Status(ErrorCode::kInvalidArgument, name + ": model matrix singular or not finite");
     }
     THINLOD_RETURN_IF_ERROR(part.mesh->validate(name));
+    const RgbaImage* texture = i < scene.textures.size() ? scene.textures[i].get() : nullptr;
+    if (texture != nullptr) {
+      if (part.material.texture.valid())
+        return Status(ErrorCode::kInvalidArgument,
+                      name + ": both a texture and a material texture handle");
+      if (!texture->consistent() || texture->empty())
+        return Status(ErrorCode::kInvalidArgument, name + ": texture is empty or inconsistent");
+      if (part.mesh->uvs.empty())
+        return Status(ErrorCode::kInvalidArgument, name + ": textured mesh has no uvs");
+    }
     triangles += part.mesh->triangleCount();
     // Only referenced vertices frame the texture: stray points would waste texels.
     referencedScratch_.assign(part.mesh->vertexCount(), 0);
@@ -193,8 +208,19 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
       ++it;
     }
   }
+  for (auto it = textureCache_.begin(); it != textureCache_.end();) {
+    if (it->second.source.expired()) {
+      renderer_->deleteTexture(it->second.handle);
+      it = textureCache_.erase(it);
+    } else {
+      ++it;
+    }
+  }
   items.clear();
-  for (const ImpostorPart& part : scene.parts) {
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+    const ImpostorPart& part = scene.parts[i];
+    const std::shared_ptr<const RgbaImage> partTexture =
+        i < scene.textures.size() ? scene.textures[i] : nullptr;
     auto cached = meshCache_.find(part.mesh.get());
     if (cached == meshCache_.end() || cached->second.source.lock() != part.mesh) {
       auto handle = renderer_->uploadMesh(*part.mesh);
@@ -202,7 +228,21 @@ Status ImpostorRenderer::prepare(const ImpostorScene& scene, const ImpostorOptio
       meshCache_[part.mesh.get()] = CachedMesh{part.mesh, *handle};
       cached = meshCache_.find(part.mesh.get());
     }
-    items.push_back(render::DrawItem{cached->second.handle, part.model, part.material});
+    render::Material material = part.material;
+    if (partTexture != nullptr) {
+      auto texture = textureCache_.find(partTexture.get());
+      if (texture == textureCache_.end() || texture->second.source.lock() != partTexture) {
+        render::TextureOptions textureOptions;
+        textureOptions.linearFilter = true;
+        textureOptions.clampToEdge = false;  // base-colour textures tile, as the frontend draws them
+        auto handle = renderer_->uploadTexture(*partTexture, textureOptions);
+        if (!handle.ok()) return handle.status();
+        textureCache_[partTexture.get()] = CachedTexture{partTexture, *handle};
+        texture = textureCache_.find(partTexture.get());
+      }
+      material.texture = texture->second.handle;
+    }
+    items.push_back(render::DrawItem{cached->second.handle, part.model, material});
   }
   timings_.uploadMs = millisecondsSince(uploadStart);
   return Status();

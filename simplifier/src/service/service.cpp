@@ -145,6 +145,7 @@ void SimplifierService::Impl::dropUnusedModels() {
 }
 
 Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const IndexedMesh> mesh,
+                                                       float attributeWeight,
                                                        const std::string& what) {
   auto model = std::make_unique<MeshModel>();
   // Builds of large meshes take a second or more: say so in the log.
@@ -154,7 +155,10 @@ Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const Ind
   if (report)
     progress("event=pm_build_started what=\"" + what +
              "\" triangles=" + std::to_string(mesh->triangleCount()));
-  Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh);
+  BuildOptions build;
+  build.attributeWeight = attributeWeight;
+  model->attributeWeight = attributeWeight;
+  Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh, build);
   if (!pm.ok()) return Status(pm.status().code(), what + ": " + pm.status().message());
   ++stats.progressiveMeshBuilds;
   if (report)
@@ -177,7 +181,12 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   if (!object.fullMesh) return invalid("object " + std::to_string(object.id) + " has no mesh");
   auto found = meshModels.find(object.fullMesh.get());
   if (found != meshModels.end()) return found->second.get();
-  return buildModel(object.fullMesh, "object " + std::to_string(object.id));
+  // A textured object's levels keep their uvs (extract always carries them);
+  // attribute quadrics keep the texture from sliding across the surface.
+  const bool textured = object.shape != nullptr && !object.shape->appearance.texturePath.empty() &&
+                        !object.fullMesh->uvs.empty();
+  return buildModel(object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f,
+                    "object " + std::to_string(object.id));
 }
 
 Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::Bytes& bytes) {
@@ -190,7 +199,7 @@ Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::B
     return Status(decoded.status().code(), "sourceMesh: " + decoded.status().message());
   }
   auto mesh = std::make_shared<const IndexedMesh>(std::move(decoded).value());
-  Result<MeshModel*> built = buildModel(mesh, "sourceMesh");
+  Result<MeshModel*> built = buildModel(mesh, 0.0f, "sourceMesh");
   if (!built.ok()) return built.status();
   // Move it from the scene-mesh map into the source map (bounded).
   auto node = meshModels.extract(mesh.get());
@@ -206,7 +215,7 @@ bool SimplifierService::Impl::curveWithoutMeasuring(MeshModel& model) {
   if (!curveCache || model.cacheLookedUp) return false;
   model.cacheLookedUp = true;
   Result<MeshCurves> curves =
-      curveCache->find(*model.original, kCurveProducer, model.pm, options.curve);
+      curveCache->find(*model.original, curveProducerFor(model.attributeWeight), model.pm, options.curve);
   if (!curves.ok() || curves->levels.empty()) return false;
   ++stats.curvesFromDisk;
   model.ladder = creditLevels(curves->levels, options.curve.minRelativeError);
@@ -234,7 +243,7 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   };
   if (curveCache) {
     const int hitsBefore = curveCache->stats().hits;
-    curves = curveCache->getOrMeasure(*model.original, kCurveProducer, minTriangles,
+    curves = curveCache->getOrMeasure(*model.original, curveProducerFor(model.attributeWeight), minTriangles,
                                       model.pm.maxTriangles(), extract, options.curve);
     if (curves.ok()) {
       if (curveCache->stats().hits > hitsBefore) {
@@ -283,7 +292,12 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
       }
     }
   }
-  const IndexedMesh mesh = pm.extract(target);
+  // A textured object's full resolution is its own mesh, uv seams intact:
+  // the progressive mesh welds the seam's split vertices (one uv each), which
+  // a texture shows. Only when cleanup dropped no triangle (same count).
+  const bool original = model.attributeWeight > 0.0f && target >= pm.maxTriangles() &&
+                        model.original->triangleCount() == pm.maxTriangles();
+  const IndexedMesh mesh = original ? *model.original : pm.extract(target);
   const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
   Result<protocol::SimplifyResult> encoded =
       encodedMeshResult(mesh, deliveredLevel(credit.relativeError));

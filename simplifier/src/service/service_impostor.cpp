@@ -71,6 +71,27 @@ protocol::ConicRange toWire(const ConicRange& range) {
 
 }  // namespace
 
+std::shared_ptr<const RgbaImage> SimplifierService::Impl::textureOf(
+    const scene::SceneObject& object, const IndexedMesh& mesh) {
+  if (object.shape == nullptr || mesh.uvs.empty()) return nullptr;
+  const std::string& path = object.shape->appearance.texturePath;
+  if (path.empty()) return nullptr;
+  auto known = textureFiles.find(path);
+  if (known != textureFiles.end()) return known->second;
+  constexpr std::size_t kMaxTextureFiles = 256;
+  if (textureFiles.size() >= kMaxTextureFiles) textureFiles.clear();
+  std::shared_ptr<const RgbaImage> image;
+  Result<RgbaImage> decoded = codec::readImageFile(path);
+  if (decoded.ok()) {
+    image = std::make_shared<const RgbaImage>(std::move(decoded).value());
+  } else {
+    progress("event=texture_failed error=\"" + decoded.status().message() +
+             "\" action=impostor_untextured");
+  }
+  textureFiles.emplace(path, image);
+  return image;
+}
+
 Status SimplifierService::Impl::ensureRendering() {
   if (impostors) return context->isCurrent() ? Status() : context->makeCurrent();
   Result<std::unique_ptr<render::OffscreenContext>> created =
@@ -253,6 +274,15 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
     impostorScene.parts.push_back(
         ImpostorPart{mesh, object->objectToWorld, scene::shapeMaterial(*object->shape)});
   }
+
+  // Textured objects are captured with their texture (one part per object, in order).
+  bool anyTexture = false;
+  for (std::size_t i = 0; i < objects.size() && i < impostorScene.parts.size(); ++i) {
+    impostorScene.textures.push_back(textureOf(*objects[i], *impostorScene.parts[i].mesh));
+    anyTexture |= impostorScene.textures.back() != nullptr;
+  }
+  if (!anyTexture || impostorScene.textures.size() != impostorScene.parts.size())
+    impostorScene.textures.clear();
 
   // --- Render. ---
   protocol::Representation representation;

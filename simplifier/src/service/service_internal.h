@@ -28,6 +28,9 @@ namespace thinlod::simplifier::service_detail {
 // Tag of the progressive-mesh producer in curve cache keys: change it when
 // BuildOptions or the simplifier's behaviour change.
 inline constexpr const char* kCurveProducer = "qem-service v1 boundaries=1 flips=1";
+// The producer of a textured object's curves (attribute quadrics on its uvs,
+// ServiceOptions::texturedAttributeWeight): another progressive mesh.
+std::string curveProducerFor(float attributeWeight);
 // Share of a level's error budget that Draco quantization may add.
 inline constexpr double kQuantizationBudget = 0.1;
 
@@ -85,6 +88,7 @@ struct MeshModel {
   std::shared_ptr<const IndexedMesh> original;
   double diameter = 0.0;  // L of `original` (referenceLength(referenceSphere(original)))
   ProgressiveMesh pm;
+  float attributeWeight = 0.0f;  // BuildOptions::attributeWeight pm was built with
   bool curveReady = false;
   bool cacheLookedUp = false;  // curveWithoutMeasuring found no file once: do not ask again
   std::vector<LevelCredit> ladder;
@@ -142,6 +146,8 @@ struct SimplifierService::Impl {
   std::map<std::uint64_t, std::unique_ptr<service_detail::MeshModel>> sourceMeshModels;
   std::map<service_detail::PrimitiveLevelKey, std::shared_ptr<const IndexedMesh>> primitiveLevels;
   std::unique_ptr<MeshCurveCache> curveCache;
+  // Decoded scene textures by file (null: the file failed, logged once).
+  std::map<std::string, std::shared_ptr<const RgbaImage>> textureFiles;
   // Rendering (created lazily on the calling thread; renderer before context).
   std::unique_ptr<render::OffscreenContext> context;
   std::unique_ptr<ImpostorRenderer> impostors;
@@ -153,6 +159,7 @@ struct SimplifierService::Impl {
   Result<service_detail::MeshModel*> meshModelFor(const scene::SceneObject& object);
   Result<service_detail::MeshModel*> meshModelForSource(const protocol::Bytes& bytes);
   Result<service_detail::MeshModel*> buildModel(std::shared_ptr<const IndexedMesh> mesh,
+                                                float attributeWeight,
                                                 const std::string& what);
   Status ensureCurve(service_detail::MeshModel& model);
   // The curve from memory or the cache file only (never measured): true when
@@ -163,6 +170,10 @@ struct SimplifierService::Impl {
   }
   Status ensureRendering();
   void dropUnusedModels();
+  // The base-colour texture an impostor draws `object` with when its part is
+  // `mesh`: the Shape's resolved texture file when the mesh has uvs, else null.
+  std::shared_ptr<const RgbaImage> textureOf(const scene::SceneObject& object,
+                                             const IndexedMesh& mesh);
 
   Result<protocol::SimplifyResult> simplifyMesh(const protocol::SimplifyRequest& request,
                                                 service_detail::MeshModel& model);

@@ -25,6 +25,11 @@ DeliveredLevel deliveredLevel(double relativeError) {
   return out;
 }
 
+std::string curveProducerFor(float attributeWeight) {
+  if (!(attributeWeight > 0.0f)) return kCurveProducer;
+  return std::string(kCurveProducer) + " attributes=" + std::to_string(attributeWeight);
+}
+
 std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
   if (frame.size() < codec::kFrameHeaderBytes) return 0;
   return static_cast<std::uint32_t>(frame[12]) | (static_cast<std::uint32_t>(frame[13]) << 8) |

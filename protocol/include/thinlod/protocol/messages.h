@@ -45,6 +45,7 @@ inline constexpr std::size_t kMaxTextBytes = 4096;           // error messages, 
 inline constexpr std::size_t kMaxNameBytes = 256;            // peer names, capabilities
 inline constexpr std::size_t kMaxCapabilities = 64;
 inline constexpr std::size_t kMaxSceneOperations = 65536;  // per SceneUpdate
+inline constexpr std::size_t kMaxSharedTextures = 1024;    // per SceneUpdate
 inline constexpr std::size_t kMaxObjectIdsPerRequest = 4096;
 inline constexpr std::size_t kMaxCurveSamples = 4096;
 inline constexpr std::uint32_t kMaxTriangleCount = 1u << 26;  // per representation
@@ -108,6 +109,16 @@ struct Representation {
   double accuracy = 0.0;  // what this representation reaches (1/d)
   std::uint32_t triangleCount = 0;
   std::uint32_t pointCount = 0;  // kHybrid: disc points in `mesh` (an encodeHybrid frame)
+  // kMesh / kHybrid: the shared base-colour texture (SharedTexture::textureId
+  // of this update or an earlier one); 0: none. Not with an inline `texture`.
+  std::uint64_t textureId = 0;
+};
+
+// A texture sent once per session and shared by every representation that
+// names its id (docs/protocol.md, "Shared textures").
+struct SharedTexture {
+  std::uint64_t textureId = 0;  // >= 1, unique within an update
+  Texture texture;              // not kNone
 };
 
 // --- Handshake (every connection starts with Hello / HelloReply) ---
@@ -164,6 +175,7 @@ struct SceneUpdate {
   std::uint64_t frame = 0;  // frontend frame the plan was made for
   double targetAccuracy = 0.0;
   std::vector<SceneOperation> operations;
+  std::vector<SharedTexture> textures;  // at most kMaxSharedTextures; before the operations
 };
 
 struct FrameStats {
@@ -264,6 +276,7 @@ const char* messageName(const Message& message);
 bool operator==(const ConicRange& a, const ConicRange& b);
 bool operator==(const Texture& a, const Texture& b);
 bool operator==(const Representation& a, const Representation& b);
+bool operator==(const SharedTexture& a, const SharedTexture& b);
 bool operator==(const Hello& a, const Hello& b);
 bool operator==(const HelloReply& a, const HelloReply& b);
 bool operator==(const ViewerPose& a, const ViewerPose& b);

@@ -54,6 +54,11 @@ struct ImpostorPart {
 
 struct ImpostorScene {
   std::vector<ImpostorPart> parts;
+  // Empty, or one per part: that part's base-colour texture (null: none;
+  // needs uvs on its mesh, and its material.texture must then be none).
+  // Uploaded and kept on the GPU while the pointer lives, drawn by the
+  // common renderer as the frontend's reference draws it.
+  std::vector<std::shared_ptr<const RgbaImage>> textures;
   render::Lighting lighting;  // object space
 };
 
@@ -223,6 +228,10 @@ class ImpostorRenderer {
     std::weak_ptr<const IndexedMesh> source;
     render::MeshHandle handle;
   };
+  struct CachedTexture {
+    std::weak_ptr<const RgbaImage> source;
+    render::TextureHandle handle;
+  };
   explicit ImpostorRenderer(render::OffscreenContext& context);
   Status prepare(const ImpostorScene& scene, const ImpostorOptions& options,
                  const glm::vec3& viewpoint, ImpostorFraming& framing,
@@ -233,6 +242,7 @@ class ImpostorRenderer {
   std::unique_ptr<render::MeshRenderer> renderer_;
   std::unique_ptr<render::RenderTarget> target_;
   std::unordered_map<const IndexedMesh*, CachedMesh> meshCache_;
+  std::unordered_map<const RgbaImage*, CachedTexture> textureCache_;
   ImpostorTimings timings_;
   std::vector<float> depthScratch_;
   std::vector<glm::vec3> pointScratch_;

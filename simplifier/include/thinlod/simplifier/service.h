@@ -70,6 +70,11 @@ struct ServiceOptions {
   std::size_t maxCachedScenes = 4;           // least recently used scenes are dropped
   int maxPrimitiveTriangles = 65536;         // finest primitive tessellation served
   std::size_t meshedImpostorTriangles = 64;  // depth-mesh target (QEM) of meshed impostors
+  // BuildOptions::attributeWeight of textured objects' progressive meshes
+  // (a Shape with a resolved texture and a mesh with uvs): a full-range uv
+  // change costs like sqrt(w) of the bbox diagonal, 10% at 0.01. Untextured
+  // objects keep 0 (geometry only).
+  float texturedAttributeWeight = 0.01f;
   // Render impostors from the coarsest level within one texel
   // (impostor_level.h); false: always the full meshes (the reference capture).
   bool impostorFromLevels = true;

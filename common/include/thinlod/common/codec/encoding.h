@@ -137,14 +137,19 @@ Result<std::vector<std::uint8_t>> encodeTextureWith(const RgbaImage& texture, Te
 Result<RgbaImage> decodeTexture(const std::uint8_t* data, std::size_t size,
                                 const DecodeLimits& limits = {});
 
-// A texture file of a scene (PNG or JPEG, told by its first bytes; no frame
-// header): the image's own width and height are checked against `limits`
+// A texture file of a scene (PNG or JPEG, told by its first bytes, or TGA,
+// whose 18-byte header is checked first: no colour map, true-colour or grey,
+// raw pixels inside the file; no frame header): the image's own width and height are checked against `limits`
 // (maxDecodableSide, and width * height * 4 <= maxPayloadBytes * 16) before
 // any pixel is decoded; grey, grey + alpha and RGB become RGBA8 (alpha 255).
 // Other formats are kUnsupported, malformed bytes kParseError, images over
 // the limits kResourceExhausted. Rows top-down, as RgbaImage stores them.
 Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
                                   const DecodeLimits& limits = {});
+// The image file at `path` (a scene's texture): read with readFileBounded
+// (limits.maxPayloadBytes) and decoded as decodeImageFile; errors start with
+// the path. The one loader of texture files for the three daemons.
+Result<RgbaImage> readImageFile(const std::string& path, const DecodeLimits& limits = {});
 
 // FNV-1a 64 over bytes: the frame's payload checksum (catches corruption on
 // the link, not forgery).

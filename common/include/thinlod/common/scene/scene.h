@@ -71,12 +71,15 @@ struct Material {
 struct Appearance {
   bool hasMaterial = false;  // VRML: no material means unlit (emissive white)
   Material material;
-  // Base-colour texture as the file names it (imported scenes only,
-  // scene_import.h); empty when there is none. texturePath: the file it
-  // resolved to (resolveTextures), empty when it did not resolve. The
-  // frontend's reference rendering draws it; the link does not carry
-  // textures yet, so the frontend's own representations are untextured.
+  // Base-colour texture as the file names it (an imported material,
+  // scene_import.h, or a VRML ImageTexture's first url); empty when there is
+  // none. textureAlternatives: an ImageTexture's further urls, tried in order
+  // when the first names no file. texturePath: the file it resolved to
+  // (resolveTextures), empty when it did not resolve. Drawn by the frontend's
+  // reference and, through the link's shared textures (docs/protocol.md), by
+  // the frontend's textured mesh representations and the simplifier's impostors.
   std::string textureUrl;
+  std::vector<std::string> textureAlternatives;
   std::string texturePath;
 };
 

@@ -53,6 +53,10 @@ struct SceneLoadOptions {
   ImportLimits importLimits;  // .gltf .glb .dae .fbx .obj scene files (scene_import.h)
 };
 
+// The url rules for mesh and texture urls: a relative file name (no scheme,
+// not absolute, no ".."); kInvalidArgument / kUnsupported naming `where`.
+Status checkUrl(const std::string& url, const std::string& where);
+
 // Loads every mesh-file geometry in the scene (see the url rules above).
 // Mesh warnings go to Geometry::loadWarnings and Scene::warnings.
 Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
