@@ -169,6 +169,21 @@ Result<std::vector<double>> cumulativeAreas(const MeshGeometry& geometry, const 
   return cumulative;
 }
 
+// Both meshes validated and their cumulative areas (original first).
+struct BothAreas {
+  std::vector<double> original;
+  std::vector<double> simplified;
+};
+
+Result<BothAreas> cumulativeAreasOfBoth(const MeshGeometry& original,
+                                        const MeshGeometry& simplified) {
+  Result<std::vector<double>> o = cumulativeAreas(original, "original mesh");
+  if (!o.ok()) return o.status();
+  Result<std::vector<double>> s = cumulativeAreas(simplified, "simplified mesh");
+  if (!s.ok()) return s.status();
+  return BothAreas{std::move(o).value(), std::move(s).value()};
+}
+
 struct ScoredPoint {
   double squaredDistance;
   SurfacePoint point;
@@ -260,18 +275,15 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
   }
   const MeshGeometry originalGeometry(original);
   const MeshGeometry simplifiedGeometry(simplified);
-  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
-  if (!originalAreas.ok()) return originalAreas.status();
-  Result<std::vector<double>> simplifiedAreas =
-      cumulativeAreas(simplifiedGeometry, "simplified mesh");
-  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  Result<BothAreas> areas = cumulativeAreasOfBoth(originalGeometry, simplifiedGeometry);
+  if (!areas.ok()) return areas.status();
 
   const TriangleBvh originalBvh(original);
   const TriangleBvh simplifiedBvh(simplified);
   const DirectionalError forward = measureDirection(
-      originalGeometry, samplePoints(originalGeometry, *originalAreas, options), simplifiedBvh);
+      originalGeometry, samplePoints(originalGeometry, areas->original, options), simplifiedBvh);
   const DirectionalError backward = measureDirection(
-      simplifiedGeometry, samplePoints(simplifiedGeometry, *simplifiedAreas, options), originalBvh);
+      simplifiedGeometry, samplePoints(simplifiedGeometry, areas->simplified, options), originalBvh);
 
   SurfaceError error;
   error.maxForward = forward.max;
@@ -336,11 +348,8 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   }
   const MeshGeometry originalGeometry(original);
   const MeshGeometry simplifiedGeometry(simplified);
-  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
-  if (!originalAreas.ok()) return originalAreas.status();
-  Result<std::vector<double>> simplifiedAreas =
-      cumulativeAreas(simplifiedGeometry, "simplified mesh");
-  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  Result<BothAreas> areas = cumulativeAreasOfBoth(originalGeometry, simplifiedGeometry);
+  if (!areas.ok()) return areas.status();
   if (original.uvs.empty() || simplified.uvs.empty()) {
     return Status(ErrorCode::kInvalidArgument, "measureUvError: both meshes need uvs");
   }
@@ -363,7 +372,7 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   sampling.samplesPerMesh = options.samples;
   sampling.seed = options.seed;
   sampling.includeVerticesAndEdges = false;
-  const SamplePoints points = samplePoints(simplifiedGeometry, *simplifiedAreas, sampling);
+  const SamplePoints points = samplePoints(simplifiedGeometry, areas->simplified, sampling);
   const TriangleBvh bvh(original);
   // The original laid out in uv space (z = 0), for the texel's preimage.
   IndexedMesh uvLayout;
