@@ -5,8 +5,8 @@
 #include <functional>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
-#include <limits>
 #include <glm/vec3.hpp>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -282,8 +282,9 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
   const TriangleBvh simplifiedBvh(simplified);
   const DirectionalError forward = measureDirection(
       originalGeometry, samplePoints(originalGeometry, areas->original, options), simplifiedBvh);
-  const DirectionalError backward = measureDirection(
-      simplifiedGeometry, samplePoints(simplifiedGeometry, areas->simplified, options), originalBvh);
+  const DirectionalError backward =
+      measureDirection(simplifiedGeometry,
+                       samplePoints(simplifiedGeometry, areas->simplified, options), originalBvh);
 
   SurfaceError error;
   error.maxForward = forward.max;
@@ -328,7 +329,9 @@ bool barycentrics(const detail::Triangle& tri, const dvec3& p, double& wb, doubl
 double percentile95(std::vector<double>& values) {
   if (values.empty()) return 0.0;
   const std::size_t k = (values.size() * 95) / 100;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(k, values.size() - 1)), values.end());
+  std::nth_element(values.begin(),
+                   values.begin() + static_cast<std::ptrdiff_t>(std::min(k, values.size() - 1)),
+                   values.end());
   return values[std::min(k, values.size() - 1)];
 }
 

@@ -74,14 +74,14 @@ struct MeshCurveOptions {
 
 struct CurveLevel {
   std::size_t requestedTriangles = 0;
-  std::size_t triangles = 0;      // what the extraction returned
-  double relativeMaxError = 0.0;  // measured d, before the floor: max of the next two
-  double relativeHausdorffError = 0.0;  // Hausdorff max / L
-  double relativeTextureError = 0.0;    // texel displacement p95 / L (0: untextured)
+  std::size_t triangles = 0;             // what the extraction returned
+  double relativeMaxError = 0.0;         // measured d, before the floor: max of the next two
+  double relativeHausdorffError = 0.0;   // Hausdorff max / L
+  double relativeTextureError = 0.0;     // texel displacement p95 / L (0: untextured)
   double relativeTextureMaxError = 0.0;  // its max / L, reported only
   double relativeMeanError = 0.0;        // Hausdorff mean / L
-  double accuracy = 0.0;         // 1 / max(d, floor)
-  std::size_t encodedBytes = 0;  // 0 when not measured
+  double accuracy = 0.0;                 // 1 / max(d, floor)
+  std::size_t encodedBytes = 0;          // 0 when not measured
   int positionBits = 0;
   double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / L)
 };
