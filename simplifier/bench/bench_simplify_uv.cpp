@@ -154,15 +154,17 @@ Row measure(const std::string& method, const IndexedMesh& input, const IndexedMe
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"bench_simplify_uv: uv and geometric error of textured-mesh simplification, "
-               "ours vs meshoptimizer"};
+  CLI::App app{
+      "bench_simplify_uv: uv and geometric error of textured-mesh simplification, "
+      "ours vs meshoptimizer"};
   std::string packageDir = "/usr/share/assimp/models";
   std::string modelsDir = std::string(THINLOD_SHARED_DIR) + "/models";
   std::size_t samples = 50000;
   float attributeWeight = 0.01f;
   app.add_option("--package-dir", packageDir, "assimp-testmodels' model folder");
   app.add_option("--models-dir", modelsDir, "shared models (spot.obj)");
-  app.add_option("--samples", samples, "surface samples per measurement")->check(CLI::PositiveNumber);
+  app.add_option("--samples", samples, "surface samples per measurement")
+      ->check(CLI::PositiveNumber);
   app.add_option("--attribute-weight", attributeWeight, "attributeWeight of ours+attr")
       ->check(CLI::PositiveNumber);
   std::vector<double> ratios = {0.5, 0.1, 0.01};
@@ -173,7 +175,8 @@ int main(int argc, char** argv) {
 
   std::vector<Model> models;
   addImported(models, "duck (Collada)", packageDir + "/Collada/duck.dae");
-  addImported(models, "BoxTextured (glTF2)", packageDir + "/glTF2/BoxTextured-glTF/BoxTextured.gltf");
+  addImported(models, "BoxTextured (glTF2)",
+              packageDir + "/glTF2/BoxTextured-glTF/BoxTextured.gltf");
   addImported(models, "spider (OBJ)", packageDir + "/OBJ/spider.obj");
   addImported(models, "earthCylindrical (Collada)", packageDir + "/Collada/earthCylindrical.DAE");
   addImported(models, "spot (shared)", modelsDir + "/spot.obj");
@@ -183,13 +186,15 @@ int main(int argc, char** argv) {
   models.push_back({"charted sphere (generated)",
                     weldPositionUv(thinlod::qemtest::makeChartedSphere(3, 16, 0.08f).mesh)});
 
-  std::printf("meshoptimizer %d.%d (meshopt_simplify; no attribute-aware simplifier in this "
-              "version), %zu samples per measurement, ours+attr attributeWeight %g\n\n",
-              MESHOPTIMIZER_VERSION / 1000, (MESHOPTIMIZER_VERSION % 1000) / 10, samples,
-              static_cast<double>(attributeWeight));
-  std::printf("| model (triangles, open place edges) | target | method | triangles | geom max %% | "
-              "geom mean %% | uv mean | uv p95 | texel displ. mean %% | p95 %% | max %% | "
-              "open place edges |\n");
+  std::printf(
+      "meshoptimizer %d.%d (meshopt_simplify; no attribute-aware simplifier in this "
+      "version), %zu samples per measurement, ours+attr attributeWeight %g\n\n",
+      MESHOPTIMIZER_VERSION / 1000, (MESHOPTIMIZER_VERSION % 1000) / 10, samples,
+      static_cast<double>(attributeWeight));
+  std::printf(
+      "| model (triangles, open place edges) | target | method | triangles | geom max %% | "
+      "geom mean %% | uv mean | uv p95 | texel displ. mean %% | p95 %% | max %% | "
+      "open place edges |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Model& model : models) {
     if (!only.empty() && model.name.find(only) == std::string::npos) continue;
@@ -204,8 +209,8 @@ int main(int argc, char** argv) {
       BuildOptions options;
     };
     std::vector<std::pair<std::string, ProgressiveMesh>> pms;
-    for (const Ours& o : {Ours{"ours", BuildOptions{}}, Ours{"ours+attr", attr},
-                          Ours{"ours-welded", welded}}) {
+    for (const Ours& o :
+         {Ours{"ours", BuildOptions{}}, Ours{"ours+attr", attr}, Ours{"ours-welded", welded}}) {
       Result<ProgressiveMesh> pm = ProgressiveMesh::build(input, o.options);
       if (!pm.ok()) {
         std::cerr << model.name << " " << o.name << ": " << pm.status().toString() << "\n";
@@ -216,19 +221,21 @@ int main(int argc, char** argv) {
     const int inputOpen = openPlaceEdges(input);
     for (double ratio : ratios) {
       const std::size_t target = std::max<std::size_t>(
-          1, static_cast<std::size_t>(std::lround(ratio * static_cast<double>(input.triangleCount()))));
+          1, static_cast<std::size_t>(
+                 std::lround(ratio * static_cast<double>(input.triangleCount()))));
       std::vector<Row> rows;
-      for (const auto& [name, pm] : pms) rows.push_back(measure(name, input, pm.extract(target), samples));
+      for (const auto& [name, pm] : pms)
+        rows.push_back(measure(name, input, pm.extract(target), samples));
       IndexedMesh mo = thinlod::testing::simplifyWithMeshoptimizer(input, target);
       mo.uvs = input.uvs;  // meshoptimizer's indices refer to the input's vertices
       rows.push_back(measure("meshopt", input, mo, samples));
       for (const Row& r : rows) {
-        std::printf("| %s (%zu, %d) | %.0f%% (%zu) | %s | %zu | %.3f | %.4f | %.5f | %.5f | %.4f | "
-                    "%.3f | %.3f | %d |\n",
-                    model.name.c_str(), input.triangleCount(), inputOpen, 100.0 * ratio, target,
-                    r.method.c_str(), r.triangles, r.geometricMaxPct, r.geometricMeanPct, r.uvMean,
-                    r.uvP95, r.displacementMeanPct, r.displacementP95Pct, r.displacementMaxPct,
-                    r.openEdges);
+        std::printf(
+            "| %s (%zu, %d) | %.0f%% (%zu) | %s | %zu | %.3f | %.4f | %.5f | %.5f | %.4f | "
+            "%.3f | %.3f | %d |\n",
+            model.name.c_str(), input.triangleCount(), inputOpen, 100.0 * ratio, target,
+            r.method.c_str(), r.triangles, r.geometricMaxPct, r.geometricMeanPct, r.uvMean, r.uvP95,
+            r.displacementMeanPct, r.displacementP95Pct, r.displacementMaxPct, r.openEdges);
       }
       std::fflush(stdout);
     }

@@ -121,18 +121,15 @@ TEST_P(PackageInvalidFiles, GiveACleanStatus) {
 // Every file of `dpkg -L assimp-testmodels | grep -i invalid`.
 INSTANTIATE_TEST_SUITE_P(
     AssimpTestmodels, PackageInvalidFiles,
-    ::testing::Values(PackageCase{"invalid/OutOfMemory.off", false},
-                      PackageCase{"invalid/empty.3ds", false}, PackageCase{"invalid/empty.ase", false},
-                      PackageCase{"invalid/empty.lwo", false},
-                      PackageCase{"invalid/empty.md5mesh", false},
-                      PackageCase{"invalid/empty.obj", false}, PackageCase{"invalid/empty.off", false},
-                      PackageCase{"invalid/empty.ply", false}, PackageCase{"invalid/empty.raw", false},
-                      PackageCase{"invalid/empty.smd", false}, PackageCase{"invalid/empty.x", false},
-                      PackageCase{"invalid/emptyIrrMesh.xml", false},
-                      PackageCase{"invalid/malformed.obj", false},
-                      PackageCase{"invalid/malformed2.obj", true},
-                      PackageCase{"invalid/readme.txt", false},
-                      PackageCase{"OFF/invalid.off", false}),
+    ::testing::Values(
+        PackageCase{"invalid/OutOfMemory.off", false}, PackageCase{"invalid/empty.3ds", false},
+        PackageCase{"invalid/empty.ase", false}, PackageCase{"invalid/empty.lwo", false},
+        PackageCase{"invalid/empty.md5mesh", false}, PackageCase{"invalid/empty.obj", false},
+        PackageCase{"invalid/empty.off", false}, PackageCase{"invalid/empty.ply", false},
+        PackageCase{"invalid/empty.raw", false}, PackageCase{"invalid/empty.smd", false},
+        PackageCase{"invalid/empty.x", false}, PackageCase{"invalid/emptyIrrMesh.xml", false},
+        PackageCase{"invalid/malformed.obj", false}, PackageCase{"invalid/malformed2.obj", true},
+        PackageCase{"invalid/readme.txt", false}, PackageCase{"OFF/invalid.off", false}),
     [](const ::testing::TestParamInfo<PackageCase>& info) {
       std::string name = info.param.file;
       for (char& c : name) {
@@ -179,9 +176,10 @@ std::string gltfTriangle(const std::vector<float>& positions, const std::string&
   static const char* kBase64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string b64;
   for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::uint32_t n = static_cast<std::uint8_t>(bytes[i]) << 16 |
-                            (i + 1 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 1]) << 8 : 0) |
-                            (i + 2 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 2]) : 0);
+    const std::uint32_t n =
+        static_cast<std::uint8_t>(bytes[i]) << 16 |
+        (i + 1 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 1]) << 8 : 0) |
+        (i + 2 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 2]) : 0);
     b64 += kBase64[n >> 18 & 63];
     b64 += kBase64[n >> 12 & 63];
     b64 += i + 1 < bytes.size() ? kBase64[n >> 6 & 63] : '=';
@@ -208,25 +206,26 @@ TEST_F(HostileFiles, TheWellFormedTemplatesLoad) {
 }
 
 TEST_F(HostileFiles, HugeDeclaredCountsAreRefused) {
-  for (const auto& [name, bytes] : std::vector<std::pair<std::string, std::string>>{
-           {"count.dae", collada(kTriangle, "2000000000", "", kGeometryNode)},
-           {"accessor.dae",
-            collada(kTriangle, "9", "", kGeometryNode)
-                .replace(collada(kTriangle, "9", "", kGeometryNode).find("count=\"3\""), 9,
-                         "count=\"1000000000\"")},
-           {"vertices.off", "OFF\n2000000000 2000000000 0\n0 0 0\n"},
-           {"faces.off", "OFF\n3 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
-           {"vertices.ply",
-            "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
-            "property float y\nproperty float z\nelement face 1\n"
-            "property list uchar int vertex_indices\nend_header\n0 0 0\n"},
-           {"index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4000000000\n"},
-           {"count.gltf",
-            R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
-            R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
-            R"("buffers":[{"byteLength":36}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
-            R"("accessors":[{"bufferView":0,"componentType":5126,"count":4000000000,"type":"VEC3"}]})"},
-       }) {
+  for (
+      const auto& [name, bytes] : std::vector<std::pair<std::string, std::string>>{
+          {"count.dae", collada(kTriangle, "2000000000", "", kGeometryNode)},
+          {"accessor.dae",
+           collada(kTriangle, "9", "", kGeometryNode)
+               .replace(collada(kTriangle, "9", "", kGeometryNode).find("count=\"3\""), 9,
+                        "count=\"1000000000\"")},
+          {"vertices.off", "OFF\n2000000000 2000000000 0\n0 0 0\n"},
+          {"faces.off", "OFF\n3 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+          {"vertices.ply",
+           "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+           "property float y\nproperty float z\nelement face 1\n"
+           "property list uchar int vertex_indices\nend_header\n0 0 0\n"},
+          {"index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4000000000\n"},
+          {"count.gltf",
+           R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+           R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+           R"("buffers":[{"byteLength":36}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":4000000000,"type":"VEC3"}]})"},
+      }) {
     expectRefusedEverywhere(write(name, bytes), dir_);
   }
 }
@@ -256,11 +255,13 @@ TEST_F(HostileFiles, CyclicNodeGraphsAreRefused) {
   const std::string cycle = R"(<node id="a"><instance_node url="#b"/></node>)"
                             R"(<node id="b"><instance_node url="#a"/></node>)";
   const std::string self = R"(<node id="a"><instance_node url="#a"/></node>)";
-  const std::string use = R"(<node id="root"><instance_node url="#a"/><instance_geometry url="#g"/></node>)";
+  const std::string use =
+      R"(<node id="root"><instance_node url="#a"/><instance_geometry url="#g"/></node>)";
   // glTF: a node that is its own child, and two nodes that are each other's.
   const std::string base = gltfTriangle({0, 0, 0, 1, 0, 0, 0, 1, 0});
   std::string selfChild = base;
-  selfChild.replace(selfChild.find(R"("nodes":[{"mesh":0}])"), 20, R"("nodes":[{"mesh":0,"children":[0]}])");
+  selfChild.replace(selfChild.find(R"("nodes":[{"mesh":0}])"), 20,
+                    R"("nodes":[{"mesh":0,"children":[0]}])");
   std::string mutual = base;
   mutual.replace(mutual.find(R"("nodes":[{"mesh":0}])"), 20,
                  R"("nodes":[{"mesh":0,"children":[1]},{"children":[0]}])");
@@ -282,8 +283,9 @@ TEST_F(HostileFiles, VeryDeepNestingIsRefused) {
   for (int i = 0; i < kDepth; ++i) nodes += "<node>";
   nodes += R"(<instance_geometry url="#g"/>)";
   for (int i = 0; i < kDepth; ++i) nodes += "</node>";
-  std::string json = gltfTriangle({0, 0, 0, 1, 0, 0, 0, 1, 0},
-                                  R"(,"extras":)" + std::string(kDepth, '[') + std::string(kDepth, ']'));
+  std::string json =
+      gltfTriangle({0, 0, 0, 1, 0, 0, 0, 1, 0},
+                   R"(,"extras":)" + std::string(kDepth, '[') + std::string(kDepth, ']'));
   std::string gltfChain = gltfTriangle({0, 0, 0, 1, 0, 0, 0, 1, 0});
   {
     // 100 000 glTF nodes each the child of the previous.

@@ -3,11 +3,10 @@
 // where they were in uv space, and seam ends and chart corners never move.
 #include <gtest/gtest.h>
 
-#include <iostream>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <set>
 #include <tuple>
@@ -172,12 +171,11 @@ TEST_P(ChartedSphereSeams, SidesStayPairedAndChartBordersStayOnThemselves) {
   geometric.samplesPerMesh = 20000;
   Result<SurfaceError> distance = measureSurfaceError(input, out, geometric);
   ASSERT_TRUE(distance.ok());
-  std::cout << "[ seams ] " << out.triangleCount() << " triangles: Hausdorff "
-            << distance->max() << ", texture displacement mean " << error->meanDisplacement
-            << " p95 " << error->p95Displacement << " max " << error->maxDisplacement
-            << " (welded: mean " << weldedError->meanDisplacement << " max "
-            << weldedError->maxDisplacement << "), uv distance p95 " << error->p95Uv << " max "
-            << error->maxUv << "\n";
+  std::cout << "[ seams ] " << out.triangleCount() << " triangles: Hausdorff " << distance->max()
+            << ", texture displacement mean " << error->meanDisplacement << " p95 "
+            << error->p95Displacement << " max " << error->maxDisplacement << " (welded: mean "
+            << weldedError->meanDisplacement << " max " << weldedError->maxDisplacement
+            << "), uv distance p95 " << error->p95Uv << " max " << error->maxUv << "\n";
   EXPECT_GE(error->maxDisplacement, distance->maxBackward * (1.0 - 1e-6))
       << "a texel's place is on the input surface";
   EXPECT_LT(error->meanDisplacement, 0.25 * weldedError->meanDisplacement);
@@ -215,8 +213,7 @@ TEST(ProgressiveMeshSeams, WeldingByPositionAloneTearsTheTextureThatSeamsKeep) {
 TEST(ProgressiveMeshSeams, TessellatedSphereKeepsItsMeridianSeamAndPoles) {
   // The primitive sphere: one meridian seam (u = 0 and u = 1 at one place)
   // and a fan of pole vertices, one per segment, all at one place.
-  const IndexedMesh sphere =
-      tessellate(PrimitiveShape::sphere(1.0f), TessellationParams{64, 32});
+  const IndexedMesh sphere = tessellate(PrimitiveShape::sphere(1.0f), TessellationParams{64, 32});
   const ProgressiveMesh pm = buildOrDie(sphere);
   for (double ratio : {0.1, 0.01}) {
     const IndexedMesh out =
@@ -226,8 +223,8 @@ TEST(ProgressiveMeshSeams, TessellatedSphereKeepsItsMeridianSeamAndPoles) {
     // No triangle spans the seam (its uvs would run across the texture).
     for (std::size_t t = 0; t < out.indices.size(); t += 3) {
       for (int k = 0; k < 3; ++k) {
-        const float du = std::abs(out.uvs[out.indices[t + k]].x -
-                                  out.uvs[out.indices[t + (k + 1) % 3]].x);
+        const float du =
+            std::abs(out.uvs[out.indices[t + k]].x - out.uvs[out.indices[t + (k + 1) % 3]].x);
         EXPECT_LT(du, 0.5f) << "triangle " << t / 3 << " crosses the seam";
       }
     }

@@ -40,8 +40,8 @@ ChartedSphere makeChartedSphere(int chartsPerSide, int cellsPerChart, float bump
   out.atlasColumns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(charts))));
   const float cell = 1.0f / static_cast<float>(out.atlasColumns);
   out.padding = 0.1f * cell;
-  static const glm::vec3 kNormal[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                       {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const glm::vec3 kNormal[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                       {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
   static const glm::vec3 kAxisA[6] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0},
                                       {1, 0, 0},  {1, 0, 0}, {-1, 0, 0}};
   IndexedMesh& mesh = out.mesh;
@@ -76,9 +76,10 @@ ChartedSphere makeChartedSphere(int chartsPerSide, int cellsPerChart, float bump
         const auto row = static_cast<std::uint32_t>(cellsPerChart + 1);
         for (int j = 0; j < cellsPerChart; ++j) {
           for (int i = 0; i < cellsPerChart; ++i) {
-            const std::uint32_t v = first + static_cast<std::uint32_t>(j) * row +
-                                    static_cast<std::uint32_t>(i);
-            mesh.indices.insert(mesh.indices.end(), {v, v + 1, v + row + 1, v, v + row + 1, v + row});
+            const std::uint32_t v =
+                first + static_cast<std::uint32_t>(j) * row + static_cast<std::uint32_t>(i);
+            mesh.indices.insert(mesh.indices.end(),
+                                {v, v + 1, v + row + 1, v, v + row + 1, v + row});
           }
         }
       }

@@ -263,8 +263,7 @@ TEST(UvError, ASeamIsNotChargedTheDistanceBetweenItsCharts) {
       for (int i = 0; i <= 4; ++i) {
         const float x = 0.5f * side + 0.125f * i;
         m.positions.emplace_back(x, static_cast<float>(j), 0.0f);
-        m.uvs.emplace_back(side == 0 ? 0.5f * x : 0.75f + 0.5f * (x - 0.5f),
-                           static_cast<float>(j));
+        m.uvs.emplace_back(side == 0 ? 0.5f * x : 0.75f + 0.5f * (x - 0.5f), static_cast<float>(j));
       }
     }
     for (std::uint32_t i = 0; i < 4; ++i) {

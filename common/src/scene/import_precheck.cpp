@@ -8,7 +8,8 @@
 
 namespace thinlod::scene::detail {
 
-Status checkNodeGraph(const std::string& path, const std::vector<std::vector<std::uint32_t>>& children,
+Status checkNodeGraph(const std::string& path,
+                      const std::vector<std::vector<std::uint32_t>>& children,
                       const std::vector<std::uint32_t>& roots, const ImportLimits& limits) {
   const std::size_t n = children.size();
   // Post-order DFS with an explicit stack: state 0 unvisited, 1 on the
@@ -60,9 +61,9 @@ Status checkNodeGraph(const std::string& path, const std::vector<std::vector<std
     total = std::min(cap, total + instances[r]);
   }
   if (total > limits.maxNodes) {
-    return Status(ErrorCode::kResourceExhausted,
-                  path + ": the node graph expands to more than " +
-                      std::to_string(limits.maxNodes) + " node instances");
+    return Status(ErrorCode::kResourceExhausted, path + ": the node graph expands to more than " +
+                                                     std::to_string(limits.maxNodes) +
+                                                     " node instances");
   }
   return Status();
 }
@@ -111,13 +112,15 @@ bool isArrayElement(std::string_view name) {
 
 }  // namespace
 
-Status precheckCollada(const std::string& path, std::string_view bytes, const ImportLimits& limits) {
+Status precheckCollada(const std::string& path, std::string_view bytes,
+                       const ImportLimits& limits) {
   // UTF-16 (a byte-order mark; the package has such a file): the markup is
   // ASCII, so the low bytes alone carry the structure.
   std::string narrowed;
   std::string_view xml = bytes;
-  if (bytes.size() >= 2 && (static_cast<unsigned char>(bytes[0]) == 0xFF ||
-                            static_cast<unsigned char>(bytes[0]) == 0xFE) &&
+  if (bytes.size() >= 2 &&
+      (static_cast<unsigned char>(bytes[0]) == 0xFF ||
+       static_cast<unsigned char>(bytes[0]) == 0xFE) &&
       (static_cast<unsigned char>(bytes[1]) == 0xFE ||
        static_cast<unsigned char>(bytes[1]) == 0xFF)) {
     const std::size_t low = static_cast<unsigned char>(bytes[0]) == 0xFF ? 0 : 1;  // LE : BE
@@ -183,8 +186,8 @@ Status precheckCollada(const std::string& path, std::string_view bytes, const Im
     if (end >= xml.size()) return unterminated("tag", i);
     const bool closing = xml[i + 1] == '/';
     const bool selfClosing = !closing && xml[end - 1] == '/';
-    std::string_view tag = xml.substr(i + (closing ? 2 : 1), end - i - (closing ? 2 : 1) -
-                                                                 (selfClosing ? 1 : 0));
+    std::string_view tag =
+        xml.substr(i + (closing ? 2 : 1), end - i - (closing ? 2 : 1) - (selfClosing ? 1 : 0));
     std::size_t nameEnd = 0;
     while (nameEnd < tag.size() && !std::isspace(static_cast<unsigned char>(tag[nameEnd]))) {
       ++nameEnd;

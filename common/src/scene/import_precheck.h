@@ -24,7 +24,8 @@ namespace thinlod::scene::detail {
 // deeper than limits.maxDepth nodes or more than limits.maxNodes node
 // instances once every reference is expanded (kResourceExhausted).
 // Iterative: any graph size is safe. Children indices must be < the count.
-Status checkNodeGraph(const std::string& path, const std::vector<std::vector<std::uint32_t>>& children,
+Status checkNodeGraph(const std::string& path,
+                      const std::vector<std::vector<std::uint32_t>>& children,
                       const std::vector<std::uint32_t>& roots, const ImportLimits& limits);
 
 // Collada: a light scan of the XML (tags, quotes, comments, CDATA; no DTD)

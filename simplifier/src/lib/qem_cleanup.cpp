@@ -39,8 +39,9 @@ class WeldGrid {
   // *near (when given) is set to the first clean vertex within `epsilon`
   // whether accepted or not (kEmpty when there is none).
   template <typename Accept>
-  std::uint32_t find(const glm::vec3& p, double epsilon, const std::vector<glm::vec3>& cleanPositions,
-                     Accept accept, std::uint32_t* near = nullptr) const {
+  std::uint32_t find(const glm::vec3& p, double epsilon,
+                     const std::vector<glm::vec3>& cleanPositions, Accept accept,
+                     std::uint32_t* near = nullptr) const {
     const std::array<std::int64_t, 3> lo = cellOf(p, -epsilon);
     const std::array<std::int64_t, 3> hi = cellOf(p, epsilon);
     const double eps2 = epsilon * epsilon;
@@ -256,12 +257,13 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool spl
     const glm::vec3& p = mesh.positions[v];
     std::uint32_t near = kEmpty;
     std::uint32_t target =
-        splitSeams ? grid.find(p, epsilon, clean.positions,
-                               [&](std::uint32_t c) {
-                                 return sameSeamAttributes(mesh, clean.sourceVertex[c],
-                                                           static_cast<std::uint32_t>(v));
-                               },
-                               &near)
+        splitSeams ? grid.find(
+                         p, epsilon, clean.positions,
+                         [&](std::uint32_t c) {
+                           return sameSeamAttributes(mesh, clean.sourceVertex[c],
+                                                     static_cast<std::uint32_t>(v));
+                         },
+                         &near)
                    : grid.find(p, epsilon, clean.positions, [](std::uint32_t) { return true; });
     if (target == kEmpty) {
       target = static_cast<std::uint32_t>(clean.positions.size());

@@ -311,7 +311,8 @@ class Collapser {
     // A pair is a seam only when both sides qualified.
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
       if (sibling_[v] == kNone || kind_[v] != VertexKind::kBoundary) continue;
-      kind_[v] = kind_[sibling_[v]] == VertexKind::kLocked ? VertexKind::kLocked : VertexKind::kSeam;
+      kind_[v] =
+          kind_[sibling_[v]] == VertexKind::kLocked ? VertexKind::kLocked : VertexKind::kSeam;
     }
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
       if (kind_[v] == VertexKind::kSeam && kind_[sibling_[v]] != VertexKind::kSeam) {
@@ -322,7 +323,8 @@ class Collapser {
 
   // The neighbour across a border edge (one live triangle) in `neighbors`
   // whose place is `place`, kNone when there is none.
-  std::uint32_t borderNeighborAt(const std::vector<Neighbor>& neighbors, std::uint32_t place) const {
+  std::uint32_t borderNeighborAt(const std::vector<Neighbor>& neighbors,
+                                 std::uint32_t place) const {
     for (const Neighbor& nb : neighbors) {
       if (nb.triangles == 1 && group_[nb.vertex] == place) return nb.vertex;
     }
@@ -333,9 +335,7 @@ class Collapser {
   bool isSeamFollower(std::uint32_t v) const {
     return kind_[v] == VertexKind::kSeam && sibling_[v] < v;
   }
-  std::uint32_t heapVertex(std::uint32_t v) const {
-    return isSeamFollower(v) ? sibling_[v] : v;
-  }
+  std::uint32_t heapVertex(std::uint32_t v) const { return isSeamFollower(v) ? sibling_[v] : v; }
 
   // For a seam leader u and a border neighbour w: the vertex u's sibling
   // moves onto, the sibling's border neighbour at w's place (kNone: none,

@@ -5,8 +5,8 @@
 #include <functional>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
-#include <limits>
 #include <glm/vec3.hpp>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -169,6 +169,21 @@ Result<std::vector<double>> cumulativeAreas(const MeshGeometry& geometry, const 
   return cumulative;
 }
 
+// Both meshes validated and their cumulative areas (original first).
+struct BothAreas {
+  std::vector<double> original;
+  std::vector<double> simplified;
+};
+
+Result<BothAreas> cumulativeAreasOfBoth(const MeshGeometry& original,
+                                        const MeshGeometry& simplified) {
+  Result<std::vector<double>> o = cumulativeAreas(original, "original mesh");
+  if (!o.ok()) return o.status();
+  Result<std::vector<double>> s = cumulativeAreas(simplified, "simplified mesh");
+  if (!s.ok()) return s.status();
+  return BothAreas{std::move(o).value(), std::move(s).value()};
+}
+
 struct ScoredPoint {
   double squaredDistance;
   SurfacePoint point;
@@ -260,18 +275,16 @@ Result<SurfaceError> measureSurfaceError(const IndexedMesh& original, const Inde
   }
   const MeshGeometry originalGeometry(original);
   const MeshGeometry simplifiedGeometry(simplified);
-  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
-  if (!originalAreas.ok()) return originalAreas.status();
-  Result<std::vector<double>> simplifiedAreas =
-      cumulativeAreas(simplifiedGeometry, "simplified mesh");
-  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  Result<BothAreas> areas = cumulativeAreasOfBoth(originalGeometry, simplifiedGeometry);
+  if (!areas.ok()) return areas.status();
 
   const TriangleBvh originalBvh(original);
   const TriangleBvh simplifiedBvh(simplified);
   const DirectionalError forward = measureDirection(
-      originalGeometry, samplePoints(originalGeometry, *originalAreas, options), simplifiedBvh);
-  const DirectionalError backward = measureDirection(
-      simplifiedGeometry, samplePoints(simplifiedGeometry, *simplifiedAreas, options), originalBvh);
+      originalGeometry, samplePoints(originalGeometry, areas->original, options), simplifiedBvh);
+  const DirectionalError backward =
+      measureDirection(simplifiedGeometry,
+                       samplePoints(simplifiedGeometry, areas->simplified, options), originalBvh);
 
   SurfaceError error;
   error.maxForward = forward.max;
@@ -316,7 +329,9 @@ bool barycentrics(const detail::Triangle& tri, const dvec3& p, double& wb, doubl
 double percentile95(std::vector<double>& values) {
   if (values.empty()) return 0.0;
   const std::size_t k = (values.size() * 95) / 100;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(k, values.size() - 1)), values.end());
+  std::nth_element(values.begin(),
+                   values.begin() + static_cast<std::ptrdiff_t>(std::min(k, values.size() - 1)),
+                   values.end());
   return values[std::min(k, values.size() - 1)];
 }
 
@@ -336,11 +351,8 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   }
   const MeshGeometry originalGeometry(original);
   const MeshGeometry simplifiedGeometry(simplified);
-  Result<std::vector<double>> originalAreas = cumulativeAreas(originalGeometry, "original mesh");
-  if (!originalAreas.ok()) return originalAreas.status();
-  Result<std::vector<double>> simplifiedAreas =
-      cumulativeAreas(simplifiedGeometry, "simplified mesh");
-  if (!simplifiedAreas.ok()) return simplifiedAreas.status();
+  Result<BothAreas> areas = cumulativeAreasOfBoth(originalGeometry, simplifiedGeometry);
+  if (!areas.ok()) return areas.status();
   if (original.uvs.empty() || simplified.uvs.empty()) {
     return Status(ErrorCode::kInvalidArgument, "measureUvError: both meshes need uvs");
   }
@@ -363,7 +375,7 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   sampling.samplesPerMesh = options.samples;
   sampling.seed = options.seed;
   sampling.includeVerticesAndEdges = false;
-  const SamplePoints points = samplePoints(simplifiedGeometry, *simplifiedAreas, sampling);
+  const SamplePoints points = samplePoints(simplifiedGeometry, areas->simplified, sampling);
   const TriangleBvh bvh(original);
   // The original laid out in uv space (z = 0), for the texel's preimage.
   IndexedMesh uvLayout;

@@ -14,8 +14,8 @@
 //   drawn; surface_error.h). The 95th percentile, not the max: the max is
 //   set by a few samples where a simplified chart border cuts a corner of
 //   its chart and a texel comes from the neighbouring chart of the atlas
-//   (duck.dae at 50%: p95 0.64%, max 4.9% of the diagonal; meshopt_simplify
-//   0.18 the same p95, max 44%), which an atlas' gutter hides and no
+//   (duck.dae at 50%: p95 0.65%, max 5.3% of the diagonal; meshopt_simplify
+//   0.18 p95 0.64%, max 44%), which an atlas' gutter hides and no
 //   collapse order avoids entirely. docs/simplifier.md "UV error".
 // - triangles curve: resources = extracted triangle count against a.
 //   bytes curve: resources = Draco-encoded frame size (encodeMesh, position
@@ -74,14 +74,14 @@ struct MeshCurveOptions {
 
 struct CurveLevel {
   std::size_t requestedTriangles = 0;
-  std::size_t triangles = 0;      // what the extraction returned
-  double relativeMaxError = 0.0;  // measured d, before the floor: max of the next two
-  double relativeHausdorffError = 0.0;  // Hausdorff max / L
-  double relativeTextureError = 0.0;    // texel displacement p95 / L (0: untextured)
+  std::size_t triangles = 0;             // what the extraction returned
+  double relativeMaxError = 0.0;         // measured d, before the floor: max of the next two
+  double relativeHausdorffError = 0.0;   // Hausdorff max / L
+  double relativeTextureError = 0.0;     // texel displacement p95 / L (0: untextured)
   double relativeTextureMaxError = 0.0;  // its max / L, reported only
   double relativeMeanError = 0.0;        // Hausdorff mean / L
-  double accuracy = 0.0;         // 1 / max(d, floor)
-  std::size_t encodedBytes = 0;  // 0 when not measured
+  double accuracy = 0.0;                 // 1 / max(d, floor)
+  std::size_t encodedBytes = 0;          // 0 when not measured
   int positionBits = 0;
   double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / L)
 };

@@ -60,7 +60,7 @@ struct BuildOptions {
   // > 0: attribute quadrics (Hoppe 1999) on uvs and colors, a full-range
   // attribute error weighing like a distance of sqrt(weight) * bbox diagonal.
   float attributeWeight = 0.0f;
-  float weldEpsilon = 1e-6f;        // weld distance, relative to the bbox diagonal
+  float weldEpsilon = 1e-6f;  // weld distance, relative to the bbox diagonal
   // Keep uv and colour seams: vertices within the weld distance are welded
   // only when their uv (within 1e-6) and colour agree too; the two sides of
   // a seam (two vertices at one place) collapse together along the seam, so
