@@ -349,6 +349,63 @@ TEST(Transport, ChannelRejoinsARestartedServer) {
   }));
 }
 
+// Resynchronisation: the Hello a restarted server gets carries what the
+// client said it holds (Channel::setHeld) by then; a bad list changes nothing.
+TEST(Transport, RejoinHelloCarriesTheLatestHoldings) {
+  auto endpoint = bindLoopback();
+  ASSERT_TRUE(endpoint);
+  const std::string address = endpoint->address();
+  auto channel = connectTo(address, helloAs(Role::kFrontend, "holder"));
+  Recorder r;
+  ASSERT_TRUE(pumpUntil(pumpBoth(*endpoint, *channel, r), [&] { return channel->connected(); }));
+  const EndpointEvent* first = r.findServer(
+      [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; });
+  ASSERT_NE(first, nullptr);
+  EXPECT_TRUE(std::get<Hello>(first->message).held.empty());
+
+  HeldRepresentation a;
+  a.objectId = 2;
+  a.representationId = 77;
+  a.triangleCount = 120;
+  HeldRepresentation b = a;
+  b.objectId = 5;
+  b.kind = RepresentationKind::kSimpleImpostor;
+  b.triangleCount = 2;
+  ASSERT_TRUE(channel->setHeld({a, b}).ok());
+  HeldRepresentation unordered = a;
+  unordered.objectId = 1;
+  EXPECT_FALSE(channel->setHeld({a, unordered}).ok());  // refused, the list stays {a, b}
+
+  endpoint.reset();
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        for (auto& e : channel->poll(5ms)) r.client.push_back(std::move(e));
+      },
+      [&] { return !channel->connected(); }));
+  Endpoint::Options options;
+  options.address = address;
+  options.transport = fastTransport();
+  ASSERT_TRUE(pumpUntil([] { std::this_thread::sleep_for(10ms); },
+                        [&] {
+                          auto bound = Endpoint::bind(options);
+                          if (bound.ok()) endpoint = std::move(*bound);
+                          return endpoint != nullptr;
+                        }));
+  Recorder after;
+  auto step = pumpBoth(*endpoint, *channel, after);
+  ASSERT_TRUE(pumpUntil(step, [&] {
+    return after.findServer(
+               [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; }) !=
+           nullptr;
+  }));
+  const EndpointEvent* joined = after.findServer(
+      [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; });
+  const Hello& hello = std::get<Hello>(joined->message);
+  ASSERT_EQ(hello.held.size(), 2u);
+  EXPECT_TRUE(hello.held[0] == a);
+  EXPECT_TRUE(hello.held[1] == b);
+}
+
 TEST(Transport, ChannelNoticesASilentServerAndRejoins) {
   // A fake server that answers one Hello and then stays silent (a crashed
   // or hung backbone), then answers again (restarted).
