@@ -995,41 +995,9 @@ TEST(BackboneCoreSession, NewFrontendSessionIsServedFromStoredCopies) {
 
 // ------------------------------------------------------ resynchronisation
 
-// What a frontend holds, as the real one reports it in Hello.held
-// (frontend/src/daemon/wire_conversion.h heldRepresentations).
-struct Holdings {
-  std::map<std::uint64_t, protocol::HeldRepresentation> byObject;
-  void apply(const protocol::SceneUpdate& update) {
-    for (const protocol::SceneOperation& op : update.operations) {
-      if (op.type == protocol::SceneOperation::Type::kRemove) {
-        byObject.erase(op.objectId);
-        continue;
-      }
-      protocol::HeldRepresentation& h = byObject[op.objectId];
-      h.objectId = op.objectId;
-      h.representationId = op.representation.representationId;
-      h.kind = op.representation.kind;
-      h.triangleCount = op.representation.triangleCount;
-      h.pointCount = op.representation.pointCount;
-    }
-  }
-  double total() const {
-    double sum = 0.0;
-    for (const auto& [id, h] : byObject) sum += h.triangleCount;
-    return sum;
-  }
-  protocol::Hello hello() const {
-    protocol::Hello hello;
-    hello.role = protocol::Role::kFrontend;
-    hello.name = "frontend@test";
-    for (const auto& [id, h] : byObject) hello.held.push_back(h);
-    return hello;
-  }
-};
-
 // A frontend served by one backbone process for a few poses.
-Holdings servedByAFirstBackbone(double budget) {
-  Holdings holdings;
+FrontendModel servedByAFirstBackbone(double budget) {
+  FrontendModel holdings;
   auto core = makeCore(polygonBudget(budget));
   EXPECT_NE(core, nullptr);
   if (!core) return holdings;
@@ -1056,11 +1024,11 @@ std::unique_ptr<BackboneCore> restartedCore(double budget) {
 // from the first pose on, never over the polygon budget, and whatever the
 // old process sent is replaced by this one's copies or removed.
 TEST(BackboneCoreResync, RestartedBackboneStartsFromWhatTheFrontendHolds) {
-  Holdings holdings = servedByAFirstBackbone(400);
+  FrontendModel holdings = servedByAFirstBackbone(400);
   ASSERT_GT(holdings.total(), 0.0);
   ASSERT_LE(holdings.total(), 400.0);
   std::set<std::uint64_t> oldIds;
-  for (const auto& [id, h] : holdings.byObject) oldIds.insert(h.representationId);
+  for (const auto& [id, h] : holdings.held) oldIds.insert(h.representationId);
 
   auto core = restartedCore(400);
   ASSERT_NE(core, nullptr);
@@ -1068,7 +1036,7 @@ TEST(BackboneCoreResync, RestartedBackboneStartsFromWhatTheFrontendHolds) {
   ASSERT_TRUE(protocol::validate(protocol::Message(hello)).ok());
   ASSERT_TRUE(core->admitFrontend(hello).ok());
   ASSERT_TRUE(core->startFrontendSession(hello).ok());
-  EXPECT_EQ(core->heldForeign(), holdings.byObject.size());
+  EXPECT_EQ(core->heldForeign(), holdings.held.size());
   EXPECT_EQ(core->heldTakenBack(), 0u);
   EXPECT_EQ(core->frontendTriangles(), holdings.total());
 
@@ -1091,8 +1059,8 @@ TEST(BackboneCoreResync, RestartedBackboneStartsFromWhatTheFrontendHolds) {
     ASSERT_EQ(holdings.total(), core->frontendTriangles()) << "step " << step;
     ASSERT_LE(holdings.total(), 400.0) << "step " << step;
   }
-  ASSERT_FALSE(holdings.byObject.empty());
-  for (const auto& [id, h] : holdings.byObject)
+  ASSERT_FALSE(holdings.held.empty());
+  for (const auto& [id, h] : holdings.held)
     EXPECT_EQ(oldIds.count(h.representationId), 0u) << "object " << id << " still shows the "
                                                     << "old process's copy";
 }
@@ -1100,8 +1068,8 @@ TEST(BackboneCoreResync, RestartedBackboneStartsFromWhatTheFrontendHolds) {
 // Held copies of objects the new session does not show are removed with its
 // first update (they would otherwise stay at the frontend, unmirrored).
 TEST(BackboneCoreResync, HeldObjectsTheNewSessionDoesNotShowAreRemoved) {
-  Holdings holdings = servedByAFirstBackbone(400);
-  ASSERT_FALSE(holdings.byObject.empty());
+  FrontendModel holdings = servedByAFirstBackbone(400);
+  ASSERT_FALSE(holdings.held.empty());
   auto core = restartedCore(400);
   ASSERT_NE(core, nullptr);
   ASSERT_TRUE(core->startFrontendSession(holdings.hello()).ok());
@@ -1110,9 +1078,9 @@ TEST(BackboneCoreResync, HeldObjectsTheNewSessionDoesNotShowAreRemoved) {
   submitAll(*core);
   const PoseOutcome outcome = core->finishPose();
   EXPECT_EQ(countOps(outcome.update, protocol::SceneOperation::Type::kRemove),
-            holdings.byObject.size());
+            holdings.held.size());
   holdings.apply(outcome.update);
-  EXPECT_TRUE(holdings.byObject.empty());
+  EXPECT_TRUE(holdings.held.empty());
   EXPECT_EQ(core->frontendTriangles(), 0.0);
   EXPECT_TRUE(protocol::validate(protocol::Message(outcome.update)).ok());
 }
@@ -1120,7 +1088,7 @@ TEST(BackboneCoreResync, HeldObjectsTheNewSessionDoesNotShowAreRemoved) {
 // A restarted backbone with a smaller budget than what the frontend holds:
 // it never adds to the excess, and brings the frontend within its budget.
 TEST(BackboneCoreResync, HoldingsOverTheNewBudgetOnlyShrink) {
-  Holdings holdings = servedByAFirstBackbone(400);
+  FrontendModel holdings = servedByAFirstBackbone(400);
   const double start = holdings.total();
   ASSERT_GT(start, 150.0);
   auto core = restartedCore(100);
@@ -1153,15 +1121,15 @@ TEST(BackboneCoreResync, ANewSessionOfTheSameProcessTakesItsOwnCopiesBack) {
   ASSERT_NE(core, nullptr);
   deliverCurves(*core);
   FakeSimplifier fake(*core);
-  Holdings holdings;
+  FrontendModel holdings;
   for (int step = 0; step < 3; ++step) {
     ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
     answer(*core, fake, submitAll(*core));
     holdings.apply(core->finishPose().update);
   }
-  ASSERT_FALSE(holdings.byObject.empty());
+  ASSERT_FALSE(holdings.held.empty());
   ASSERT_TRUE(core->startFrontendSession(holdings.hello()).ok());
-  EXPECT_EQ(core->heldTakenBack() + core->heldForeign(), holdings.byObject.size());
+  EXPECT_EQ(core->heldTakenBack() + core->heldForeign(), holdings.held.size());
   EXPECT_GT(core->heldTakenBack(), 0u);
   EXPECT_EQ(core->frontendTriangles(), holdings.total());
   ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());

@@ -447,6 +447,15 @@ Bytes wireHelloWithFrameCost(const FrameCostConstants& c) {
   return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
 }
 
+// A frontend's Hello with only the fields of the first protocol revision.
+Bytes olderFrontendHello() {
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("frontend@old");
+  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
+  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
 TEST(HelloFrameCost, ConstantsSurviveTheWireBitForBit) {
   Hello hello = frontendHello();
   hello.frameCost = someFrameCost();
@@ -472,11 +481,7 @@ TEST(HelloFrameCost, AbsentConstantsStayAbsentAndOlderHellosDecode) {
   ASSERT_TRUE(back.ok());
   EXPECT_FALSE(std::get<Hello>(*back).frameCost.has_value());
   // A Hello built without the new field at all (an older frontend's).
-  fb::FlatBufferBuilder b;
-  auto name = b.CreateString("frontend@old");
-  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
-  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
-  Result<Message> old = decode(Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()));
+  Result<Message> old = decode(olderFrontendHello());
   ASSERT_TRUE(old.ok()) << old.status().toString();
   EXPECT_FALSE(std::get<Hello>(*old).frameCost.has_value());
 }
@@ -597,11 +602,7 @@ TEST(HelloHeld, HoldingsSurviveTheWireAndOlderHellosHaveNone) {
   EXPECT_FALSE(other == hello);
 
   // The frontend of an earlier protocol revision sends no list.
-  fb::FlatBufferBuilder b;
-  auto name = b.CreateString("frontend@old");
-  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
-  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
-  Result<Message> old = decode(Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()));
+  Result<Message> old = decode(olderFrontendHello());
   ASSERT_TRUE(old.ok()) << old.status().toString();
   EXPECT_TRUE(std::get<Hello>(*old).held.empty());
 }

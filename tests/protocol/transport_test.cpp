@@ -61,6 +61,23 @@ std::unique_ptr<Channel> connectTo(const std::string& address, Hello hello,
   return channel.ok() ? std::move(*channel) : nullptr;
 }
 
+// A server restarted on `address` (same port, fresh state). ZeroMQ closes
+// the old listener asynchronously, so the port may stay busy for a moment:
+// the bind is retried.
+std::unique_ptr<Endpoint> rebindSameAddress(const std::string& address) {
+  Endpoint::Options options;
+  options.address = address;
+  options.transport = fastTransport();
+  std::unique_ptr<Endpoint> endpoint;
+  (void)pumpUntil([] { std::this_thread::sleep_for(10ms); },
+                  [&] {
+                    auto bound = Endpoint::bind(options);
+                    if (bound.ok()) endpoint = std::move(*bound);
+                    return endpoint != nullptr;
+                  });
+  return endpoint;
+}
+
 std::function<void()> pumpBoth(Endpoint& endpoint, Channel& channel, Recorder& r) {
   return [&] {
     for (auto& e : endpoint.poll(5ms)) r.server.push_back(std::move(e));
@@ -327,17 +344,9 @@ TEST(Transport, ChannelRejoinsARestartedServer) {
       [&] { return !channel->connected(); }));
   EXPECT_EQ(r.count(ChannelEvent::Kind::kDisconnected), 1u);
 
-  // Same port, fresh state. ZeroMQ closes the old listener asynchronously,
-  // so the port may stay busy for a moment: retry the bind.
-  Endpoint::Options options;
-  options.address = address;
-  options.transport = fastTransport();
-  ASSERT_TRUE(pumpUntil([] { std::this_thread::sleep_for(10ms); },
-                        [&] {
-                          auto bound = Endpoint::bind(options);
-                          if (bound.ok()) endpoint = std::move(*bound);
-                          return endpoint != nullptr;
-                        }));
+  // Same port, fresh state.
+  endpoint = rebindSameAddress(address);
+  ASSERT_TRUE(endpoint);
   Recorder after;
   auto step = pumpBoth(*endpoint, *channel, after);
   ASSERT_TRUE(pumpUntil(step, [&] { return channel->connected() && !endpoint->peers().empty(); }));
@@ -382,15 +391,8 @@ TEST(Transport, RejoinHelloCarriesTheLatestHoldings) {
         for (auto& e : channel->poll(5ms)) r.client.push_back(std::move(e));
       },
       [&] { return !channel->connected(); }));
-  Endpoint::Options options;
-  options.address = address;
-  options.transport = fastTransport();
-  ASSERT_TRUE(pumpUntil([] { std::this_thread::sleep_for(10ms); },
-                        [&] {
-                          auto bound = Endpoint::bind(options);
-                          if (bound.ok()) endpoint = std::move(*bound);
-                          return endpoint != nullptr;
-                        }));
+  endpoint = rebindSameAddress(address);
+  ASSERT_TRUE(endpoint);
   Recorder after;
   auto step = pumpBoth(*endpoint, *channel, after);
   ASSERT_TRUE(pumpUntil(step, [&] {
