@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace thinlod::protocol::seeds {
 
@@ -208,6 +209,23 @@ std::vector<NamedMessage> seedMessages() {
   costs.additive = true;
   frontend.frameCost = costs;
   out.push_back({"hello_frontend_frame_cost", frontend});
+  // A frontend's holdings (a new backbone session resynchronises from them).
+  Hello holding = frontend;
+  holding.frameCost.reset();
+  for (const auto& [object, kind, triangles, points] :
+       {std::tuple{1u, RepresentationKind::kMesh, 120u, 0u},
+        std::tuple{4u, RepresentationKind::kMeshedImpostor, 32u, 0u},
+        std::tuple{9u, RepresentationKind::kSimpleImpostor, 2u, 0u},
+        std::tuple{12u, RepresentationKind::kHybrid, 40u, 300u}}) {
+    HeldRepresentation h;
+    h.objectId = object;
+    h.representationId = (std::uint64_t{5} << 40) + object;
+    h.kind = kind;
+    h.triangleCount = triangles;
+    h.pointCount = points;
+    holding.held.push_back(h);
+  }
+  out.push_back({"hello_frontend_held", holding});
 
   // Hybrid triangles + points.
   SimplifyRequest hybridRequest = byPath;

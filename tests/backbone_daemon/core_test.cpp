@@ -979,6 +979,174 @@ TEST(BackboneCoreSession, NewFrontendSessionIsServedFromStoredCopies) {
   EXPECT_LE(outcome.frontendTriangles, 400.0);
 }
 
+// ------------------------------------------------------ resynchronisation
+
+// A frontend served by one backbone process for a few poses.
+FrontendModel servedByAFirstBackbone(double budget) {
+  FrontendModel holdings;
+  auto core = makeCore(polygonBudget(budget));
+  EXPECT_NE(core, nullptr);
+  if (!core) return holdings;
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  for (int step = 0; step < 4; ++step) {
+    EXPECT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    holdings.apply(core->finishPose().update);
+  }
+  return holdings;
+}
+
+std::unique_ptr<BackboneCore> restartedCore(double budget) {
+  CoreOptions options = polygonBudget(budget);
+  options.firstRequestId = std::uint64_t{7} << 40;  // another process's ids
+  auto core = makeCore(options);
+  if (core) deliverCurves(*core);
+  return core;
+}
+
+// A restarted backbone (new process: empty stock, its own ids) learns from
+// the Hello what the frontend kept drawing: its mirror equals the frontend
+// from the first pose on, never over the polygon budget, and whatever the
+// old process sent is replaced by this one's copies or removed.
+TEST(BackboneCoreResync, RestartedBackboneStartsFromWhatTheFrontendHolds) {
+  FrontendModel holdings = servedByAFirstBackbone(400);
+  ASSERT_GT(holdings.total(), 0.0);
+  ASSERT_LE(holdings.total(), 400.0);
+  std::set<std::uint64_t> oldIds;
+  for (const auto& [id, h] : holdings.held) oldIds.insert(h.representationId);
+
+  auto core = restartedCore(400);
+  ASSERT_NE(core, nullptr);
+  const protocol::Hello hello = holdings.hello();
+  ASSERT_TRUE(protocol::validate(protocol::Message(hello)).ok());
+  ASSERT_TRUE(core->admitFrontend(hello).ok());
+  ASSERT_TRUE(core->startFrontendSession(hello).ok());
+  EXPECT_EQ(core->heldForeign(), holdings.held.size());
+  EXPECT_EQ(core->heldTakenBack(), 0u);
+  EXPECT_EQ(core->frontendTriangles(), holdings.total());
+
+  FakeSimplifier fake(*core);
+  std::vector<OutgoingRequest> late;  // answered one pose later
+  for (int step = 0; step < 12; ++step) {
+    const glm::vec3 eye = kEntrance + glm::vec3(0.05f * step, 0.0f, -0.05f * step);
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, eye, kCow)).ok());
+    std::vector<OutgoingRequest> now = submitAll(*core);
+    for (std::uint64_t cancelled : core->takeCancellations()) {
+      late.erase(std::remove_if(late.begin(), late.end(),
+                                [&](const OutgoingRequest& r) { return wireIdOf(r) == cancelled; }),
+                 late.end());
+    }
+    answer(*core, fake, late);
+    late = std::move(now);
+    const PoseOutcome outcome = core->finishPose();
+    ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+    holdings.apply(outcome.update);
+    ASSERT_EQ(holdings.total(), core->frontendTriangles()) << "step " << step;
+    ASSERT_LE(holdings.total(), 400.0) << "step " << step;
+  }
+  ASSERT_FALSE(holdings.held.empty());
+  for (const auto& [id, h] : holdings.held)
+    EXPECT_EQ(oldIds.count(h.representationId), 0u) << "object " << id << " still shows the "
+                                                    << "old process's copy";
+}
+
+// Held copies of objects the new session does not show are removed with its
+// first update (they would otherwise stay at the frontend, unmirrored).
+TEST(BackboneCoreResync, HeldObjectsTheNewSessionDoesNotShowAreRemoved) {
+  FrontendModel holdings = servedByAFirstBackbone(400);
+  ASSERT_FALSE(holdings.held.empty());
+  auto core = restartedCore(400);
+  ASSERT_NE(core, nullptr);
+  ASSERT_TRUE(core->startFrontendSession(holdings.hello()).ok());
+  const glm::vec3 away = kEntrance + glm::vec3(0.0f, 0.0f, 10.0f);
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, away)).ok());
+  submitAll(*core);
+  const PoseOutcome outcome = core->finishPose();
+  EXPECT_EQ(countOps(outcome.update, protocol::SceneOperation::Type::kRemove),
+            holdings.held.size());
+  holdings.apply(outcome.update);
+  EXPECT_TRUE(holdings.held.empty());
+  EXPECT_EQ(core->frontendTriangles(), 0.0);
+  EXPECT_TRUE(protocol::validate(protocol::Message(outcome.update)).ok());
+}
+
+// A restarted backbone with a smaller budget than what the frontend holds:
+// it never adds to the excess, and brings the frontend within its budget.
+TEST(BackboneCoreResync, HoldingsOverTheNewBudgetOnlyShrink) {
+  FrontendModel holdings = servedByAFirstBackbone(400);
+  const double start = holdings.total();
+  ASSERT_GT(start, 150.0);
+  auto core = restartedCore(100);
+  ASSERT_NE(core, nullptr);
+  ASSERT_TRUE(core->startFrontendSession(holdings.hello()).ok());
+  FakeSimplifier fake(*core);
+  double previous = start;
+  for (int step = 0; step < 12; ++step) {
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    const PoseOutcome outcome = core->finishPose();
+    holdings.apply(outcome.update);
+    ASSERT_EQ(holdings.total(), core->frontendTriangles()) << "step " << step;
+    if (previous > 100.0) {
+      ASSERT_LE(holdings.total(), previous) << "step " << step;
+    } else {
+      ASSERT_LE(holdings.total(), 100.0) << "step " << step;
+    }
+    previous = holdings.total();
+  }
+  EXPECT_LE(holdings.total(), 100.0);
+}
+
+// The same backbone process (a session that timed out during a stall): the
+// held copies it still has in its stock are taken back whole (a copy whose
+// stock place a newer result took is foreign, as in another process), and
+// none of them is shipped again.
+TEST(BackboneCoreResync, ANewSessionOfTheSameProcessTakesItsOwnCopiesBack) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  deliverCurves(*core);
+  FakeSimplifier fake(*core);
+  FrontendModel holdings;
+  for (int step = 0; step < 3; ++step) {
+    ASSERT_TRUE(core->beginPose(poseAt(step, step * 0.5, kEntrance, kCow)).ok());
+    answer(*core, fake, submitAll(*core));
+    holdings.apply(core->finishPose().update);
+  }
+  ASSERT_FALSE(holdings.held.empty());
+  ASSERT_TRUE(core->startFrontendSession(holdings.hello()).ok());
+  EXPECT_EQ(core->heldTakenBack() + core->heldForeign(), holdings.held.size());
+  EXPECT_GT(core->heldTakenBack(), 0u);
+  EXPECT_EQ(core->frontendTriangles(), holdings.total());
+  ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  submitAll(*core);
+  const PoseOutcome outcome = core->finishPose();
+  holdings.apply(outcome.update);
+  EXPECT_EQ(holdings.total(), core->frontendTriangles());
+  // What was taken back is not shipped again.
+  EXPECT_LE(outcome.adds, core->heldForeign());
+  for (const auto& op : outcome.update.operations)
+    EXPECT_EQ(op.type, protocol::SceneOperation::Type::kAddOrReplace);
+}
+
+TEST(BackboneCoreResync, AHelloHoldingAnObjectTheSceneLacksIsRefused) {
+  auto core = makeCore(polygonBudget(400));
+  ASSERT_NE(core, nullptr);
+  protocol::Hello hello;
+  hello.role = protocol::Role::kFrontend;
+  hello.name = "frontend@test";
+  protocol::HeldRepresentation h;
+  h.objectId = 99;
+  h.triangleCount = 10;
+  hello.held.push_back(h);
+  const Status admitted = core->admitFrontend(hello);
+  ASSERT_FALSE(admitted.ok());
+  EXPECT_EQ(admitted.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(admitted.message().find("object 99"), std::string::npos) << admitted.toString();
+  EXPECT_FALSE(core->startFrontendSession(hello).ok());
+  EXPECT_EQ(core->frontendTriangles(), 0.0);
+}
+
 // The loop is closed: a SceneUpdate the frontend refused (FrameStats
 // rejected_plans) is corrected in the backbone's mirror and its objects are
 // sent again; an applied one is simply forgotten.

@@ -197,15 +197,25 @@ inline protocol::ViewerPose poseAt(std::uint64_t sequence, double seconds, glm::
   return pose;
 }
 
-// What the frontend holds after applying updates (object id -> triangles).
+// What the frontend holds after applying updates (object id -> triangles),
+// and what it says in its Hello (Hello.held, as
+// frontend/src/daemon/wire_conversion.h heldRepresentations builds it).
 struct FrontendModel {
   std::map<std::uint64_t, std::uint32_t> triangles;
+  std::map<std::uint64_t, protocol::HeldRepresentation> held;
   void apply(const protocol::SceneUpdate& update) {
     for (const protocol::SceneOperation& op : update.operations) {
       if (op.type == protocol::SceneOperation::Type::kRemove) {
         triangles.erase(op.objectId);
+        held.erase(op.objectId);
       } else {
         triangles[op.objectId] = op.representation.triangleCount;
+        protocol::HeldRepresentation& h = held[op.objectId];
+        h.objectId = op.objectId;
+        h.representationId = op.representation.representationId;
+        h.kind = op.representation.kind;
+        h.triangleCount = op.representation.triangleCount;
+        h.pointCount = op.representation.pointCount;
       }
     }
   }
@@ -213,6 +223,13 @@ struct FrontendModel {
     double sum = 0.0;
     for (const auto& entry : triangles) sum += entry.second;
     return sum;
+  }
+  protocol::Hello hello() const {
+    protocol::Hello hello;
+    hello.role = protocol::Role::kFrontend;
+    hello.name = "frontend@test";
+    for (const auto& [id, h] : held) hello.held.push_back(h);
+    return hello;
   }
 };
 

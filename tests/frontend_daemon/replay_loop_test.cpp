@@ -70,8 +70,13 @@ class FakeLink final : public BackboneLink {
     return arrived;
   }
   std::uint64_t bytesReceived() const override { return bytes; }
+  Status setHeld(std::vector<protocol::HeldRepresentation> h) override {
+    held.push_back(std::move(h));
+    return Status();
+  }
 
   bool up = true;
+  std::vector<std::vector<protocol::HeldRepresentation>> held;  // every setHeld, in order
   std::int64_t dropAtNs = std::numeric_limits<std::int64_t>::max();
   Responder responder;
   std::vector<protocol::ViewerPose> poses;
@@ -103,6 +108,7 @@ class SceneProducer final : public FrameProducer {
     produced.appliedPlan = scene.lastAppliedPlan();
     produced.committedBatches = committed.plans.size();
     produced.renderMs = static_cast<double>(renderNs) / kMs;
+    if (committed.changed()) produced.held = heldRepresentations(scene);
     return produced;
   }
   Result<FrameQuality> measure(std::uint64_t, const Pose&) override {
@@ -551,6 +557,34 @@ TEST_F(ReplayLoopTest, LostFirstUpdateOfASessionIsReported) {
   EXPECT_TRUE(link.frameStats[0].rejectedPlans.empty());
   EXPECT_EQ(link.frameStats[1].rejectedPlans, (std::vector<std::uint64_t>{1}));
   EXPECT_EQ(result.updatesMissed, 1u);
+}
+
+// Resynchronisation: what is held goes to the link (the Hello of the next
+// reconnect) each time it changes, and only then.
+TEST_F(ReplayLoopTest, HoldingsGoToTheLinkWheneverTheyChange) {
+  options.lockstep = true;
+  options.lockstepTimeout = std::chrono::milliseconds(50);
+  options.rate = -1.0;
+  link.responder = [](const protocol::ViewerPose& pose)
+      -> std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> {
+    if (pose.sequence == 1) return std::nullopt;  // frame 1: nothing new
+    protocol::SceneUpdate update =
+        sphereUpdate(pose.sequence + 1, pose.sequence, pose.sequence == 0 ? 7 : 3, 1.0);
+    update.operations[0].representation.representationId = 100 + pose.sequence;
+    return std::make_pair(kMs, update);
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_EQ(result.records.size(), 3u);
+  ASSERT_EQ(link.held.size(), 2u);  // frames 0 and 2
+  ASSERT_EQ(link.held[0].size(), 1u);
+  EXPECT_EQ(link.held[0][0].objectId, 7u);
+  EXPECT_EQ(link.held[0][0].representationId, 100u);
+  EXPECT_EQ(link.held[0][0].kind, protocol::RepresentationKind::kMesh);
+  EXPECT_EQ(link.held[0][0].triangleCount, kSphereTriangles);
+  ASSERT_EQ(link.held[1].size(), 2u);  // ascending ids
+  EXPECT_EQ(link.held[1][0].objectId, 3u);
+  EXPECT_EQ(link.held[1][0].representationId, 102u);
+  EXPECT_EQ(link.held[1][1].objectId, 7u);
 }
 
 TEST_F(ReplayLoopTest, StopRequestEndsTheReplayEarly) {

@@ -523,6 +523,15 @@ Bytes wireHelloWithFrameCost(const FrameCostConstants& c) {
   return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
 }
 
+// A frontend's Hello with only the fields of the first protocol revision.
+Bytes olderFrontendHello() {
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("frontend@old");
+  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
+  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
 TEST(HelloFrameCost, ConstantsSurviveTheWireBitForBit) {
   Hello hello = frontendHello();
   hello.frameCost = someFrameCost();
@@ -548,11 +557,7 @@ TEST(HelloFrameCost, AbsentConstantsStayAbsentAndOlderHellosDecode) {
   ASSERT_TRUE(back.ok());
   EXPECT_FALSE(std::get<Hello>(*back).frameCost.has_value());
   // A Hello built without the new field at all (an older frontend's).
-  fb::FlatBufferBuilder b;
-  auto name = b.CreateString("frontend@old");
-  auto body = w::CreateHello(b, 1, 1, w::Role::Frontend, name).Union();
-  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
-  Result<Message> old = decode(Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()));
+  Result<Message> old = decode(olderFrontendHello());
   ASSERT_TRUE(old.ok()) << old.status().toString();
   EXPECT_FALSE(std::get<Hello>(*old).frameCost.has_value());
 }
@@ -603,6 +608,134 @@ TEST(HelloFrameCost, NonFiniteNegativeAndImplausibleConstantsAreRefusedNamingThe
   edge.triangleSeconds = kMaxTriangleSeconds;
   edge.pixelSeconds = kMaxPixelSeconds;
   EXPECT_TRUE(decode(wireHelloWithFrameCost(edge)).ok());
+}
+
+}  // namespace
+}  // namespace thinlod::protocol
+
+// ---- Hello.held: a frontend's holdings for a new backbone session ----
+namespace thinlod::protocol {
+namespace {
+
+namespace fb = flatbuffers;
+namespace w = thinlod::wire;
+
+HeldRepresentation held(std::uint64_t object, RepresentationKind kind, std::uint32_t triangles,
+                        std::uint32_t points = 0) {
+  HeldRepresentation h;
+  h.objectId = object;
+  h.representationId = 1000 + object;
+  h.kind = kind;
+  h.triangleCount = triangles;
+  h.pointCount = points;
+  return h;
+}
+
+Hello helloHolding(std::vector<HeldRepresentation> items) {
+  Hello hello;
+  hello.role = Role::kFrontend;
+  hello.name = "frontend@test";
+  hello.held = std::move(items);
+  return hello;
+}
+
+// A Hello whose held list is what the sender wrote (a hostile or broken peer).
+Bytes wireHelloHolding(const std::vector<HeldRepresentation>& items) {
+  fb::FlatBufferBuilder b;
+  auto name = b.CreateString("frontend@hostile");
+  std::vector<fb::Offset<w::HeldRepresentation>> offsets;
+  for (const HeldRepresentation& h : items)
+    offsets.push_back(w::CreateHeldRepresentation(b, h.objectId, h.representationId,
+                                                  static_cast<w::RepresentationKind>(h.kind),
+                                                  h.triangleCount, h.pointCount));
+  auto vec = b.CreateVector(offsets);
+  auto body =
+      w::CreateHello(b, 1, 1, w::Role::Frontend, name, 7, 0, 0, 0, 0, 0, vec).Union();
+  b.Finish(w::CreateEnvelope(b, kProtocolVersion, w::Body::Hello, body), "TLOD");
+  return Bytes(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
+TEST(HelloHeld, HoldingsSurviveTheWireAndOlderHellosHaveNone) {
+  const Hello hello =
+      helloHolding({held(1, RepresentationKind::kMesh, 120),
+                    held(3, RepresentationKind::kMeshedImpostor, 32),
+                    held(9, RepresentationKind::kHybrid, 40, 300),
+                    held(12, RepresentationKind::kSimpleImpostor, 2)});
+  Result<Bytes> bytes = encode(Message(hello));
+  ASSERT_TRUE(bytes.ok()) << bytes.status().toString();
+  Result<Message> back = decode(*bytes);
+  ASSERT_TRUE(back.ok()) << back.status().toString();
+  const Hello& got = std::get<Hello>(*back);
+  ASSERT_EQ(got.held.size(), 4u);
+  EXPECT_EQ(got.held[2].objectId, 9u);
+  EXPECT_EQ(got.held[2].representationId, 1009u);
+  EXPECT_EQ(got.held[2].kind, RepresentationKind::kHybrid);
+  EXPECT_EQ(got.held[2].triangleCount, 40u);
+  EXPECT_EQ(got.held[2].pointCount, 300u);
+  EXPECT_TRUE(got == hello);
+  Hello other = hello;
+  other.held[0].triangleCount = 121;
+  EXPECT_FALSE(other == hello);
+
+  // The frontend of an earlier protocol revision sends no list.
+  Result<Message> old = decode(olderFrontendHello());
+  ASSERT_TRUE(old.ok()) << old.status().toString();
+  EXPECT_TRUE(std::get<Hello>(*old).held.empty());
+}
+
+TEST(HelloHeld, MalformedHoldingsAreRefusedNamingTheEntry) {
+  struct Case {
+    const char* what;
+    std::vector<HeldRepresentation> items;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"object 0", {held(0, RepresentationKind::kMesh, 10)}, "Hello.held[0].object_id"},
+      {"descending ids",
+       {held(5, RepresentationKind::kMesh, 10), held(4, RepresentationKind::kMesh, 10)},
+       "Hello.held[1].object_id"},
+      {"an object twice",
+       {held(5, RepresentationKind::kMesh, 10), held(5, RepresentationKind::kMesh, 12)},
+       "unique and ascending"},
+      {"unknown kind", {held(2, static_cast<RepresentationKind>(9), 10)}, "Hello.held[0].kind"},
+      {"too many triangles",
+       {held(2, RepresentationKind::kMesh, kMaxTriangleCount + 1)},
+       "Hello.held[0].triangle_count"},
+      {"points on a mesh", {held(2, RepresentationKind::kMesh, 10, 5)}, "Hello.held[0].point_count"},
+      {"too many points",
+       {held(2, RepresentationKind::kHybrid, 10, kMaxPointCount + 1)},
+       "Hello.held[0].point_count"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    Result<Message> decoded = decode(wireHelloHolding(c.items));
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_NE(decoded.status().message().find(c.expected), std::string::npos)
+        << decoded.status().toString();
+    // We never send what a peer would refuse either.
+    EXPECT_FALSE(encode(Message(helloHolding(c.items))).ok());
+  }
+  // Holdings belong to frontends.
+  Hello worker = helloHolding({held(1, RepresentationKind::kMesh, 10)});
+  worker.role = Role::kSimplifier;
+  Result<Bytes> workerBytes = encode(Message(worker));
+  ASSERT_FALSE(workerBytes.ok());
+  EXPECT_NE(workerBytes.status().message().find("frontends only"), std::string::npos);
+}
+
+TEST(HelloHeld, TheListIsBoundedByKMaxHeldRepresentations) {
+  std::vector<HeldRepresentation> items;
+  for (std::uint64_t id = 1; id <= kMaxHeldRepresentations; ++id)
+    items.push_back(held(id, RepresentationKind::kMesh, 2));
+  Result<Bytes> full = encode(Message(helloHolding(items)));
+  ASSERT_TRUE(full.ok()) << full.status().toString();
+  ASSERT_TRUE(decode(*full).ok());
+  items.push_back(held(kMaxHeldRepresentations + 1, RepresentationKind::kMesh, 2));
+  EXPECT_FALSE(encode(Message(helloHolding(items))).ok());
+  Result<Message> over = decode(wireHelloHolding(items));
+  ASSERT_FALSE(over.ok());
+  EXPECT_NE(over.status().message().find("Hello.held"), std::string::npos)
+      << over.status().toString();
 }
 
 }  // namespace

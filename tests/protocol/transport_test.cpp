@@ -61,6 +61,23 @@ std::unique_ptr<Channel> connectTo(const std::string& address, Hello hello,
   return channel.ok() ? std::move(*channel) : nullptr;
 }
 
+// A server restarted on `address` (same port, fresh state). ZeroMQ closes
+// the old listener asynchronously, so the port may stay busy for a moment:
+// the bind is retried.
+std::unique_ptr<Endpoint> rebindSameAddress(const std::string& address) {
+  Endpoint::Options options;
+  options.address = address;
+  options.transport = fastTransport();
+  std::unique_ptr<Endpoint> endpoint;
+  (void)pumpUntil([] { std::this_thread::sleep_for(10ms); },
+                  [&] {
+                    auto bound = Endpoint::bind(options);
+                    if (bound.ok()) endpoint = std::move(*bound);
+                    return endpoint != nullptr;
+                  });
+  return endpoint;
+}
+
 std::function<void()> pumpBoth(Endpoint& endpoint, Channel& channel, Recorder& r) {
   return [&] {
     for (auto& e : endpoint.poll(5ms)) r.server.push_back(std::move(e));
@@ -327,17 +344,9 @@ TEST(Transport, ChannelRejoinsARestartedServer) {
       [&] { return !channel->connected(); }));
   EXPECT_EQ(r.count(ChannelEvent::Kind::kDisconnected), 1u);
 
-  // Same port, fresh state. ZeroMQ closes the old listener asynchronously,
-  // so the port may stay busy for a moment: retry the bind.
-  Endpoint::Options options;
-  options.address = address;
-  options.transport = fastTransport();
-  ASSERT_TRUE(pumpUntil([] { std::this_thread::sleep_for(10ms); },
-                        [&] {
-                          auto bound = Endpoint::bind(options);
-                          if (bound.ok()) endpoint = std::move(*bound);
-                          return endpoint != nullptr;
-                        }));
+  // Same port, fresh state.
+  endpoint = rebindSameAddress(address);
+  ASSERT_TRUE(endpoint);
   Recorder after;
   auto step = pumpBoth(*endpoint, *channel, after);
   ASSERT_TRUE(pumpUntil(step, [&] { return channel->connected() && !endpoint->peers().empty(); }));
@@ -347,6 +356,56 @@ TEST(Transport, ChannelRejoinsARestartedServer) {
     return after.findServer(
         [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kMessage; });
   }));
+}
+
+// Resynchronisation: the Hello a restarted server gets carries what the
+// client said it holds (Channel::setHeld) by then; a bad list changes nothing.
+TEST(Transport, RejoinHelloCarriesTheLatestHoldings) {
+  auto endpoint = bindLoopback();
+  ASSERT_TRUE(endpoint);
+  const std::string address = endpoint->address();
+  auto channel = connectTo(address, helloAs(Role::kFrontend, "holder"));
+  Recorder r;
+  ASSERT_TRUE(pumpUntil(pumpBoth(*endpoint, *channel, r), [&] { return channel->connected(); }));
+  const EndpointEvent* first = r.findServer(
+      [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; });
+  ASSERT_NE(first, nullptr);
+  EXPECT_TRUE(std::get<Hello>(first->message).held.empty());
+
+  HeldRepresentation a;
+  a.objectId = 2;
+  a.representationId = 77;
+  a.triangleCount = 120;
+  HeldRepresentation b = a;
+  b.objectId = 5;
+  b.kind = RepresentationKind::kSimpleImpostor;
+  b.triangleCount = 2;
+  ASSERT_TRUE(channel->setHeld({a, b}).ok());
+  HeldRepresentation unordered = a;
+  unordered.objectId = 1;
+  EXPECT_FALSE(channel->setHeld({a, unordered}).ok());  // refused, the list stays {a, b}
+
+  endpoint.reset();
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        for (auto& e : channel->poll(5ms)) r.client.push_back(std::move(e));
+      },
+      [&] { return !channel->connected(); }));
+  endpoint = rebindSameAddress(address);
+  ASSERT_TRUE(endpoint);
+  Recorder after;
+  auto step = pumpBoth(*endpoint, *channel, after);
+  ASSERT_TRUE(pumpUntil(step, [&] {
+    return after.findServer(
+               [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; }) !=
+           nullptr;
+  }));
+  const EndpointEvent* joined = after.findServer(
+      [](const EndpointEvent& e) { return e.kind == EndpointEvent::Kind::kJoined; });
+  const Hello& hello = std::get<Hello>(joined->message);
+  ASSERT_EQ(hello.held.size(), 2u);
+  EXPECT_TRUE(hello.held[0] == a);
+  EXPECT_TRUE(hello.held[1] == b);
 }
 
 TEST(Transport, ChannelNoticesASilentServerAndRejoins) {

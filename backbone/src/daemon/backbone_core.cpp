@@ -134,7 +134,19 @@ Status BackboneCore::admitFrontend(const protocol::Hello& hello) const {
   THINLOD_RETURN_IF_ERROR(protocol::checkSameScene("backbone", sceneGraph_.fingerprint, scenePath_,
                                                    "frontend", hello.sceneFingerprint,
                                                    hello.sceneFile));
+  THINLOD_RETURN_IF_ERROR(checkHeld(hello.held));
   return frameCostFor(hello).status();
+}
+
+Status BackboneCore::checkHeld(const std::vector<protocol::HeldRepresentation>& held) const {
+  if (held.size() > protocol::kMaxHeldRepresentations)
+    return invalid("Hello.held lists " + std::to_string(held.size()) + " representations, limit " +
+                   std::to_string(protocol::kMaxHeldRepresentations));
+  for (const protocol::HeldRepresentation& h : held)
+    if (objectById_.count(h.objectId) == 0)
+      return invalid("Hello.held names object " + idText(h.objectId) +
+                     ", which the backbone's scene does not have");
+  return Status();
 }
 
 const char* frameCostSourceName(FrameCostSource source) {
@@ -184,6 +196,41 @@ Status BackboneCore::startFrontendSession(const protocol::Hello& hello) {
     scheduler_ = std::move(scheduler).value();
   }
   sessionFrameCost_ = *session;
+  THINLOD_RETURN_IF_ERROR(checkHeld(hello.held));
+  heldForeign_ = 0;
+  heldTakenBack_ = 0;
+  for (const protocol::HeldRepresentation& h : hello.held) {
+    const std::uint32_t object = objectById_.at(h.objectId);
+    const backbone::SceneObject& o = scene_.objects[object];
+    if (o.optionCount == 0) continue;
+    // The option of the held kind (its first option if this backbone has
+    // none of that kind: the units count all the same).
+    std::uint32_t option = o.firstOption;
+    for (std::uint32_t k = o.firstOption; k < o.firstOption + o.optionCount; ++k) {
+      if (optionStates_[k].wireKind == h.kind) {
+        option = k;
+        break;
+      }
+    }
+    backbone::RepresentationCopy copy;
+    copy.present = true;
+    copy.id = h.representationId;
+    // Credited with nothing: the scheduler never keeps it for accuracy
+    // (valid nowhere; the smallest positive accuracy, as copies need > 0).
+    copy.relativeAccuracy = std::numeric_limits<double>::min();
+    copy.triangles = double(h.triangleCount);
+    if (h.kind == protocol::RepresentationKind::kHybrid && options_.hybridKappa > 0.0)
+      copy.triangles += double(h.pointCount) / options_.hybridKappa;
+    copy.encodedBytes = 0.0;
+    copy.validity = ConicRange::nowhere();
+    if (mirror_.adopt(object, option, copy)) {
+      ++heldTakenBack_;
+    } else {
+      // Its id may be another process's: a foreign copy goes by none.
+      scene_.options[option].atFrontend.id = 0;
+      ++heldForeign_;
+    }
+  }
   return Status();
 }
 
@@ -196,6 +243,8 @@ Status BackboneCore::initialize() {
   converted_ = std::move(converted).value();
   scene_ = std::move(converted_.scheduling);
   converted_.scheduling = backbone::SchedulingScene();
+  for (std::uint32_t k = 0; k < converted_.records.size(); ++k)
+    objectById_[converted_.records[k].id] = k;
 
   // Until a frontend session says otherwise: the default frame cost.
   CoreOptions initial = options_;

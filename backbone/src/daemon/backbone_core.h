@@ -211,7 +211,22 @@ class BackboneCore {
   // A new frontend session: resetFrontend(), then the scheduler's frame-cost
   // constants are the ones this frontend's Hello earns (frameCostFor). Errors
   // as frameCostFor's; the core is then reset but keeps its old constants.
+  // Then the mirror starts from what the Hello says the frontend holds
+  // (Hello.held, checked by checkHeld): a held copy this process still has
+  // in its stock under the same id is taken back whole; any other is a
+  // foreign copy credited with nothing (no accuracy, valid nowhere) whose
+  // primitive units count against the polygon budget until a copy of this
+  // session replaces it or the plan removes the object. A backbone that
+  // restarted thus neither over-fills the frontend nor leaves what it never
+  // sent there unmirrored (docs/backbone.md, "Resynchronisation").
   Status startFrontendSession(const protocol::Hello& hello);
+  // Hello.held against this scene: every object id known (the decoder
+  // checked count, order, kinds and sizes). kInvalidArgument naming the
+  // first unknown id.
+  Status checkHeld(const std::vector<protocol::HeldRepresentation>& held) const;
+  // Foreign and taken-back copies of the last startFrontendSession.
+  std::size_t heldForeign() const { return heldForeign_; }
+  std::size_t heldTakenBack() const { return heldTakenBack_; }
   // The constants a session of this frontend would use (see the contract);
   // kInvalidArgument when the frame-time budget has none for it or the
   // Hello's are unusable (validateCalibratedFrameCost).
@@ -337,6 +352,9 @@ class BackboneCore {
   std::optional<protocol::LinkShaper> shaper_;
   std::uint64_t shapedBytes_ = 0;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
+  std::map<std::uint64_t, std::uint32_t> objectById_;  // wire object id -> object index
+  std::size_t heldForeign_ = 0;
+  std::size_t heldTakenBack_ = 0;
 };
 
 }  // namespace thinlod::backbone_daemon

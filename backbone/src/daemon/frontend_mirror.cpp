@@ -16,6 +16,29 @@ void FrontendMirror::reset() {
   resync_.clear();
 }
 
+bool FrontendMirror::adopt(std::uint32_t object, std::uint32_t index,
+                           const backbone::RepresentationCopy& copy) {
+  if (frontendPayload_.size() < scene_.options.size())
+    frontendPayload_.resize(scene_.options.size());
+  if (stockPayload_.size() < scene_.options.size()) stockPayload_.resize(scene_.options.size());
+  takeOff(object);
+  backbone::RepresentationOption& option = scene_.options[index];
+  const bool takeBack = copy.id != 0 && option.atBackbone.present &&
+                        option.atBackbone.id == copy.id && stockPayload_[index];
+  if (takeBack) {
+    option.atFrontend = option.atBackbone;
+    frontendPayload_[index] = std::move(stockPayload_[index]);
+    option.atBackbone = backbone::RepresentationCopy();
+    stockPayload_[index].reset();
+  } else {
+    option.atFrontend = copy;
+    frontendPayload_[index].reset();
+  }
+  triangles_ += option.atFrontend.triangles;
+  touched_(object);
+  return takeBack;
+}
+
 void FrontendMirror::storeGenerated(std::uint32_t option, backbone::RepresentationCopy copy,
                                     protocol::Representation payload) {
   if (stockPayload_.size() < scene_.options.size()) stockPayload_.resize(scene_.options.size());

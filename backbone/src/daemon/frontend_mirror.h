@@ -36,6 +36,13 @@ class FrontendMirror {
 
   // The frontend session ended: it holds nothing, nothing is awaited.
   void reset();
+  // A new session's frontend says it holds `copy` of `option` (Hello.held):
+  // the object's frontend side is set to it, nothing to acknowledge. When
+  // the stock holds that option's copy under the same (non-zero) id, the
+  // stock copy and its payload move to the frontend instead (a session of
+  // the same backbone process). Otherwise the copy has no payload, so taking
+  // it off later stocks nothing. True when the stock copy was taken back.
+  bool adopt(std::uint32_t object, std::uint32_t option, const backbone::RepresentationCopy& copy);
 
   // ---- the stock (generated, not at the frontend) ----
   void storeGenerated(std::uint32_t option, backbone::RepresentationCopy copy,

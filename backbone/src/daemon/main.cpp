@@ -309,8 +309,9 @@ class Daemon {
     switch (event.kind) {
       case protocol::EndpointEvent::Kind::kJoined: {
         const protocol::Hello& hello = std::get<protocol::Hello>(event.message);
-        spdlog::info("event=frontend_joined peer={} name={} frame_cost={}", event.peer.value,
-                     hello.name, hello.frameCost ? "sent" : "none");
+        spdlog::info("event=frontend_joined peer={} name={} frame_cost={} held={}",
+                     event.peer.value, hello.name, hello.frameCost ? "sent" : "none",
+                     hello.held.size());
         hellos_[event.peer.value] = hello;
         break;
       }
@@ -427,6 +428,13 @@ class Daemon {
             cost.constants.initSeconds * 1e3, cost.constants.finalSeconds * 1e3,
             cost.constants.setupSeconds * 1e6, cost.constants.triangleSeconds * 1e9,
             cost.constants.pixelSeconds * 1e9, cost.constants.additive ? 1 : 0);
+      const auto held = hello != hellos_.end() ? hello->second.held.size() : 0;
+      if (held > 0)
+        spdlog::info(
+            "event=frontend_resync peer={} held={} taken_back={} foreign={} "
+            "frontend_triangles={:.0f}",
+            peer.value, held, core_.heldTakenBack(), core_.heldForeign(),
+            core_.frontendTriangles());
       active_ = peer;
       hadFrontend_ = true;
     }

@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/trigonometric.hpp>
+#include <initializer_list>
 #include <optional>
 #include <system_error>
 
@@ -36,6 +37,7 @@ std::string_view trim(std::string_view s) {
 
 std::vector<std::string_view> splitFields(std::string_view s) {
   std::vector<std::string_view> fields;
+  fields.reserve(10);  // a pose line's fields: one allocation per line
   std::size_t i = 0;
   while (i < s.size()) {
     while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
@@ -60,20 +62,21 @@ std::optional<double> parseNumber(std::string_view field) {
 // Parses fields[first..first+names.size()) into `out`, checking finiteness
 // (as float when `asFloat`, since positions are stored as float).
 Status parseFields(std::size_t line, const std::vector<std::string_view>& fields, std::size_t first,
-                   const std::vector<const char*>& names, bool asFloat, double* out) {
-  for (std::size_t k = 0; k < names.size(); ++k) {
+                   std::initializer_list<const char*> names, bool asFloat, double* out) {
+  std::size_t k = 0;
+  for (const char* name : names) {
     const std::string_view field = fields[first + k];
     const std::optional<double> value = parseNumber(field);
     if (!value) {
-      return lineError(line, std::string("field ") + names[k] + " is not a number: '" +
+      return lineError(line, std::string("field ") + name + " is not a number: '" +
                                  std::string(field) + "'");
     }
     const bool finite = asFloat ? std::isfinite(static_cast<float>(*value)) : std::isfinite(*value);
     if (!finite) {
       return lineError(
-          line, std::string("field ") + names[k] + " is not finite: '" + std::string(field) + "'");
+          line, std::string("field ") + name + " is not finite: '" + std::string(field) + "'");
     }
-    out[k] = *value;
+    out[k++] = *value;
   }
   return Status::okStatus();
 }
@@ -239,8 +242,13 @@ void TraceStreamParser::completeLine(Output& out) {
   ++lines_;
   const bool overlong = overlong_;
   overlong_ = false;
-  std::string line;
-  line.swap(partial_);
+  // The line is read where it was gathered; clearing keeps the buffer for
+  // the next line (one allocation per stream, not per line).
+  struct ClearOnExit {
+    std::string& text;
+    ~ClearOnExit() { text.clear(); }
+  } clearPartial{partial_};
+  const std::string& line = partial_;
   if (failed_) return;
   if (overlong) {
     reject(lineError(lines_, "line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes"),

@@ -85,6 +85,10 @@ void ChannelLink::drain(std::chrono::milliseconds timeout, int wakeFd) {
   }
 }
 
+Status ChannelLink::setHeld(std::vector<protocol::HeldRepresentation> held) {
+  return channel_->setHeld(std::move(held));
+}
+
 std::vector<protocol::SceneUpdate> ChannelLink::poll(std::chrono::milliseconds timeout,
                                                      int wakeFd) {
   drain(timeout, wakeFd);

@@ -33,6 +33,7 @@ class ChannelLink final : public BackboneLink {
   std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout,
                                           int wakeFd = -1) override;
   std::uint64_t bytesReceived() const override;
+  Status setHeld(std::vector<protocol::HeldRepresentation> held) override;
 
   // Polls until the handshake is done, `timeout` passes or stop() is true,
   // logging progress every `progressEvery`. SceneUpdates arriving meanwhile

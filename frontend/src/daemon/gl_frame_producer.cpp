@@ -103,6 +103,11 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   produced.renderMs = report->timing.totalMs;
   produced.drawCalls = report->drawCalls;
   produced.uploadedBytes = report->uploadedBytes;
+  std::vector<protocol::HeldRepresentation> held = heldRepresentations(renderer_->scene());
+  if (held != lastHeld_) {
+    lastHeld_ = held;
+    produced.held = std::move(held);
+  }
   return produced;
 }
 

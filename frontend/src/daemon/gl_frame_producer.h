@@ -78,6 +78,7 @@ class GlFrameProducer final : public FrameProducer {
   std::vector<std::uint32_t> covered_;
   ShownFrameLog kept_;
   HeldObjects held_;
+  std::vector<protocol::HeldRepresentation> lastHeld_;  // as last reported (ProducedFrame::held)
   std::uint64_t heldPlan_ = 0;
   std::size_t heldCount_ = 0;
   std::size_t keptPeakBytes_ = 0;

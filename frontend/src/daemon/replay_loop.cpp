@@ -108,6 +108,10 @@ class Replay {
         break;
       }
       const std::int64_t frameDoneNs = clock_.nowNs();
+      if (produced->held) {
+        const Status held = link_.setHeld(std::move(*produced->held));
+        if (!held.ok()) observer_.onSendFailed("Hello.held", i, held);
+      }
       recordDrawn(i, pose, *produced, frameDoneNs);
       if (fresh) record_.poseToFrameMs = (frameDoneNs - sampledNs) / kNsPerMs;
 

@@ -16,6 +16,10 @@
 //   (bad update, upload dropped) and of updates missed (a jump in the plan
 //   numbers of one backbone process: lost on the way); each is repeated in 3
 //   FrameStats in a row, since a FrameStats can be lost too.
+// - Resynchronisation: whenever a frame's holdings changed
+//   (ProducedFrame::held), they go to BackboneLink::setHeld, so the Hello a
+//   reconnect says (a restarted or timed-out backbone) tells the new session
+//   what is held; the frontend keeps drawing it meanwhile.
 // - Memory: the loop keeps no records (the observer streams them, e.g. into a
 //   FrameLog); per frame it keeps 8 bytes (when the pose was sent, for
 //   update_latency_ms of a later answer) and 1 bit (answered), whatever the
@@ -62,6 +66,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -98,6 +103,9 @@ class BackboneLink {
   virtual std::vector<protocol::SceneUpdate> poll(std::chrono::milliseconds timeout,
                                                   int wakeFd = -1) = 0;
   virtual std::uint64_t bytesReceived() const = 0;  // encoded bytes, all messages, ever
+  // What the frontend holds now, for the Hello of every later (re)connect
+  // (Hello.held): a new backbone session starts its mirror from it.
+  virtual Status setHeld(std::vector<protocol::HeldRepresentation> held) = 0;
 };
 
 struct ProducedFrame {
@@ -110,6 +118,10 @@ struct ProducedFrame {
   double renderMs = 0.0;
   std::size_t drawCalls = 0;
   std::size_t uploadedBytes = 0;
+  // Set when what the frontend holds changed since the previous frame
+  // (heldRepresentations of the scene drawn); the loop hands it to
+  // BackboneLink::setHeld.
+  std::optional<std::vector<protocol::HeldRepresentation>> held;
 };
 
 // Renders the frontend frame and its reference.

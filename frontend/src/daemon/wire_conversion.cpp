@@ -118,6 +118,7 @@ Result<Representation> convertOne(const protocol::Representation& wire, std::uin
   rep.kind = wire.kind;  // one enum on the wire and at the frontend
   rep.transform = wire.transform;
   rep.generation = wire.generation;
+  rep.representationId = wire.representationId;
   const std::string kindName = representationKindName(rep.kind);
 
   if (rep.kind == RepresentationKind::kHybrid) {
@@ -308,6 +309,27 @@ protocol::FrameStats toFrameStats(const FrameRecord& record, std::int64_t timest
   stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
   stats.rejectedPlans = std::move(rejectedPlans);
   return stats;
+}
+
+std::vector<protocol::HeldRepresentation> heldRepresentations(const FrontendScene& scene) {
+  std::vector<protocol::HeldRepresentation> held;
+  held.reserve(scene.objects().size());
+  for (const auto& [id, object] : scene.objects()) {  // ascending ids
+    if (held.size() == protocol::kMaxHeldRepresentations) break;
+    protocol::HeldRepresentation h;
+    h.objectId = id;
+    h.representationId = object.representation.representationId;
+    h.kind = object.representation.kind;
+    h.triangleCount = static_cast<std::uint32_t>(
+        std::min<std::size_t>(object.triangleCount, protocol::kMaxTriangleCount));
+    h.pointCount =
+        object.representation.kind == RepresentationKind::kHybrid
+            ? static_cast<std::uint32_t>(std::min<std::size_t>(object.pointCount,
+                                                               protocol::kMaxPointCount))
+            : 0;
+    held.push_back(h);
+  }
+  return held;
 }
 
 }  // namespace thinlod::frontend::daemon

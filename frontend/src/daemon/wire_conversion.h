@@ -84,6 +84,12 @@ Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
 protocol::FrameStats toFrameStats(const FrameRecord& record, std::int64_t timestampNs,
                                   std::vector<std::uint64_t> rejectedPlans);
 
+// What the scene holds (committed objects, ascending ids) as Hello.held says
+// it: the backbone's representation id, kind, triangles (and a hybrid's
+// points), each count saturated at the protocol's limit, at most
+// protocol::kMaxHeldRepresentations entries (more objects than a scene
+// update can carry never happen: the first ones are kept).
+std::vector<protocol::HeldRepresentation> heldRepresentations(const FrontendScene& scene);
 // Bytes of mesh and texture payload in an update (what decoding has to chew).
 std::size_t payloadBytes(const protocol::SceneUpdate& update);
 

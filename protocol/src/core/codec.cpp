@@ -89,8 +89,19 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Hello
   if (const auto& c = m.frameCost)
     frameCost = w::CreateFrameCost(b, c->initSeconds, c->finalSeconds, c->setupSeconds,
                                    c->triangleSeconds, c->pixelSeconds, c->additive);
+  fb::Offset<fb::Vector<fb::Offset<w::HeldRepresentation>>> held = 0;
+  if (!m.held.empty()) {
+    std::vector<fb::Offset<w::HeldRepresentation>> items;
+    items.reserve(m.held.size());
+    for (const HeldRepresentation& h : m.held)
+      items.push_back(w::CreateHeldRepresentation(b, h.objectId, h.representationId,
+                                                  static_cast<w::RepresentationKind>(h.kind),
+                                                  h.triangleCount, h.pointCount));
+    held = b.CreateVector(items);
+  }
   auto t = w::CreateHello(b, m.minVersion, m.maxVersion, static_cast<w::Role>(m.role), name,
-                          m.instanceId, caps, m.capacity, m.sceneFingerprint, sceneFile, frameCost);
+                          m.instanceId, caps, m.capacity, m.sceneFingerprint, sceneFile, frameCost,
+                          held);
   return {w::Body::Hello, t.Union()};
 }
 
@@ -371,6 +382,22 @@ Result<Message> fromWire(const FieldPath& path, const w::Hello* m) {
     costs.pixelSeconds = c->pixel_seconds();
     costs.additive = c->additive();
     out.frameCost = costs;
+  }
+  // Counted and each entry present here; values checked by validate.cpp's check(Hello).
+  THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("held"), m->held(), kMaxHeldRepresentations));
+  if (const auto* held = m->held()) {
+    out.held.reserve(held->size());
+    for (fb::uoffset_t i = 0; i < held->size(); ++i) {
+      const w::HeldRepresentation* h = held->Get(i);
+      THINLOD_RETURN_IF_ERROR(requirePresent(path.element("held", i), h));
+      HeldRepresentation item;
+      item.objectId = h->object_id();
+      item.representationId = h->representation_id();
+      item.kind = static_cast<RepresentationKind>(h->kind());
+      item.triangleCount = h->triangle_count();
+      item.pointCount = h->point_count();
+      out.held.push_back(item);
+    }
   }
   return Message(std::move(out));
 }

@@ -68,11 +68,16 @@ bool operator==(const Representation& a, const Representation& b) {
 bool operator==(const SharedTexture& a, const SharedTexture& b) {
   return a.textureId == b.textureId && a.texture == b.texture;
 }
+bool operator==(const HeldRepresentation& a, const HeldRepresentation& b) {
+  return a.objectId == b.objectId && a.representationId == b.representationId &&
+         a.kind == b.kind && a.triangleCount == b.triangleCount && a.pointCount == b.pointCount;
+}
 bool operator==(const Hello& a, const Hello& b) {
   return a.minVersion == b.minVersion && a.maxVersion == b.maxVersion && a.role == b.role &&
          a.name == b.name && a.instanceId == b.instanceId && a.capabilities == b.capabilities &&
          a.capacity == b.capacity && a.sceneFingerprint == b.sceneFingerprint &&
-         a.sceneFile == b.sceneFile && sameFrameCost(a.frameCost, b.frameCost);
+         a.sceneFile == b.sceneFile && sameFrameCost(a.frameCost, b.frameCost) &&
+         a.held == b.held;
 }
 bool operator==(const HelloReply& a, const HelloReply& b) {
   return a.accepted == b.accepted && a.version == b.version && a.role == b.role &&

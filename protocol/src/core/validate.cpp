@@ -257,6 +257,27 @@ Status check(const FieldPath& path, const Hello& m) {
     const Status usable = validateCalibratedFrameCost(*m.frameCost);
     if (!usable.ok()) return invalidField(path.child("frame_cost"), usable.message());
   }
+  THINLOD_RETURN_IF_ERROR(checkCount(path.child("held"), m.held.size(), kMaxHeldRepresentations));
+  if (!m.held.empty() && m.role != Role::kFrontend)
+    return invalidField(path.child("held"), "is for frontends only");
+  for (std::size_t i = 0; i < m.held.size(); ++i) {
+    const HeldRepresentation& h = m.held[i];
+    const FieldPath at = path.element("held", i);
+    if (h.objectId == 0) return invalidField(at.child("object_id"), "is 0");
+    // Ascending and unique: one held representation per object.
+    if (i > 0 && h.objectId <= m.held[i - 1].objectId)
+      return invalidField(at.child("object_id"),
+                          "is " + std::to_string(h.objectId) +
+                              ": ids must be unique and ascending (previous " +
+                              std::to_string(m.held[i - 1].objectId) + ")");
+    if (!validKind(h.kind))
+      return invalidField(at.child("kind"), "is not a known RepresentationKind");
+    if (h.triangleCount > kMaxTriangleCount)
+      return tooLarge(at.child("triangle_count"), "is " + std::to_string(h.triangleCount) +
+                                                      ", limit " +
+                                                      std::to_string(kMaxTriangleCount));
+    THINLOD_RETURN_IF_ERROR(checkPointCount(at.child("point_count"), h.kind, h.pointCount));
+  }
   return Status();
 }
 

@@ -60,6 +60,14 @@ Channel::~Channel() {
 }
 
 bool Channel::connected() const { return impl_->ready; }
+
+Status Channel::setHeld(std::vector<HeldRepresentation> held) {
+  Hello next = impl_->options.hello;
+  next.held = std::move(held);
+  THINLOD_RETURN_IF_ERROR(validate(next));
+  impl_->options.hello = std::move(next);
+  return Status();
+}
 const TransportStats& Channel::stats() const { return impl_->stats; }
 
 std::vector<ChannelEvent> Channel::poll(std::chrono::milliseconds timeout) {

@@ -73,6 +73,9 @@ struct Representation {
   glm::mat4 transform{1.0f};  // object -> world
   glm::vec4 color{1.0f};      // multiplies texture and vertex colours, components in [0,1]
   std::uint32_t generation = 0;
+  // The backbone's id of this representation (SceneUpdate), reported back in
+  // a Hello (Hello.held) so a new backbone session knows what is held.
+  std::uint64_t representationId = 0;
   // kHybrid only: the disc points (object space, base colours; the renderer
   // pre-lights them). A hybrid needs triangles (mesh) or points or both; its
   // triangles are drawn lit like a kMesh.

@@ -54,6 +54,7 @@ inline constexpr double kMaxKappa = 64.0;                     // point rate / tr
 inline constexpr std::uint32_t kMaxViewportDimension = 16384;
 inline constexpr std::uint32_t kMaxWorkerCapacity = 1024;
 inline constexpr std::size_t kMaxRejectedPlans = 1024;  // per FrameStats
+inline constexpr std::size_t kMaxHeldRepresentations = 65536;  // per Hello (= kMaxSceneOperations)
 // Verifier limits: nesting depth and number of tables per message.
 inline constexpr unsigned kMaxTableDepth = 16;
 inline constexpr unsigned kMaxTables = 4 * kMaxSceneOperations + 64;
@@ -122,6 +123,16 @@ struct SharedTexture {
 };
 
 // --- Handshake (every connection starts with Hello / HelloReply) ---
+// One representation a frontend holds, as the SceneUpdate that brought it
+// said (docs/protocol.md, "Resynchronisation").
+struct HeldRepresentation {
+  std::uint64_t objectId = 0;          // > 0, unique within a Hello
+  std::uint64_t representationId = 0;  // Representation.representationId (0: unknown)
+  RepresentationKind kind = RepresentationKind::kMesh;
+  std::uint32_t triangleCount = 0;  // <= kMaxTriangleCount
+  std::uint32_t pointCount = 0;     // kHybrid only, <= kMaxPointCount
+};
+
 struct Hello {
   std::uint16_t minVersion = kMinSupportedVersion;
   std::uint16_t maxVersion = kProtocolVersion;
@@ -140,6 +151,10 @@ struct Hello {
   // plausibility limits, t_tri > 0); the backbone's frame-time budget of
   // this frontend's session uses them before its own --frame-cost.
   std::optional<FrameCostConstants> frameCost;
+  // A frontend's holdings when it said Hello (at most kMaxHeldRepresentations,
+  // ascending object ids, each once): a backbone session starts its mirror
+  // from them, so a restarted backbone knows what it did not send.
+  std::vector<HeldRepresentation> held;
 };
 
 struct HelloReply {
@@ -277,6 +292,7 @@ bool operator==(const ConicRange& a, const ConicRange& b);
 bool operator==(const Texture& a, const Texture& b);
 bool operator==(const Representation& a, const Representation& b);
 bool operator==(const SharedTexture& a, const SharedTexture& b);
+bool operator==(const HeldRepresentation& a, const HeldRepresentation& b);
 bool operator==(const Hello& a, const Hello& b);
 bool operator==(const HelloReply& a, const HelloReply& b);
 bool operator==(const ViewerPose& a, const ViewerPose& b);

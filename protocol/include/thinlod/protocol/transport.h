@@ -191,6 +191,11 @@ class Channel {
   std::vector<ChannelEvent> poll(std::chrono::milliseconds timeout);
   // Handshake done and the server alive.
   bool connected() const;
+  // What the Hello of every later (re)connect says the client holds
+  // (Hello.held; a frontend's resynchronisation, docs/protocol.md). The
+  // Hello with them is checked as at connect(); on an error nothing changes.
+  // The session already open is not told.
+  Status setHeld(std::vector<HeldRepresentation> held);
   Status send(const Message& message);
   Status sendEncoded(const Bytes& encoded);
   const TransportStats& stats() const;
