@@ -1081,9 +1081,9 @@ PoseOutcome BackboneCore::finishPose() {
 }
 
 Status BackboneCore::setSharedTextures(SceneTextures textures) {
-  if (textures.objectTexture.size() != converted_.records.size())
+  if (textures.objectTexture.size() != sceneObjects_.size())
     return invalid("shared textures: " + std::to_string(textures.objectTexture.size()) +
-                   " object entries for " + std::to_string(converted_.records.size()) + " objects");
+                   " object entries for " + std::to_string(sceneObjects_.size()) + " objects");
   for (std::size_t i = 0; i < textures.textures.size(); ++i) {
     if (textures.textures[i].textureId != i + 1)
       return invalid("shared texture " + std::to_string(i) + " has id " +
@@ -1096,7 +1096,16 @@ Status BackboneCore::setSharedTextures(SceneTextures textures) {
                      std::to_string(textures.textures.size()));
   }
   sharedTextures_ = std::move(textures.textures);
-  objectTexture_ = std::move(textures.objectTexture);
+  // Per scheduled record (requests name records, not scene objects: an
+  // imposter node or a collapsed LOD makes one record of several objects).
+  // A record stands for its scene object (id = 1 + index); a cluster's
+  // impostor is captured textured by the simplifier, its copies name none.
+  objectTexture_.assign(converted_.records.size(), 0);
+  for (std::size_t k = 0; k < converted_.records.size(); ++k) {
+    const ObjectRecord& record = converted_.records[k];
+    if (!record.cluster && record.id >= 1 && record.id <= textures.objectTexture.size())
+      objectTexture_[k] = textures.objectTexture[record.id - 1];
+  }
   texturesAtFrontend_.clear();
   return Status();
 }

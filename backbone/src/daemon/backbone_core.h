@@ -309,7 +309,7 @@ class BackboneCore {
   backbone::SchedulingScene scene_;
   FrontendMirror mirror_{scene_, [this](std::uint32_t object) { touchObject(object); }};
   std::vector<protocol::SharedTexture> sharedTextures_;  // id i + 1 at index i
-  std::vector<std::uint64_t> objectTexture_;             // per object, 0 = untextured
+  std::vector<std::uint64_t> objectTexture_;             // per record, 0 = untextured
   std::map<std::uint64_t, std::uint64_t> texturesAtFrontend_;  // texture id -> plan that sent it
   std::vector<OptionState> optionStates_;
   std::vector<double> meshBytesPerTriangle_;  // per object
