@@ -20,6 +20,7 @@
 
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/scene/scene_import.h"
+#include "thinlod/common/scene/skinned_import.h"
 #include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::scene {
@@ -76,6 +77,7 @@ void expectRefusedEverywhere(const std::string& path, const fs::path& scratch) {
   if (isImportedSceneExtension(path)) {
     clean(importScene(path).status(), "importScene");
     clean(loadSceneFile(path).status(), "loadSceneFile");
+    clean(importSkinnedModel(path).status(), "importSkinnedModel");  // the same front door
   }
   if (isSupportedMeshExtension(path)) {
     clean(loadMeshFile(path).status(), "loadMeshFile");

@@ -572,21 +572,18 @@ const char* formatName(const std::string& ext) {
   if (ext == ".gltf" || ext == ".glb") return "glTF2";
   if (ext == ".dae") return "Collada";
   if (ext == ".fbx") return "FBX";
-  return "OBJ";
+  if (ext == ".obj") return "OBJ";
+  return "Assimp";  // skinned formats (.x, .smd, .md5mesh, ...): importSkinnedModel
 }
 
-}  // namespace
-
-bool isImportedSceneExtension(const std::string& path) {
-  const std::string ext = lowerExtension(path);
-  return ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".fbx" || ext == ".obj";
-}
-
-Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
-  if (!isImportedSceneExtension(path)) {
-    return Status(ErrorCode::kUnsupported,
-                  path + ": not an imported scene format (.gltf .glb .dae .fbx .obj)");
-  }
+// The one front door to Assimp (importScene and importSkinnedModel): the
+// file's size against the limits, the glTF and Collada pre-checks, Assimp
+// behind the bounded IO system with its logging off, its failures and
+// exceptions as a Status naming the file; `convert(aiScene, declared)` turns
+// what Assimp returned into T inside the same guard.
+template <typename T, typename Convert>
+Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
+                            Convert convert) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
     return Status(ErrorCode::kNotFound, path + ": no such file");
@@ -633,12 +630,10 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
                       path + ": contains no triangles (point and line primitives are dropped)");
       }
       return Status(ErrorCode::kParseError,
-                    path + ": " + formatName(lowerExtension(path)) + " import failed: " +
+                    path + ": " + formatName(ext) + " import failed: " +
                         (why.empty() ? std::string("unknown Assimp error") : why));
     }
-    Result<Scene> scene = Converter(path, *ai, limits, declared).run();
-    if (scene.ok()) scene->header = std::string("import ") + formatName(lowerExtension(path));
-    return scene;
+    return convert(*ai, declared);
   } catch (const std::bad_alloc&) {
     return Status(ErrorCode::kResourceExhausted, path + ": out of memory while importing");
   } catch (const std::exception& e) {
@@ -646,6 +641,26 @@ Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
   } catch (...) {
     return Status(ErrorCode::kInternal, path + ": import failed with an unknown exception");
   }
+}
+
+}  // namespace
+
+bool isImportedSceneExtension(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".fbx" || ext == ".obj";
+}
+
+Result<Scene> importScene(const std::string& path, const ImportLimits& limits) {
+  if (!isImportedSceneExtension(path)) {
+    return Status(ErrorCode::kUnsupported,
+                  path + ": not an imported scene format (.gltf .glb .dae .fbx .obj)");
+  }
+  return readThroughAssimp<Scene>(
+      path, limits, [&](const aiScene& ai, const std::optional<GltfDeclared>& declared) {
+        Result<Scene> scene = Converter(path, ai, limits, declared).run();
+        if (scene.ok()) scene->header = std::string("import ") + formatName(lowerExtension(path));
+        return scene;
+      });
 }
 
 Result<LoadedMesh> importSceneAsMesh(const std::string& path, const ImportLimits& limits) {
@@ -984,46 +999,10 @@ class SkinnedConverter {
 
 Result<SkinnedModel> importSkinnedModel(const std::string& path,
                                         const SkinnedImportLimits& limits) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Status(ErrorCode::kNotFound, path + ": no such file");
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) return Status(ErrorCode::kIoError, path + ": cannot stat: " + ec.message());
-  if (size == 0) return Status(ErrorCode::kInvalidArgument, path + ": empty file");
-  if (size > limits.files.maxFileBytes) {
-    return Status(ErrorCode::kResourceExhausted, path + ": " + std::to_string(size) +
-                                                     " bytes exceed the limit of " +
-                                                     std::to_string(limits.files.maxFileBytes));
-  }
-  try {
-    const std::string ext = lowerExtension(path);
-    if (ext == ".gltf" || ext == ".glb") {
-      Result<GltfDeclared> checked = precheckGltf(path, size, limits.files);
-      if (!checked.ok()) return checked.status();
-    }
-    Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
-    auto* io = new BoundedIOSystem(limits.files);
-    importer.SetIOHandler(io);  // the importer owns it
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                           aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-    const aiScene* ai = importer.ReadFile(path, flags);
-    if (!io->refusal().empty()) {
-      return Status(ErrorCode::kResourceExhausted, path + ": " + io->refusal());
-    }
-    if (ai == nullptr) {
-      const std::string why = importer.GetErrorString();
-      return Status(ErrorCode::kParseError,
-                    path + ": import failed: " + (why.empty() ? "unknown Assimp error" : why));
-    }
-    return SkinnedConverter(path, *ai, limits).run();
-  } catch (const std::bad_alloc&) {
-    return Status(ErrorCode::kResourceExhausted, path + ": out of memory while importing");
-  } catch (const std::exception& e) {
-    return Status(ErrorCode::kParseError, path + ": import failed: " + e.what());
-  } catch (...) {
-    return Status(ErrorCode::kInternal, path + ": import failed with an unknown exception");
-  }
+  return readThroughAssimp<SkinnedModel>(
+      path, limits.files, [&](const aiScene& ai, const std::optional<GltfDeclared>&) {
+        return SkinnedConverter(path, ai, limits).run();
+      });
 }
 
 }  // namespace thinlod::scene

@@ -3,8 +3,9 @@
 // core/skinning.h (docs/animation.md).
 //
 // Contract:
-// - The same front door as importScene (scene_import.h): every file opened
-//   is bounded by ImportLimits before it is read, glTF is pre-checked, no
+// - The same front door as importScene (scene_import.h; one function in
+//   assimp_import.cpp): every file opened is bounded by ImportLimits before
+//   it is read, glTF and Collada are pre-checked, no
 //   Assimp type or exception crosses this interface, failures are a Status
 //   naming the file.
 // - Skeleton: every node of the file is a bone, parents first (restLocal =
