@@ -32,12 +32,12 @@
 //   Material::diffuseColor; emissive, specular, shininess, opacity where
 //   present. The base-colour texture's path is recorded in
 //   Appearance::textureUrl (as written in the file, "*N" for an embedded
-//   image); loadSceneFile resolves it (resolveTextures). Textures are drawn
-//   by the frontend's reference rendering only: the link does not carry
-//   them yet, and embedded ones are not read.
+//   image); loadSceneFile resolves it (resolveTextures). The link carries
+//   resolved textures (docs/protocol.md, "Shared textures"); embedded ones
+//   are not read.
 // - Transforms must be translation * rotation * scale (glTF requires that);
 //   a sheared node matrix is kUnsupported. Cameras, lights, animations and
-//   skins are ignored.
+//   skins are ignored here (skinned_import.h reads skins and clips).
 // - Thread-safe: one Assimp::Importer per call, no shared state.
 #pragma once
 
