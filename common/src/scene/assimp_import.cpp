@@ -792,7 +792,7 @@ class SkinnedConverter {
       const int index = static_cast<int>(model_.skeleton.bones.size());
       model_.skeleton.bones.push_back(std::move(bone));
       depth.push_back(d);
-      nodeIndex_.emplace(node, index);
+      nodes_.push_back(node);  // bone index == position
       byName_.emplace(node->mName.C_Str(), index);  // first node of a name wins
       if (node->mNumChildren > 0 && node->mChildren == nullptr) {
         return fail(ErrorCode::kInvalidArgument, "node without its children");
@@ -807,8 +807,9 @@ class SkinnedConverter {
 
   Status copyMeshes() {
     std::vector<bool> skinnedCopied(ai_.mNumMeshes, false);
-    // Mesh instances in node order.
-    for (const auto& [node, index] : orderedNodes()) {
+    // Mesh instances in node order (bone i is nodes_[i]).
+    for (std::size_t index = 0; index < nodes_.size(); ++index) {
+      const aiNode* node = nodes_[index];
       for (unsigned m = 0; m < node->mNumMeshes; ++m) {
         const unsigned meshIndex = node->mMeshes[m];
         if (meshIndex >= ai_.mNumMeshes || ai_.mMeshes[meshIndex] == nullptr) {
@@ -830,13 +831,6 @@ class SkinnedConverter {
     if (!allUvs_) model_.mesh.uvs.clear();
     if (model_.mesh.normals.empty()) model_.mesh.computeNormals();
     return Status::okStatus();
-  }
-
-  std::vector<std::pair<const aiNode*, int>> orderedNodes() const {
-    std::vector<std::pair<const aiNode*, int>> nodes(nodeIndex_.begin(), nodeIndex_.end());
-    std::sort(nodes.begin(), nodes.end(),
-              [](const auto& a, const auto& b) { return a.second < b.second; });
-    return nodes;
   }
 
   Status copyMesh(const aiMesh& mesh, std::uint32_t node) {
@@ -989,7 +983,7 @@ class SkinnedConverter {
   const aiScene& ai_;
   SkinnedImportLimits limits_;
   SkinnedModel model_;
-  std::map<const aiNode*, int> nodeIndex_;
+  std::vector<const aiNode*> nodes_;  // the first bones, in preorder
   std::map<std::string, int> byName_;
   bool allNormals_ = true;
   bool allUvs_ = true;
