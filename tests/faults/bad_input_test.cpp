@@ -12,15 +12,22 @@
 //   bytes after the handshake, then valid work.
 // (tests/backbone_daemon covers bad bytes from peers that never said Hello;
 // tests/protocol the transport itself.)
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 
 #include <chrono>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
 #include <thread>
 
 #include "fault_harness.h"
@@ -89,27 +96,50 @@ void sendEachAndExpectLogged(const std::vector<BadInput>& inputs,
 
 // ---------------------------------------------------------------- backbone
 
-TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePeers) {
-  ScratchDir dir("backbone");
-  DaemonProcess backbone(
-      {THINLOD_BACKBONE_EXE, "--scene", kScene, "--models-dir", kModels, "--frontend.address",
-       "tcp://127.0.0.1:0", "--simplifier.address", "tcp://127.0.0.1:0", "--ready-file",
-       (dir.path() / "ready.json").string(), "--budget-polygons", "200", "--curve-timeout-s", "30",
-       // Lockstep (a sync wait): the cow's curve request goes at startup and
-       // the backbone waits for it before ready (live serving holds it back).
-       "--sync-wait-ms", "1", "--transport.heartbeat_ms", "100", "--transport.liveness_misses",
-       "50"},
-      dir.path() / "backbone.log");
-  ASSERT_TRUE(backbone.waitForLog("event=listening")) << backbone.log();
-  // The backbone logs "listening" before it writes the ready file (renamed
-  // into place): wait for the file too (the sanitizer build lost this race).
+// The backbone on ephemeral loopback ports over the paper room, in lockstep
+// (a sync wait: the cow's curve request goes at startup and the backbone
+// waits for it before ready), long liveness so slow test steps never lose a
+// peer.
+std::vector<std::string> backboneArgs(const ScratchDir& dir) {
+  return {THINLOD_BACKBONE_EXE, "--scene", kScene, "--models-dir", kModels, "--frontend.address",
+          "tcp://127.0.0.1:0", "--simplifier.address", "tcp://127.0.0.1:0", "--ready-file",
+          (dir.path() / "ready.json").string(), "--budget-polygons", "200", "--curve-timeout-s",
+          "30", "--sync-wait-ms", "1", "--transport.heartbeat_ms", "100",
+          "--transport.liveness_misses", "50"};
+}
+
+// The backbone logs "listening" before it writes the ready file (renamed
+// into place): wait for the file too (the sanitizer build lost this race).
+nlohmann::json waitForReadyFile(const fs::path& path) {
   nlohmann::json ready;
   for (const auto end = std::chrono::steady_clock::now() + kDeadline;
        std::chrono::steady_clock::now() < end;
        std::this_thread::sleep_for(std::chrono::milliseconds(20))) {
-    ready = nlohmann::json::parse(readFile(dir.path() / "ready.json"), nullptr, false);
-    if (ready.is_object()) break;
+    ready = nlohmann::json::parse(readFile(path), nullptr, false);
+    if (ready.is_object() && ready.contains("frontend") && ready.contains("simplifier")) break;
   }
+  return ready;
+}
+
+// A hand-made worker's answer to the cow's curve request: a plausible curve
+// and a dummy mesh (the backbone only needs the curve to be ready).
+protocol::SimplifyResult curveAnswer(const protocol::SimplifyRequest& request) {
+  protocol::SimplifyResult curve;
+  curve.requestId = request.requestId;
+  curve.objectId = request.objectId;
+  curve.triangleCount = 200;
+  curve.accuracy = 3.0 * std::sqrt(200.0);
+  curve.mesh.assign(700, 0x42);
+  for (double t = 50.0; t < 5804.0; t *= 2.0) curve.curve.push_back({3.0 * std::sqrt(t), t});
+  curve.curve.push_back({3.0 * std::sqrt(5804.0), 5804.0});
+  return curve;
+}
+
+TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePeers) {
+  ScratchDir dir("backbone");
+  DaemonProcess backbone(backboneArgs(dir), dir.path() / "backbone.log");
+  ASSERT_TRUE(backbone.waitForLog("event=listening")) << backbone.log();
+  const nlohmann::json ready = waitForReadyFile(dir.path() / "ready.json");
   ASSERT_TRUE(ready.is_object() && ready.contains("frontend") && ready.contains("simplifier"))
       << readFile(dir.path() / "ready.json");
 
@@ -124,14 +154,7 @@ TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePe
       receiveA<protocol::SimplifyRequest>(worker);
   ASSERT_TRUE(curveRequest && curveRequest->curvePoints > 0) << backbone.log();
 
-  protocol::SimplifyResult curve;
-  curve.requestId = curveRequest->requestId;
-  curve.objectId = curveRequest->objectId;
-  curve.triangleCount = 200;
-  curve.accuracy = 3.0 * std::sqrt(200.0);
-  curve.mesh.assign(700, 0x42);
-  for (double t = 50.0; t < 5804.0; t *= 2.0) curve.curve.push_back({3.0 * std::sqrt(t), t});
-  curve.curve.push_back({3.0 * std::sqrt(5804.0), 5804.0});
+  const protocol::SimplifyResult curve = curveAnswer(*curveRequest);
 
   const std::vector<BadInput> workerInputs =
       badInputs(curve, Receiver::kEndpoint, worker.routingId());
@@ -196,6 +219,145 @@ TEST(FaultsBadInput, BackboneLogsAndDropsBadBytesOnBothSocketsAndServesTheSamePe
   EXPECT_EQ(countOccurrences(log, "event=worker_left"), 0u) << log;
   EXPECT_EQ(countOccurrences(log, "event=frontend_left"), 0u) << log;
   EXPECT_EQ(backbone.stop(SIGTERM), 0) << log;
+}
+
+// Sum of the numbers after `key` on every line holding `event`.
+std::uint64_t sumOfField(const std::string& log, const std::string& event, const std::string& key) {
+  std::uint64_t sum = 0;
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find(event) == std::string::npos) continue;
+    const std::size_t at = line.find(key);
+    if (at != std::string::npos) sum += std::stoull(line.substr(at + key.size()));
+  }
+  return sum;
+}
+
+// Floods and slow senders on the frontend socket (issue 21's hostile peers):
+// 64 TCP connections that start a ZMTP greeting and stall; a peer that never
+// said Hello sending 20,000 garbage messages and then 20,000 valid poses; the
+// joined frontend's own session sending 20,000 garbage messages. Through all
+// of it the joined frontend is served, no peer is dropped, every bad message
+// is accounted for (a warning or a count in a summary line) and the log and
+// the replies to the unknown peer stay bounded (FloodGate in
+// protocol/src/net/socket_impl.h: 20 warnings and 50 rejects a second).
+TEST(FaultsBadInput, BackboneServesItsFrontendThroughFloodsAndSlowSenders) {
+  ScratchDir dir("flood");
+  std::vector<std::string> args = backboneArgs(dir);
+  args.insert(args.end(), {"--log-level", "debug"});  // unknown_peer_dropped is a debug line
+  DaemonProcess backbone(args, dir.path() / "backbone.log");
+  ASSERT_TRUE(backbone.waitForLog("event=listening")) << backbone.log();
+  const nlohmann::json ready = waitForReadyFile(dir.path() / "ready.json");
+  ASSERT_TRUE(ready.is_object() && ready.contains("frontend") && ready.contains("simplifier"))
+      << readFile(dir.path() / "ready.json");
+  const std::string frontendAddress = ready["frontend"].get<std::string>();
+
+  zmq::context_t context(1);
+  RawDealer worker(context, ready["simplifier"].get<std::string>(), "flood-worker");
+  worker.send(helloAs(protocol::Role::kSimplifier, "flood-worker", 4));
+  std::optional<protocol::HelloReply> joined = receiveA<protocol::HelloReply>(worker);
+  ASSERT_TRUE(joined && joined->accepted) << backbone.log();
+  std::optional<protocol::SimplifyRequest> curveRequest =
+      receiveA<protocol::SimplifyRequest>(worker);
+  ASSERT_TRUE(curveRequest && curveRequest->curvePoints > 0) << backbone.log();
+  worker.send(curveAnswer(*curveRequest));
+  ASSERT_TRUE(backbone.waitForLog("event=ready ")) << backbone.log();
+
+  RawDealer frontend(context, frontendAddress, "flood-frontend");
+  frontend.send(helloAs(protocol::Role::kFrontend, "flood-frontend", 0));
+  joined = receiveA<protocol::HelloReply>(frontend);
+  ASSERT_TRUE(joined && joined->accepted) << backbone.log();
+
+  // Slow senders: the first two bytes of a ZMTP greeting, then nothing.
+  const std::size_t colon = frontendAddress.rfind(':');
+  ASSERT_NE(colon, std::string::npos) << frontendAddress;
+  sockaddr_in target{};
+  target.sin_family = AF_INET;
+  target.sin_port = htons(static_cast<std::uint16_t>(std::stoi(frontendAddress.substr(colon + 1))));
+  target.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::vector<int> stalled;
+  for (int i = 0; i < 64; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    stalled.push_back(fd);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<const sockaddr*>(&target), sizeof(target)), 0)
+        << std::strerror(errno);
+    const unsigned char greeting[2] = {0xff, 0x00};
+    ASSERT_EQ(::send(fd, greeting, sizeof(greeting), MSG_NOSIGNAL), 2);
+  }
+  frontend.send(entrancePose(2));
+  std::optional<protocol::SceneUpdate> update = receiveA<protocol::SceneUpdate>(frontend);
+  ASSERT_TRUE(update) << backbone.log();
+  EXPECT_EQ(update->frame, 2u);
+
+  constexpr int kFlood = 20000;
+  std::mt19937 random(21);
+  auto junk = [&] {
+    Bytes bytes(64);
+    for (std::uint8_t& b : bytes) b = static_cast<std::uint8_t>(random());
+    return bytes;
+  };
+  const auto floodStart = Clock::now();
+  RawDealer flooder(context, frontendAddress, "flooder");
+  for (int i = 0; i < kFlood; ++i) flooder.sendFrames({junk()});
+  for (int i = 0; i < kFlood; ++i) flooder.send(entrancePose(1000 + static_cast<std::uint64_t>(i)));
+  for (int i = 0; i < kFlood; ++i) {
+    frontend.sendFrames({junk()});
+    // Garbage does not count as being heard from: keep the session alive.
+    if (i % 1000 == 0) frontend.send(protocol::Heartbeat{1, static_cast<std::uint64_t>(i)});
+    if (i % 1000 == 0) worker.keepAlive();
+  }
+  frontend.send(entrancePose(3));
+  update = receiveA<protocol::SceneUpdate>(frontend);
+  ASSERT_TRUE(update) << backbone.log();
+  EXPECT_EQ(update->frame, 3u);
+
+  // The summary lines come once the window of what they count has ended.
+  const auto accounted = [&] {
+    const std::string log = backbone.log();
+    return countOccurrences(log, "event=malformed_dropped") +
+           countOccurrences(log, "event=unknown_peer_dropped") +
+           sumOfField(log, "event=malformed_suppressed", "count=");
+  };
+  ASSERT_TRUE(pumpUntil(
+      [&] {
+        frontend.keepAlive();
+        worker.keepAlive();
+        std::this_thread::sleep_for(50ms);
+      },
+      [&] { return accounted() >= 3u * kFlood; }, kDeadline))
+      << accounted() << " of " << 3 * kFlood << " bad messages accounted for";
+  const double seconds = std::chrono::duration<double>(Clock::now() - floodStart).count();
+  const std::string log = backbone.log();
+  EXPECT_EQ(accounted(), 3u * kFlood);
+  const std::size_t lines = countOccurrences(log, "event=malformed_dropped") +
+                            countOccurrences(log, "event=unknown_peer_dropped");
+  EXPECT_LE(lines, static_cast<std::size_t>(20.0 * (std::ceil(seconds) + 1.0)))
+      << lines << " warnings in " << seconds << " s";
+
+  // Each unknown pose may get a reject, at most 50 a second; at least one
+  // arrives (a peer the backbone forgot must learn to say Hello again).
+  std::size_t rejects = 0;
+  for (auto end = Clock::now() + 500ms; Clock::now() < end;) {
+    if (!waitReadable(flooder.socket(), 50ms)) continue;
+    zmq::message_t frame;
+    if (!flooder.socket().recv(frame, zmq::recv_flags::dontwait)) continue;
+    Result<Message> decoded = decodeFrame(frame);
+    if (decoded.ok() && std::holds_alternative<protocol::HelloReply>(*decoded)) ++rejects;
+  }
+  const double rejectSeconds = std::chrono::duration<double>(Clock::now() - floodStart).count();
+  EXPECT_GE(rejects, 1u);
+  EXPECT_LE(rejects, static_cast<std::size_t>(50.0 * (std::ceil(rejectSeconds) + 1.0)))
+      << rejects << " rejects in " << rejectSeconds << " s";
+
+  for (int fd : stalled) ::close(fd);
+  frontend.send(entrancePose(4));
+  update = receiveA<protocol::SceneUpdate>(frontend);
+  ASSERT_TRUE(update) << backbone.log();
+  EXPECT_EQ(update->frame, 4u);
+  EXPECT_EQ(countOccurrences(backbone.log(), "event=frontend_left"), 0u);
+  EXPECT_EQ(countOccurrences(backbone.log(), "event=worker_left"), 0u);
+  EXPECT_EQ(backbone.stop(SIGTERM), 0) << backbone.log();
 }
 
 // ---------------------------------------------------------- simplifier

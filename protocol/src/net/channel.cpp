@@ -172,6 +172,11 @@ Status Channel::Impl::sendMessage(const Message& message, Clock::time_point now)
 }
 
 void Channel::Impl::drain(Clock::time_point now) {
+  if (const std::uint64_t held = badMessageLog.takeHeldBack(now)) {
+    spdlog::warn("event=malformed_suppressed channel={} count={} reason=\"more bad messages "
+                 "than the log takes per second\"",
+                 options.hello.name, held);
+  }
   for (int i = 0; i < kMaxMessagesPerPoll && socket; ++i) {
     zmq::message_t payload;
     try {
@@ -179,8 +184,10 @@ void Channel::Impl::drain(Clock::time_point now) {
       if (payload.more()) {
         while (payload.more()) (void)socket->recv(payload, zmq::recv_flags::none);
         ++stats.malformedDropped;
-        spdlog::warn("event=malformed_dropped channel={} reason=\"more than one frame\"",
-                     options.hello.name);
+        if (badMessageLog.admit(now)) {
+          spdlog::warn("event=malformed_dropped channel={} reason=\"more than one frame\"",
+                       options.hello.name);
+        }
         continue;
       }
     } catch (const zmq::error_t& e) {
@@ -206,8 +213,10 @@ void Channel::Impl::handle(const zmq::message_t& payload, Clock::time_point now)
       decode(static_cast<const std::uint8_t*>(payload.data()), payload.size());
   if (!decoded.ok()) {
     ++stats.malformedDropped;
-    spdlog::warn("event=malformed_dropped channel={} bytes={} error=\"{}\"", options.hello.name,
-                 payload.size(), decoded.status().toString());
+    if (badMessageLog.admit(now)) {
+      spdlog::warn("event=malformed_dropped channel={} bytes={} error=\"{}\"",
+                   options.hello.name, payload.size(), decoded.status().toString());
+    }
     return;
   }
   lastHeard = now;

@@ -154,6 +154,14 @@ Status Endpoint::Impl::sendMessage(const std::string& routingId, const Message& 
 }
 
 void Endpoint::Impl::drain(Clock::time_point now) {
+  if (const std::uint64_t held = badMessageLog.takeHeldBack(now)) {
+    spdlog::warn("event=malformed_suppressed endpoint={} count={} reason=\"more bad messages "
+                 "than the log takes per second\"",
+                 options.name, held);
+  }
+  if (const std::uint64_t held = rejectsSent.takeHeldBack(now)) {
+    spdlog::warn("event=rejects_suppressed endpoint={} count={}", options.name, held);
+  }
   for (int i = 0; i < kMaxMessagesPerPoll; ++i) {
     zmq::message_t id;
     zmq::message_t payload;
@@ -161,8 +169,10 @@ void Endpoint::Impl::drain(Clock::time_point now) {
       if (!socket.recv(id, zmq::recv_flags::dontwait)) return;
       if (!id.more()) {
         ++stats.malformedDropped;
-        spdlog::warn("event=malformed_dropped endpoint={} reason=\"no payload frame\"",
-                     options.name);
+        if (badMessageLog.admit(now)) {
+          spdlog::warn("event=malformed_dropped endpoint={} reason=\"no payload frame\"",
+                       options.name);
+        }
         continue;
       }
       // The rest of a multipart message is already here (atomic delivery).
@@ -176,9 +186,12 @@ void Endpoint::Impl::drain(Clock::time_point now) {
       }
       if (extraFrames) {
         ++stats.malformedDropped;
-        spdlog::warn(
-            "event=malformed_dropped endpoint={} peer={} reason=\"more than one payload frame\"",
-            options.name, hexId(id.to_string()));
+        if (badMessageLog.admit(now)) {
+          spdlog::warn(
+              "event=malformed_dropped endpoint={} peer={} reason=\"more than one payload "
+              "frame\"",
+              options.name, hexId(id.to_string()));
+        }
         continue;
       }
     } catch (const zmq::error_t& e) {
@@ -213,9 +226,12 @@ void Endpoint::Impl::handle(const std::string& routingId, const zmq::message_t& 
   auto known = byRouting.find(routingId);
   if (!decoded.ok()) {
     ++stats.malformedDropped;
-    spdlog::warn("event=malformed_dropped endpoint={} peer={} bytes={} error=\"{}\"", options.name,
-                 hexId(routingId), payload.size(), decoded.status().toString());
-    if (decoded.status().code() == ErrorCode::kVersionMismatch && known == byRouting.end()) {
+    if (badMessageLog.admit(now)) {
+      spdlog::warn("event=malformed_dropped endpoint={} peer={} bytes={} error=\"{}\"",
+                   options.name, hexId(routingId), payload.size(), decoded.status().toString());
+    }
+    if (decoded.status().code() == ErrorCode::kVersionMismatch && known == byRouting.end() &&
+        rejectsSent.admit(now)) {
       reject(routingId, decoded.status());
     }
     return;
@@ -227,9 +243,16 @@ void Endpoint::Impl::handle(const std::string& routingId, const zmq::message_t& 
   }
   if (known == byRouting.end()) {
     ++stats.unexpectedDropped;
-    spdlog::debug("event=unknown_peer_dropped endpoint={} peer={} message={}", options.name,
-                  hexId(routingId), messageName(message));
-    reject(routingId, Status(ErrorCode::kUnavailable, "unknown peer: send Hello first"));
+    if (badMessageLog.admit(now)) {
+      spdlog::debug("event=unknown_peer_dropped endpoint={} peer={} message={}", options.name,
+                    hexId(routingId), messageName(message));
+    }
+    // A peer the backbone forgot (it restarted) learns from this reply to say
+    // Hello again; under a flood some are held back, and the peer's next
+    // message after the window gets one.
+    if (rejectsSent.admit(now)) {
+      reject(routingId, Status(ErrorCode::kUnavailable, "unknown peer: send Hello first"));
+    }
     return;
   }
   const std::uint64_t peerId = known->second;

@@ -32,4 +32,24 @@ std::string hexId(const std::string& routingId) {
   return out;
 }
 
+bool FloodGate::admit(Clock::time_point now) {
+  if (now - windowStart_ >= window_) {
+    windowStart_ = now;
+    admitted_ = 0;
+  }
+  if (admitted_ < perWindow_) {
+    ++admitted_;
+    return true;
+  }
+  ++heldBack_;
+  return false;
+}
+
+std::uint64_t FloodGate::takeHeldBack(Clock::time_point now) {
+  if (heldBack_ == 0 || now - windowStart_ < window_) return 0;
+  const std::uint64_t count = heldBack_;
+  heldBack_ = 0;
+  return count;
+}
+
 }  // namespace thinlod::protocol::detail

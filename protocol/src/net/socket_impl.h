@@ -78,6 +78,28 @@ class FaultInjector {
 Status sendWithFaults(FaultInjector& injector, TransportStats& stats, const std::string& who,
                       const char* messageName, const std::function<Status()>& sendOnce);
 
+// Bounds what a flood of bad messages costs beyond reading them: at most
+// `perWindow` events per window are admitted (a warning written, a reject
+// sent); the rest are counted, and the count is handed out once their window
+// has ended, for one summary line. A peer sending garbage at line rate then
+// writes about `perWindow` lines a second instead of one per message (about
+// 150 bytes each: hours of that fill a disk) and gets no reply per message
+// (a reject per message doubles a flood's traffic).
+class FloodGate {
+ public:
+  FloodGate(int perWindow, Clock::duration window) : perWindow_(perWindow), window_(window) {}
+  bool admit(Clock::time_point now);
+  // Events held back in windows that have ended (then 0 again); 0 if none.
+  std::uint64_t takeHeldBack(Clock::time_point now);
+
+ private:
+  int perWindow_;
+  Clock::duration window_;
+  Clock::time_point windowStart_{};
+  int admitted_ = 0;
+  std::uint64_t heldBack_ = 0;
+};
+
 // Reads the socket's handshake-failure events (zmq_socket_monitor) and logs
 // them: a peer with a wrong or missing key, or refused by ZAP.
 class HandshakeMonitor {
@@ -125,6 +147,8 @@ struct Endpoint::Impl {
   TransportStats stats;
   detail::FaultInjector faults;  // tests only (TransportOptions::faults)
   std::vector<EndpointEvent> events;
+  detail::FloodGate badMessageLog{20, std::chrono::seconds(1)};  // warnings a second
+  detail::FloodGate rejectsSent{50, std::chrono::seconds(1)};    // replies to unknown peers
 
   Status sendRaw(const std::string& routingId, const std::uint8_t* data, std::size_t size);
   Status sendMessage(const std::string& routingId, const Message& message);
@@ -154,6 +178,7 @@ struct Channel::Impl {
   TransportStats stats;
   detail::FaultInjector faults;  // tests only (TransportOptions::faults)
   std::vector<ChannelEvent> events;
+  detail::FloodGate badMessageLog{20, std::chrono::seconds(1)};  // warnings a second
 
   Status openSocket(detail::Clock::time_point now);
   Status sendRaw(const std::uint8_t* data, std::size_t size, detail::Clock::time_point now);
