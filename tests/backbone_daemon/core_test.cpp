@@ -434,16 +434,19 @@ TEST(BackboneCoreCap, PolygonBudgetHoldsWhenTheSimplifierDeliversTooMuch) {
 // number of deferred operations.
 struct LinkRun {
   std::vector<std::pair<double, double>> sent;
+  std::vector<PoseOutcome> outcomes;
   std::size_t deferred = 0;
   std::size_t adds = 0;
 };
 
-LinkRun flyWithLinkBudget(double rate, double burst, double meshBytesPerTriangle) {
+LinkRun flyWithLinkBudget(double rate, double burst, double meshBytesPerTriangle,
+                          std::vector<LinkStep> schedule = {}) {
   LinkRun run;
   CoreOptions options;
   options.config.maxSpeed = 0.1;
   options.budget.maxLinkBytesPerSecond = rate;
   options.linkBurstBytes = burst;
+  options.linkSchedule = std::move(schedule);
   auto core = makeCore(options);
   EXPECT_NE(core, nullptr);
   if (!core) return run;
@@ -461,6 +464,7 @@ LinkRun flyWithLinkBudget(double rate, double burst, double meshBytesPerTriangle
     run.sent.emplace_back(t, double(outcome.linkBytes));
     run.deferred += outcome.deferredByLink;
     run.adds += outcome.adds;
+    run.outcomes.push_back(std::move(outcome));
   }
   return run;
 }
@@ -491,6 +495,104 @@ TEST(BackboneCoreLink, ShaperDefersWhatTheEstimatesMissedAndSendsItLater) {
   expectWithinBucket(run, 6000.0, 12000.0);
   EXPECT_GT(run.deferred, 0u);
   EXPECT_GT(run.adds, 3u);
+}
+
+// The link cut to 10 % at trace time 6 s (issue 21's fault): from the first
+// pose at or after the cut the plan's link rate and the shaper's rate are the
+// new one, and the bytes shaped from then on stay within new rate x window +
+// burst (the new bucket keeps no more tokens than the old one had), while the
+// same flight uncut sends more in that time.
+TEST(BackboneCoreLink, ALinkCutToTenPercentHoldsFromTheFirstPlanningStepAfterIt) {
+  constexpr double kRate = 12000.0, kBurst = 16000.0, kCutAt = 6.0;
+  const LinkRun uncut = flyWithLinkBudget(kRate, kBurst, 1.5);
+  const LinkRun cut = flyWithLinkBudget(kRate, kBurst, 1.5, {{kCutAt, 0.1 * kRate}});
+  ASSERT_EQ(cut.sent.size(), uncut.sent.size());
+  LinkRun after;
+  double uncutAfter = 0.0;
+  for (std::size_t i = 0; i < cut.sent.size(); ++i) {
+    const double t = cut.sent[i].first;
+    const PoseOutcome& outcome = cut.outcomes[i];
+    ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+    const double rateNow = t >= kCutAt ? 0.1 * kRate : kRate;
+    EXPECT_EQ(outcome.linkRate, static_cast<std::uint64_t>(rateNow)) << "t " << t;
+    EXPECT_LE(outcome.row.linkBytesPerSecond, rateNow * (1.0 + 1e-9)) << "t " << t;
+    if (t < kCutAt) continue;
+    after.sent.push_back(cut.sent[i]);
+    uncutAfter += uncut.sent[i].second;
+  }
+  ASSERT_GT(after.sent.size(), 20u);
+  double cutAfter = 0.0;
+  for (const auto& [t, bytes] : after.sent) cutAfter += bytes;
+  EXPECT_LT(cutAfter, uncutAfter);
+  // Every window that starts at or after the cut.
+  for (std::size_t i = 0; i < after.sent.size(); ++i) {
+    double window = 0.0;
+    for (std::size_t j = i; j < after.sent.size(); ++j) {
+      window += after.sent[j].second;
+      const double span = after.sent[j].first - after.sent[i].first;
+      ASSERT_LE(window, 0.1 * kRate * span + kBurst + 1e-6) << "window " << i << ".." << j;
+    }
+  }
+  // And before the cut the run is the uncut one.
+  for (std::size_t i = 0; i < cut.sent.size() && cut.sent[i].first < kCutAt; ++i)
+    EXPECT_EQ(cut.sent[i].second, uncut.sent[i].second) << i;
+}
+
+TEST(BackboneCoreLink, ALinkScheduleNeedsALinkBudgetAndOrderedSteps) {
+  CoreOptions options;
+  options.budget.maxTriangles = 200.0;
+  options.linkSchedule = {{1.0, 1000.0}};
+  EXPECT_EQ(validateCoreOptions(options).code(), ErrorCode::kInvalidArgument);
+  options.budget.maxLinkBytesPerSecond = 5000.0;
+  EXPECT_TRUE(validateCoreOptions(options).ok());
+  options.linkSchedule = {{2.0, 1000.0}, {1.0, 800.0}};
+  EXPECT_EQ(validateCoreOptions(options).code(), ErrorCode::kInvalidArgument);
+  options.linkSchedule = {{1.0, std::numeric_limits<double>::quiet_NaN()}};
+  EXPECT_EQ(validateCoreOptions(options).code(), ErrorCode::kInvalidArgument);
+  options.linkSchedule = {{1.0, 0.5}};
+  EXPECT_EQ(validateCoreOptions(options).code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(LinkSchedule, ParsesStepsCommentsAndBlankLines) {
+  Result<std::vector<LinkStep>> steps =
+      parseLinkSchedule("# the link drops to 10 %\n0 125000\n\n  6.5   12500 # cut\n1e1 1.25e5\n",
+                        "cut.link");
+  ASSERT_TRUE(steps.ok()) << steps.status().toString();
+  ASSERT_EQ(steps->size(), 3u);
+  EXPECT_EQ((*steps)[1].timeSeconds, 6.5);
+  EXPECT_EQ((*steps)[1].bytesPerSecond, 12500.0);
+  EXPECT_EQ((*steps)[2].timeSeconds, 10.0);
+  EXPECT_EQ(linkRateAt(*steps, 6.4999, 1.0), std::optional<double>(125000.0));
+  EXPECT_EQ(linkRateAt(*steps, 6.5, 1.0), std::optional<double>(12500.0));
+  EXPECT_EQ(linkRateAt(*steps, 1e9, 1.0), std::optional<double>(125000.0));
+  const std::vector<LinkStep> late = {{3.0, 900.0}};
+  EXPECT_EQ(linkRateAt(late, 2.0, 5000.0), std::optional<double>(5000.0));
+  EXPECT_EQ(linkRateAt(late, 2.0, std::nullopt), std::nullopt);
+}
+
+TEST(LinkSchedule, RejectsBadLinesNamingTheLine) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"", "no steps"},
+      {"# only a comment\n", "no steps"},
+      {"1\n", "cut.link:1: expected"},
+      {"1 2 3\n", "cut.link:1: unexpected"},
+      {"0 100\nnan 100\n", "cut.link:2: time"},
+      {"-1 100\n", "cut.link:1: time"},
+      {"0 inf\n", "cut.link:1: rate"},
+      {"0 0.5\n", "cut.link:1: rate"},
+      {"0 2e11\n", "cut.link:1: rate"},
+      {"0 +100\n", "cut.link:1: rate"},
+      {"0 100x\n", "cut.link:1: rate"},
+      {"0 100\n3 100\n3 50\n", "cut.link:3: times must increase"},
+      {std::string(1u << 20, '#') + "\n", "larger than"},
+  };
+  for (const auto& [text, expected] : bad) {
+    Result<std::vector<LinkStep>> steps = parseLinkSchedule(text, "cut.link");
+    ASSERT_FALSE(steps.ok()) << text.substr(0, 40);
+    EXPECT_EQ(steps.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(steps.status().message().find(expected), std::string::npos)
+        << steps.status().message();
+  }
 }
 
 // The scheduler's link log holds what the shaper let through: after every

@@ -102,6 +102,18 @@ Status validateCoreOptions(const CoreOptions& o) {
     return invalid("curve request triangles out of range");
   if (!std::isfinite(o.linkBurstBytes) || o.linkBurstBytes < 0.0 || o.linkBurstBytes > 4.0e9)
     return invalid("link burst must be in [0, 4e9] bytes (0: automatic)");
+  if (!o.linkSchedule.empty() && !o.budget.maxLinkBytesPerSecond)
+    return invalid("a link schedule needs a link budget (--budget-link) for the time before its "
+                   "first step");
+  for (std::size_t i = 0; i < o.linkSchedule.size(); ++i) {
+    const LinkStep& step = o.linkSchedule[i];
+    if (!std::isfinite(step.timeSeconds) || step.timeSeconds < 0.0 ||
+        (i > 0 && step.timeSeconds <= o.linkSchedule[i - 1].timeSeconds) ||
+        !std::isfinite(step.bytesPerSecond) || step.bytesPerSecond < 1.0 ||
+        step.bytesPerSecond > 1e11)
+      return invalid("link schedule step " + std::to_string(i + 1) +
+                     ": times >= 0 and increasing, rates in [1, 1e11] bytes/s");
+  }
   if (!std::isfinite(o.defaultAspect) || o.defaultAspect <= 0.0)
     return invalid("default aspect must be > 0");
   if (o.firstRequestId == 0 || o.firstRequestId >= (std::uint64_t(1) << 62))
@@ -805,13 +817,24 @@ Status BackboneCore::useImpostorResult(const LedgerRequest& request,
 
 // ------------------------------------------------------------------- poses
 
+backbone::Budget BackboneCore::budgetAtPose() const {
+  backbone::Budget budget = options_.budget;
+  if (!options_.linkSchedule.empty()) {
+    // The shaper's clock (finishPose): pose time, never backwards.
+    const std::int64_t nowNs = std::max(lastShaperNs_, poseTimeNs_);
+    budget.maxLinkBytesPerSecond =
+        linkRateAt(options_.linkSchedule, double(nowNs) * 1e-9, options_.budget.maxLinkBytesPerSecond);
+  }
+  return budget;
+}
+
 Status BackboneCore::runPlan() {
   if (dirty_) {
     backbone::updateSubtreeVersions(scene_);
     dirty_ = false;
     THINLOD_RETURN_IF_ERROR(backbone::validateScene(scene_));
   }
-  Result<backbone::Plan> planned = scheduler_->plan(scene_, viewer_, options_.budget, planner_);
+  Result<backbone::Plan> planned = scheduler_->plan(scene_, viewer_, budgetAtPose(), planner_);
   if (!planned.ok()) return planned.status();
   plan_ = std::move(planned).value();
   ++plansThisPose_;
@@ -995,17 +1018,35 @@ PoseOutcome BackboneCore::finishPose() {
   const std::int64_t nowNs = std::max(lastShaperNs_, poseTimeNs_);
   lastShaperNs_ = nowNs;
   const protocol::LinkShaper::Clock::time_point now{std::chrono::nanoseconds(nowNs)};
-  if (options_.budget.maxLinkBytesPerSecond && !shaper_) {
-    const double rate = std::max(1.0, std::round(*options_.budget.maxLinkBytesPerSecond));
+  const std::optional<double> linkRate = budgetAtPose().maxLinkBytesPerSecond;
+  if (linkRate) {
+    const double rate = std::min(std::max(1.0, std::round(*linkRate)), 1e11);
     const double burst = options_.linkBurstBytes > 0.0
                              ? options_.linkBurstBytes
                              : std::max(rate * options_.config.plannedLifetime, 65536.0);
-    Result<protocol::TokenBucket> bucket = protocol::TokenBucket::create(
-        static_cast<std::uint64_t>(std::min(rate, 1e11)),
-        static_cast<std::uint64_t>(std::clamp(std::round(burst), 1.0, 4294967296.0)), now);
-    if (bucket.ok()) shaper_.emplace(std::move(bucket).value());
+    const auto rateBytes = static_cast<std::uint64_t>(rate);
+    const auto burstBytes = static_cast<std::uint64_t>(std::clamp(std::round(burst), 1.0, 4294967296.0));
+    if (!shaper_) {
+      Result<protocol::TokenBucket> bucket = protocol::TokenBucket::create(rateBytes, burstBytes, now);
+      if (bucket.ok()) shaper_.emplace(std::move(bucket).value());
+    } else if (shaper_->bucket().rateBytesPerSecond() != rateBytes) {
+      // The link schedule changed the rate: a new bucket at the new rate that
+      // keeps no more tokens than the old one had (nor than its own burst),
+      // so a cut holds from this planning step on.
+      const std::uint64_t available = shaper_->bucket().availableBytes(now);
+      Result<protocol::TokenBucket> changed =
+          protocol::TokenBucket::create(rateBytes, burstBytes, now);
+      if (changed.ok()) {
+        protocol::TokenBucket bucket = std::move(changed).value();
+        if (burstBytes > available) (void)bucket.trySend(burstBytes - available, now);
+        shaper_.emplace(std::move(bucket));
+      }
+    }
   }
-  if (shaper_) shaper_->beginFrame(pose_.sequence);
+  if (shaper_) {
+    shaper_->beginFrame(pose_.sequence);
+    out.linkRate = shaper_->bucket().rateBytesPerSecond();
+  }
 
   const double cap = (options_.hardPolygonCap && options_.budget.maxTriangles)
                          ? *options_.budget.maxTriangles

@@ -60,6 +60,7 @@
 
 #include "curve_estimate.h"
 #include "frontend_mirror.h"
+#include "link_schedule.h"
 #include "request_ledger.h"
 #include "scene_conversion.h"
 #include "scene_textures.h"
@@ -108,6 +109,10 @@ struct CoreOptions {
   bool deferCurveRequests = false;
   bool hardPolygonCap = true;         // never let the frontend hold more than budget.maxTriangles
   double linkBurstBytes = 0.0;        // 0: max(budget-link * plannedLifetime, 64 KiB)
+  // Steps of the link's capacity over trace time (link_schedule.h); before
+  // the first one budget.maxLinkBytesPerSecond holds. Empty: that budget
+  // throughout. The automatic burst follows each step's rate.
+  std::vector<LinkStep> linkSchedule;
   double defaultAspect = 16.0 / 9.0;  // width/height when the pose has no viewport
   // The first request id (> 0, < 2^62). The shell draws a random one per
   // process, so a reply computed for an earlier backbone never matches.
@@ -151,6 +156,7 @@ struct PoseOutcome {
   std::uint32_t tooLargeForLink = 0;  // larger than the shaper's burst: dropped
   std::uint32_t resyncRemoves = 0;    // removals of objects a refused update left unknown
   std::uint64_t linkBytes = 0;        // shaped bytes of this update
+  std::uint64_t linkRate = 0;         // the shaper's rate at this pose (bytes/s; 0: no link budget)
   double frontendTriangles = 0.0;     // after the update is applied
 };
 
@@ -349,6 +355,8 @@ class BackboneCore {
   int posesBeyondStep_ = 0;                 // in a row, stamps beyond the step limit
   std::int64_t poseTimeNs_ = 0;
   std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
+  // The budget of this pose: options_.budget with the link schedule's rate.
+  backbone::Budget budgetAtPose() const;
   std::optional<protocol::LinkShaper> shaper_;
   std::uint64_t shapedBytes_ = 0;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "backbone_core.h"
+#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/protocol/daemon_runtime.h"
 #include "thinlod/protocol/transport.h"
@@ -43,6 +44,7 @@ struct Settings {
   double accuracy = 0.0;
   double budgetFrameMs = 0.0;
   std::string frameCost;
+  std::string linkSchedule;
   int syncWaitMs = 0;
   double curveTimeoutS = 60.0;
   // Range-checked and converted into `core` by coreOptions(); defaults from it.
@@ -104,6 +106,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "never let the frontend hold more than --budget-polygons (=false to allow)");
   runtime.addOption("link-burst", &s.core.linkBurstBytes,
                     "link shaper burst in bytes (0: max(budget-link * lifetime, 64 KiB))");
+  runtime.addOption("link-schedule", &s.linkSchedule,
+                    "file of \"TIME_S RATE_BYTES_PER_S\" lines: the link's rate from each trace "
+                    "time on (needs --budget-link for the time before; docs/backbone.md, Link)");
   runtime.addOption("decisions-csv", &s.decisionsCsv, "write one decision row per pose here");
   runtime.addOption("ready-file", &s.readyFile,
                     "write the bound addresses as JSON here once both sockets are bound");
@@ -128,6 +133,15 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
     if (!costs.ok())
       return Status(costs.status().code(), "--frame-cost " + costs.status().message());
     o.defaultFrameCost = *costs;
+  }
+  if (!s.linkSchedule.empty()) {
+    thinlod::Result<std::string> text = thinlod::readFileBounded(s.linkSchedule, 1u << 20);
+    if (!text.ok())
+      return Status(text.status().code(), "--link-schedule " + text.status().message());
+    thinlod::Result<std::vector<thinlod::backbone_daemon::LinkStep>> steps =
+        thinlod::backbone_daemon::parseLinkSchedule(*text, s.linkSchedule);
+    if (!steps.ok()) return Status(steps.status().code(), "--link-schedule " + steps.status().message());
+    o.linkSchedule = std::move(steps).value();
   }
   if (!o.budget.maxTriangles && !o.budget.maxLinkBytesPerSecond && !o.budget.fixedAccuracy &&
       !o.budget.maxFrameSeconds)
@@ -474,6 +488,10 @@ class Daemon {
           row.keeps, outcome.adds, outcome.removes, outcome.frontendTriangles, outcome.linkBytes,
           outcome.plans, ms);
     }
+    if (outcome.linkRate != 0 && outcome.linkRate != lastLinkRate_) {
+      spdlog::info("event=link_rate frame={} bytes_per_s={}", pose.sequence, outcome.linkRate);
+      lastLinkRate_ = outcome.linkRate;
+    }
     if (outcome.deferredByPolygonCap > 0 || outcome.deferredByLink > 0 ||
         outcome.tooLargeForLink > 0) {
       spdlog::info("event=deferred frame={} polygon_cap={} link={} burst_grown={}", pose.sequence,
@@ -528,6 +546,7 @@ class Daemon {
   Clock::time_point lastResultAt_;  // the one before the result being handled
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;
+  std::uint64_t lastLinkRate_ = 0;  // logged when it changes (--link-schedule)
 };
 
 }  // namespace
