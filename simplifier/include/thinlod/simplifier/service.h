@@ -30,7 +30,8 @@
 // - Hybrid requests (SimplifyRequest.representation = kHybrid): one hybrid
 //   graph per (mesh, kappa), cached in memory with its measured ladder
 //   (measureHybridLevels with options.curve's levels and sampling, credited
-//   like a mesh ladder); the rung at the requested accuracy (or the finest
+//   like a mesh ladder; the ladder is also kept in options.curveCacheDir,
+//   HybridCurveCache, so a new process only rebuilds the graph); the rung at the requested accuracy (or the finest
 //   with at most targetTriangles primitive units) is an encodeHybrid frame,
 //   its accuracy 1 / (credited error + quantization), the curve its rungs in
 //   primitive units.
@@ -112,7 +113,8 @@ struct ServiceStats {
   std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
   std::uint64_t failedRequests = 0;
   std::uint64_t hybridGraphBuilds = 0;     // one per (mesh, kappa)
-  std::uint64_t hybridCurvesMeasured = 0;  // one per graph (measureHybridLevels)
+  std::uint64_t hybridCurvesMeasured = 0;  // measureHybridLevels ran (disk miss, refused file, no cache)
+  std::uint64_t hybridCurvesFromDisk = 0;  // the ladder read from the curve cache directory
 };
 
 class SimplifierService {
