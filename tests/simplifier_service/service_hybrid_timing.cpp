@@ -5,6 +5,8 @@
 // "Measured curve"). Model: the fly-through's generateScatteredParts(300, 2,
 // 7), 96,000 triangles, written as a PLY and named by a one-Shape scene.
 // Prints CSV: run,ms,graph_builds,ladders_measured,ladders_from_disk,units,accuracy
+// (ms: the whole request, scene load included); the service's progress
+// lines (graph + ladder time, "ms=") on stderr.
 // Usage: service_hybrid_timing [kappa] [parts]
 #include <unistd.h>
 
@@ -42,6 +44,8 @@ int main(int argc, char** argv) {
   options.modelSearchPaths = {dir.string()};
   options.sceneRoot = dir.string();
   options.curveCacheDir = (dir / "curves").string();
+  // The service's own split (graph + ladder, scene load excluded) goes to stderr.
+  options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   protocol::SimplifyRequest request;  // as the backbone's startup curve request
   request.requestId = 1;
   request.objectId = 1;

@@ -116,9 +116,9 @@ Result<std::vector<HybridMeasuredLevel>> parseHybridLevels(const std::string& te
     }
     const int version = document.at("version").get<int>();
     if (version != kHybridCurveFormatVersion) {
-      return Status(ErrorCode::kVersionMismatch,
-                    "hybrid curve cache: version " + std::to_string(version) + ", expected " +
-                        std::to_string(kHybridCurveFormatVersion));
+      return Status(ErrorCode::kVersionMismatch, "hybrid curve cache: version " +
+                                                     std::to_string(version) + ", expected " +
+                                                     std::to_string(kHybridCurveFormatVersion));
     }
     if (document.at("key").get<std::string>() != expectedKey) return parseError("key mismatch");
     const Json& rungs = document.at("rungs");
@@ -158,8 +158,8 @@ std::filesystem::path HybridCurveCache::fileFor(const std::string& key) const {
 }
 
 Result<std::vector<HybridMeasuredLevel>> HybridCurveCache::getOrMeasure(
-    const IndexedMesh& original, const HybridGraph& graph, const HybridOptions& options,
-    int levels, const SurfaceErrorOptions& error) {
+    const IndexedMesh& original, const HybridGraph& graph, const HybridOptions& options, int levels,
+    const SurfaceErrorOptions& error) {
   const std::string key = hybridCurveCacheKey(original, options, levels, error);
   const std::filesystem::path path = fileFor(key);
   std::error_code ec;

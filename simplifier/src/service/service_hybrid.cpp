@@ -76,8 +76,8 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyHybrid(
       const HybridCurveCache::Stats& after = hybridCurveCache->stats();
       fromDisk = after.hits > before.hits;
       if (after.rejected > before.rejected) {
-        progress("event=hybrid_curve_cache_rejected reason=\"" +
-                 hybridCurveCache->lastRejection() + "\"");
+        progress("event=hybrid_curve_cache_rejected reason=\"" + hybridCurveCache->lastRejection() +
+                 "\"");
       }
       if (after.writeFailures > before.writeFailures) {
         progress("event=hybrid_curve_cache_write_failed dir=\"" + options.curveCacheDir + "\"");
@@ -89,13 +89,13 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyHybrid(
     if (!levels.ok()) return levels.status();
     ++(fromDisk ? stats.hybridCurvesFromDisk : stats.hybridCurvesMeasured);
     hybrid->rungs = creditHybridLevels(*levels, model.diameter, options.curve.minRelativeError);
-    progress(std::string(fromDisk ? "event=hybrid_curve_from_disk" : "event=hybrid_curve_measured") +
-             " triangles=" + std::to_string(model.original->triangleCount()) +
-             " kappa=" + std::to_string(kappa) +
-             " rungs=" + std::to_string(hybrid->rungs.size()) + " ms=" +
-             std::to_string(std::llround(std::chrono::duration<double, std::milli>(
-                                             std::chrono::steady_clock::now() - started)
-                                             .count())));
+    progress(
+        std::string(fromDisk ? "event=hybrid_curve_from_disk" : "event=hybrid_curve_measured") +
+        " triangles=" + std::to_string(model.original->triangleCount()) + " kappa=" +
+        std::to_string(kappa) + " rungs=" + std::to_string(hybrid->rungs.size()) + " ms=" +
+        std::to_string(std::llround(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+                .count())));
     found = model.hybrids.emplace(kappa, std::move(hybrid)).first;
   }
   const MeshModel::Hybrid& hybrid = *found->second;
