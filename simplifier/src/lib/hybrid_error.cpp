@@ -239,15 +239,9 @@ Result<SurfaceError> measureHybridSurfaceError(const IndexedMesh& original,
   return error;
 }
 
-Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& original,
-                                                             const HybridGraph& graph, int levels,
-                                                             const SurfaceErrorOptions& options) {
-  if (levels < 1) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "measureHybridLevels: levels " + std::to_string(levels) + " < 1");
-  }
+std::vector<HybridCurveStep> hybridLadderSteps(const HybridGraph& graph, int levels) {
   const std::vector<HybridCurveStep> steps = graph.unitsVersusError();  // units decreasing
-  if (steps.empty()) return Status(ErrorCode::kInvalidArgument, "measureHybridLevels: empty graph");
+  if (steps.empty() || levels < 1) return {};
   const auto coarsest = static_cast<std::size_t>(std::max(1.0, std::ceil(steps.back().units)));
   const auto finest = static_cast<std::size_t>(std::max(1.0, std::floor(steps.front().units)));
   // Unit targets -> the finest step with at most that many units (steps are
@@ -262,15 +256,30 @@ Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& 
   // Increasing units = decreasing step index.
   std::sort(picked.begin(), picked.end(), std::greater<>());
   picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+  std::vector<HybridCurveStep> rungs;
+  rungs.reserve(picked.size());
+  for (std::size_t i : picked) rungs.push_back(steps[i]);
+  return rungs;
+}
+
+Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& original,
+                                                             const HybridGraph& graph, int levels,
+                                                             const SurfaceErrorOptions& options) {
+  if (levels < 1) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "measureHybridLevels: levels " + std::to_string(levels) + " < 1");
+  }
+  const std::vector<HybridCurveStep> rungs = hybridLadderSteps(graph, levels);
+  if (rungs.empty()) return Status(ErrorCode::kInvalidArgument, "measureHybridLevels: empty graph");
   std::vector<HybridMeasuredLevel> out;
-  out.reserve(picked.size());
+  out.reserve(rungs.size());
   HybridCut cut(graph);
-  for (std::size_t i : picked) {
-    cut.adaptToError(steps[i].error);
+  for (const HybridCurveStep& step : rungs) {
+    cut.adaptToError(step.error);
     Result<SurfaceError> error =
         measureHybridSurfaceError(original, cut.triangleMesh(), cut.pointList(), options);
     if (!error.ok()) return error.status();
-    out.push_back(HybridMeasuredLevel{steps[i], error->max()});
+    out.push_back(HybridMeasuredLevel{step, error->max()});
   }
   return out;
 }

@@ -1,66 +1,24 @@
 // The on-disk cache of measured curves (see mesh_curve.h): key hashing and
 // JSON (de)serialization (pure), and the thin file wrapper MeshCurveCache.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <exception>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-#include <system_error>
 
+#include "curve_cache_files.h"
 #include "qem_collapse.h"
-#include "thinlod/common/core/file_bytes.h"
 #include "thinlod/simplifier/mesh_curve.h"
 
 namespace thinlod::simplifier {
 namespace {
 
 using Json = nlohmann::json;
+using curve_cache::KeyHasher;
+using curve_cache::writeFileAtomically;
 
 constexpr const char* kFormatName = "thinlod-mesh-curves";
-constexpr std::uintmax_t kMaxCacheFileBytes = 16u << 20;
-
-// FNV-1a with 128-bit state: a cache key, not a security boundary (a forged
-// file still has to pass every check in parseMeshCurves).
-class KeyHasher {
- public:
-  void bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) {
-      state_ ^= p[i];
-      state_ *= kPrime;
-    }
-  }
-  void text(const std::string& s) {
-    number(s.size());
-    bytes(s.data(), s.size());
-  }
-  template <typename T>
-  void number(T value) {
-    bytes(&value, sizeof(value));
-  }
-  template <typename T>
-  void vector(const std::vector<T>& v) {
-    number(v.size());
-    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-  }
-  std::string hex() const {
-    static const char* kDigits = "0123456789abcdef";
-    std::string out(32, '0');
-    unsigned __int128 s = state_;
-    for (int i = 31; i >= 0; --i, s >>= 4) out[i] = kDigits[static_cast<int>(s & 0xf)];
-    return out;
-  }
-
- private:
-  static constexpr unsigned __int128 kPrime =
-      (static_cast<unsigned __int128>(1) << 88) + (1u << 8) + 0x3b;
-  unsigned __int128 state_ =
-      (static_cast<unsigned __int128>(0x6c62272e07bb0142ull) << 64) | 0x62b821756295c58dull;
-};
 
 Json curveToJson(const AccuracyCurve& curve) {
   if (curve.empty()) return nullptr;
@@ -114,31 +72,6 @@ Status checkConservative(const AccuracyCurve& curve, const std::vector<AccuracyS
                         std::to_string(s.accuracy) + " for " + std::to_string(r) +
                         ", measured cheapest " + std::to_string(cheapest));
     }
-  }
-  return Status();
-}
-
-Result<std::string> readSmallFile(const std::filesystem::path& path) {
-  return readFileBounded(path.string(), kMaxCacheFileBytes);
-}
-
-// Write to a unique temporary name, then rename over the target: readers
-// never see a half-written file.
-Status writeFileAtomically(const std::filesystem::path& path, const std::string& text) {
-  std::error_code ec;
-  std::filesystem::create_directories(path.parent_path(), ec);
-  if (ec) return Status(ErrorCode::kIoError, path.parent_path().string() + ": " + ec.message());
-  std::filesystem::path temporary = path;
-  temporary += ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!out) return Status(ErrorCode::kIoError, temporary.string() + ": write failed");
-  }
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    return Status(ErrorCode::kIoError, path.string() + ": rename failed");
   }
   return Status();
 }
@@ -304,7 +237,7 @@ Result<MeshCurves> MeshCurveCache::readStored(const std::string& key) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
     return Status(ErrorCode::kNotFound, "mesh curve cache: no " + path.string());
-  Result<std::string> text = readSmallFile(path);
+  Result<std::string> text = curve_cache::readCacheFile(path);
   if (!text.ok()) return text.status();
   return parseMeshCurves(*text, key);
 }

@@ -62,6 +62,7 @@ SimplifierService::Impl::Impl(ServiceOptions o) : options(std::move(o)) {
   }
   if (!options.curveCacheDir.empty()) {
     curveCache = std::make_unique<MeshCurveCache>(options.curveCacheDir);
+    hybridCurveCache = std::make_unique<HybridCurveCache>(options.curveCacheDir);
   }
 }
 

@@ -66,17 +66,36 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyHybrid(
     // Measured like a mesh curve (same ladder length, same sampling): the
     // scheduler compares the two kinds on measured error, not a measured
     // error against a guaranteed bound (docs/hybrid.md, "Measured curve").
-    Result<std::vector<HybridMeasuredLevel>> levels = measureHybridLevels(
-        *model.original, hybrid->graph, options.curve.levels, options.curve.error);
+    // The measurement, not the graph, is the slow part: it is kept on disk.
+    Result<std::vector<HybridMeasuredLevel>> levels = Status(ErrorCode::kInternal, "not measured");
+    bool fromDisk = false;
+    if (hybridCurveCache) {
+      const HybridCurveCache::Stats before = hybridCurveCache->stats();
+      levels = hybridCurveCache->getOrMeasure(*model.original, hybrid->graph, hybridOptions,
+                                              options.curve.levels, options.curve.error);
+      const HybridCurveCache::Stats& after = hybridCurveCache->stats();
+      fromDisk = after.hits > before.hits;
+      if (after.rejected > before.rejected) {
+        progress("event=hybrid_curve_cache_rejected reason=\"" + hybridCurveCache->lastRejection() +
+                 "\"");
+      }
+      if (after.writeFailures > before.writeFailures) {
+        progress("event=hybrid_curve_cache_write_failed dir=\"" + options.curveCacheDir + "\"");
+      }
+    } else {
+      levels = measureHybridLevels(*model.original, hybrid->graph, options.curve.levels,
+                                   options.curve.error);
+    }
     if (!levels.ok()) return levels.status();
-    ++stats.hybridCurvesMeasured;
+    ++(fromDisk ? stats.hybridCurvesFromDisk : stats.hybridCurvesMeasured);
     hybrid->rungs = creditHybridLevels(*levels, model.diameter, options.curve.minRelativeError);
-    progress("event=hybrid_curve_measured triangles=" +
-             std::to_string(model.original->triangleCount()) + " kappa=" + std::to_string(kappa) +
-             " rungs=" + std::to_string(hybrid->rungs.size()) + " ms=" +
-             std::to_string(std::llround(std::chrono::duration<double, std::milli>(
-                                             std::chrono::steady_clock::now() - started)
-                                             .count())));
+    progress(
+        std::string(fromDisk ? "event=hybrid_curve_from_disk" : "event=hybrid_curve_measured") +
+        " triangles=" + std::to_string(model.original->triangleCount()) + " kappa=" +
+        std::to_string(kappa) + " rungs=" + std::to_string(hybrid->rungs.size()) + " ms=" +
+        std::to_string(std::llround(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+                .count())));
     found = model.hybrids.emplace(kappa, std::move(hybrid)).first;
   }
   const MeshModel::Hybrid& hybrid = *found->second;

@@ -17,6 +17,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_objects.h"
+#include "thinlod/simplifier/hybrid_curve_cache.h"
 #include "thinlod/simplifier/hybrid_graph.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/mesh_curve.h"
@@ -146,6 +147,8 @@ struct SimplifierService::Impl {
   std::map<std::uint64_t, std::unique_ptr<service_detail::MeshModel>> sourceMeshModels;
   std::map<service_detail::PrimitiveLevelKey, std::shared_ptr<const IndexedMesh>> primitiveLevels;
   std::unique_ptr<MeshCurveCache> curveCache;
+  // Measured hybrid ladders, same directory (null without curveCacheDir).
+  std::unique_ptr<HybridCurveCache> hybridCurveCache;
   // Decoded scene textures by file (null: the file failed, logged once).
   std::map<std::string, std::shared_ptr<const RgbaImage>> textureFiles;
   // Rendering (created lazily on the calling thread; renderer before context).

@@ -38,6 +38,12 @@
 
 namespace thinlod::simplifier {
 
+// Version of what buildHybridGraph and measureHybridLevels compute: part of
+// the hybrid curve cache key (hybrid_curve_cache.h). Bump it whenever a
+// change to the graph (queue, bounds, sampling, octree) or to the ladder's
+// choice of rungs could change a stored ladder.
+inline constexpr int kHybridGraphVersion = 1;
+
 struct HybridOptions {
   double kappa = 3.0;  // point rate / triangle rate
   double tau = 1.0;    // transition factor, > 0
@@ -275,6 +281,10 @@ struct HybridMeasuredLevel {
   HybridCurveStep step;        // the cut: every node with error <= step.error
   double measuredError = 0.0;  // sampled two-sided Hausdorff max, mesh units
 };
+// The rungs measureHybridLevels measures (its first step, pure and cheap):
+// increasing units, the last one the input (unitsVersusError().front()).
+// Empty when the graph is empty or levels < 1.
+std::vector<HybridCurveStep> hybridLadderSteps(const HybridGraph& graph, int levels);
 Result<std::vector<HybridMeasuredLevel>> measureHybridLevels(const IndexedMesh& original,
                                                              const HybridGraph& graph, int levels,
                                                              const SurfaceErrorOptions& options);

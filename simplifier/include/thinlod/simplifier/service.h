@@ -30,11 +30,12 @@
 // - Hybrid requests (SimplifyRequest.representation = kHybrid): one hybrid
 //   graph per (mesh, kappa), cached in memory with its measured ladder
 //   (measureHybridLevels with options.curve's levels and sampling, credited
-//   like a mesh ladder); the rung at the requested accuracy (or the finest
-//   with at most targetTriangles primitive units) is an encodeHybrid frame,
-//   its accuracy 1 / (credited error + quantization), the curve its rungs in
-//   primitive units.
-//   Analytic primitives have no hybrid form (kUnsupported).
+//   like a mesh ladder; the ladder is also kept in options.curveCacheDir,
+//   HybridCurveCache, so a new process only rebuilds the graph); the rung
+//   at the requested accuracy (or the finest with at most targetTriangles
+//   primitive units) is an encodeHybrid frame, its accuracy 1 / (credited
+//   error + quantization), the curve its rungs in primitive units. Analytic
+//   primitives have no hybrid form (kUnsupported).
 // - Impostors: world-space geometry, identity transform, world validity;
 //   representationId/generation stay 0 (the backbone numbers them).
 // - Errors are returned in the result's status, never thrown: kInvalidArgument
@@ -112,7 +113,9 @@ struct ServiceStats {
   std::uint64_t impostorLevelsExtracted = 0;  // render levels extracted (kept for reuse)
   std::uint64_t failedRequests = 0;
   std::uint64_t hybridGraphBuilds = 0;     // one per (mesh, kappa)
-  std::uint64_t hybridCurvesMeasured = 0;  // one per graph (measureHybridLevels)
+  // measureHybridLevels ran (cache miss, refused file, or no cache directory).
+  std::uint64_t hybridCurvesMeasured = 0;
+  std::uint64_t hybridCurvesFromDisk = 0;  // the ladder read from the curve cache directory
 };
 
 class SimplifierService {

@@ -1,0 +1,36 @@
+// The file side of the curve caches (curve_cache_files.h).
+#include "curve_cache_files.h"
+
+#include <unistd.h>
+
+#include <fstream>
+#include <system_error>
+
+#include "thinlod/common/core/file_bytes.h"
+
+namespace thinlod::simplifier::curve_cache {
+
+Result<std::string> readCacheFile(const std::filesystem::path& path) {
+  return readFileBounded(path.string(), kMaxCacheFileBytes);
+}
+
+Status writeFileAtomically(const std::filesystem::path& path, const std::string& text) {
+  std::error_code ec;
+  std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) return Status(ErrorCode::kIoError, path.parent_path().string() + ": " + ec.message());
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!out) return Status(ErrorCode::kIoError, temporary.string() + ": write failed");
+  }
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    return Status(ErrorCode::kIoError, path.string() + ": rename failed");
+  }
+  return Status();
+}
+
+}  // namespace thinlod::simplifier::curve_cache

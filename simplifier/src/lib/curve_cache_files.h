@@ -1,0 +1,66 @@
+// Private helpers of the on-disk curve caches (mesh_curve_cache.cpp,
+// hybrid_curve_cache.cpp): the key hash, the bounded read and the atomic
+// write. One directory holds both kinds of files; their keys differ because
+// each hashes its own format name first.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "thinlod/common/core/status.h"
+
+namespace thinlod::simplifier::curve_cache {
+
+// Larger files are refused before anything is allocated.
+inline constexpr std::uintmax_t kMaxCacheFileBytes = 16u << 20;
+
+// FNV-1a with 128-bit state: a cache key, not a security boundary (a forged
+// file still has to pass every check of its parser).
+class KeyHasher {
+ public:
+  void bytes(const void* data, std::size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i) {
+      state_ ^= p[i];
+      state_ *= kPrime;
+    }
+  }
+  void text(const std::string& s) {
+    number(s.size());
+    bytes(s.data(), s.size());
+  }
+  template <typename T>
+  void number(T value) {
+    bytes(&value, sizeof(value));
+  }
+  template <typename T>
+  void vector(const std::vector<T>& v) {
+    number(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  std::string hex() const {
+    static const char* kDigits = "0123456789abcdef";
+    std::string out(32, '0');
+    unsigned __int128 s = state_;
+    for (int i = 31; i >= 0; --i, s >>= 4) out[i] = kDigits[static_cast<int>(s & 0xf)];
+    return out;
+  }
+
+ private:
+  static constexpr unsigned __int128 kPrime =
+      (static_cast<unsigned __int128>(1) << 88) + (1u << 8) + 0x3b;
+  unsigned __int128 state_ =
+      (static_cast<unsigned __int128>(0x6c62272e07bb0142ull) << 64) | 0x62b821756295c58dull;
+};
+
+// The file's text, at most kMaxCacheFileBytes (readFileBounded).
+Result<std::string> readCacheFile(const std::filesystem::path& path);
+
+// Writes to a unique temporary name, then renames over the target: readers
+// never see a half-written file; concurrent writers race benignly.
+Status writeFileAtomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace thinlod::simplifier::curve_cache
