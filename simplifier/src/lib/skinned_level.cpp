@@ -6,6 +6,9 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/mat3x3.hpp>
+#include <limits>
 #include <map>
 #include <queue>
 #include <string>
@@ -76,13 +79,75 @@ Status deformChecked(const std::vector<glm::vec3>& positions, const std::vector<
   return Status::okStatus();
 }
 
-double maxDisplacement(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+// A frame the motion between two poses is measured in: an invertible affine
+// map R (a bone's motion from pose a to pose t, or the identity). Applying
+// R^-1 to both deformed meshes at t scales Hausdorff distances by at most
+// ||R^-1||, so e(t) <= ||L|| * (e(a) + max_v |R^-1 P_v(t) - P_v(a)| over both
+// meshes), L the linear part of R: the motion the bone carries everything
+// with costs nothing, only the motion relative to it is charged.
+struct MotionFrame {
+  glm::dmat4 inverse{1.0};  // R^-1
+  double norm = 1.0;        // >= ||L||_2
+};
+
+// ||L||_2^2 is the largest eigenvalue of L^T L, at most its largest absolute
+// row sum (Gershgorin): exact for rotations, tight for similarities.
+double spectralNormBound(const glm::dmat3& l) {
+  const glm::dmat3 g = glm::transpose(l) * l;
   double worst = 0.0;
-  for (std::size_t v = 0; v < a.size(); ++v) {
-    const glm::dvec3 d = glm::dvec3(a[v]) - glm::dvec3(b[v]);
+  for (int r = 0; r < 3; ++r) {
+    worst = std::max(worst, std::abs(g[0][r]) + std::abs(g[1][r]) + std::abs(g[2][r]));
+  }
+  return std::sqrt(worst);
+}
+
+// Frames of the candidate bones between the poses with skinning matrices
+// `from` and `to`: R_b = to_b * from_b^-1. Singular or non-finite ones are left
+// out; the identity is always a candidate.
+std::vector<MotionFrame> motionFrames(const std::vector<glm::mat4>& from,
+                                      const std::vector<glm::mat4>& to,
+                                      const std::vector<std::uint32_t>& bones) {
+  std::vector<MotionFrame> frames(1);
+  for (const std::uint32_t b : bones) {
+    const glm::dmat4 r = glm::dmat4(to[b]) * glm::inverse(glm::dmat4(from[b]));
+    const glm::dmat3 linear(r);
+    if (!(std::abs(glm::determinant(linear)) > 1e-12)) continue;
+    MotionFrame frame;
+    frame.inverse = glm::inverse(r);
+    frame.norm = spectralNormBound(linear);
+    bool finite = std::isfinite(frame.norm);
+    for (int c = 0; c < 4; ++c) {
+      for (int k = 0; k < 4; ++k) finite = finite && std::isfinite(frame.inverse[c][k]);
+    }
+    if (finite) frames.push_back(frame);
+  }
+  return frames;
+}
+
+// max_v |R^-1 now_v - then_v|.
+double relativeMotion(const MotionFrame& frame, const std::vector<glm::vec3>& now,
+                      const std::vector<glm::vec3>& then) {
+  double worst = 0.0;
+  for (std::size_t v = 0; v < now.size(); ++v) {
+    const glm::dvec3 d = glm::dvec3(frame.inverse * glm::dvec4(glm::dvec3(now[v]), 1.0)) -
+                         glm::dvec3(then[v]);
     worst = std::max(worst, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
   }
   return worst;
+}
+
+// The best frame's bound from one measured pose: min over frames of
+// ||L|| * (e + motion of the level + motion of the full mesh).
+double boundFrom(double error, const std::vector<MotionFrame>& frames,
+                 const std::vector<glm::vec3>& levelNow, const std::vector<glm::vec3>& levelThen,
+                 const std::vector<glm::vec3>& fullNow, const std::vector<glm::vec3>& fullThen) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const MotionFrame& frame : frames) {
+    const double b = frame.norm * (error + relativeMotion(frame, levelNow, levelThen) +
+                                   relativeMotion(frame, fullNow, fullThen));
+    best = std::min(best, b);
+  }
+  return best;
 }
 
 // Positions and triangles only: deformed normals and uvs are not what is
@@ -226,18 +291,26 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
 
   const Poser poser(skeleton, clip, options.wrap);
   std::vector<glm::vec3> fullAt, levelAt;
-  const auto deformBoth = [&](double t, std::vector<glm::vec3>& fullOut,
+  const auto deformBoth = [&](const std::vector<glm::mat4>& matrices, double t,
+                              std::vector<glm::vec3>& fullOut,
                               std::vector<glm::vec3>& levelOut) -> Status {
-    const std::vector<glm::mat4> matrices = poser.matrices(t);
     if (Status s = deformChecked(full.positions, fullSkin, matrices, t, "full mesh", fullOut);
         !s.ok()) {
       return s;
     }
     return deformChecked(level.positions, levelSkin, matrices, t, "level", levelOut);
   };
+  // Candidate frames: every bone a vertex depends on.
+  std::vector<std::uint32_t> skinBones;
+  for (const VertexSkin& s : fullSkin) {
+    skinBones.push_back(s.boneA);
+    if (!s.rigid()) skinBones.push_back(s.boneB);
+  }
+  std::sort(skinBones.begin(), skinBones.end());
+  skinBones.erase(std::unique(skinBones.begin(), skinBones.end()), skinBones.end());
   std::map<double, double> measured;  // pose time -> error
   const auto measure = [&](double t) -> Result<double> {
-    if (Status s = deformBoth(t, fullAt, levelAt); !s.ok()) return s;
+    if (Status s = deformBoth(poser.matrices(t), t, fullAt, levelAt); !s.ok()) return s;
     Result<SurfaceError> error =
         measureSurfaceError(geometry(full, fullAt), geometry(level, levelAt), options.surface);
     if (!error.ok()) return error.status();
@@ -245,19 +318,23 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
     return error->max();
   };
 
-  // The cover of [a, b]: max over substeps of the smaller triangle-inequality
-  // bound from either end (the ends themselves: their measured errors).
+  // The cover of [a, b]: max over substeps of the smaller bound from either
+  // end (the ends themselves: their measured errors).
   std::vector<glm::vec3> fullA, levelA, fullB, levelB, fullT, levelT;
   const auto cover = [&](double a, double ea, double b, double eb) -> Result<double> {
-    if (Status s = deformBoth(a, fullA, levelA); !s.ok()) return s;
-    if (Status s = deformBoth(b, fullB, levelB); !s.ok()) return s;
+    const std::vector<glm::mat4> matricesA = poser.matrices(a), matricesB = poser.matrices(b);
+    if (Status s = deformBoth(matricesA, a, fullA, levelA); !s.ok()) return s;
+    if (Status s = deformBoth(matricesB, b, fullB, levelB); !s.ok()) return s;
     double worst = std::max(ea, eb);
     const double parts = static_cast<double>(options.motionSteps + 1);
     for (std::size_t k = 1; k <= options.motionSteps; ++k) {
       const double t = a + (b - a) * static_cast<double>(k) / parts;
-      if (Status s = deformBoth(t, fullT, levelT); !s.ok()) return s;
-      const double fromA = ea + maxDisplacement(levelT, levelA) + maxDisplacement(fullT, fullA);
-      const double fromB = eb + maxDisplacement(levelT, levelB) + maxDisplacement(fullT, fullB);
+      const std::vector<glm::mat4> matricesT = poser.matrices(t);
+      if (Status s = deformBoth(matricesT, t, fullT, levelT); !s.ok()) return s;
+      const double fromA = boundFrom(ea, motionFrames(matricesA, matricesT, skinBones), levelT,
+                                     levelA, fullT, fullA);
+      const double fromB = boundFrom(eb, motionFrames(matricesB, matricesT, skinBones), levelT,
+                                     levelB, fullT, fullB);
       worst = std::max(worst, std::min(fromA, fromB));
     }
     return worst;

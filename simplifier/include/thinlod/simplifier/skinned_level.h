@@ -14,11 +14,12 @@
 //   measured, not proven: at poses the error is measureSurfaceError's
 //   (finite surface samples, so <= the true distance at that pose); between
 //   two measured poses a and b the error at t is covered by the triangle
-//   inequality, e(t) <= e(a) + mL(t, a) + mF(t, a) (mX: the largest
-//   displacement of a vertex of X between the two poses; a point of a
-//   triangle moves by a convex combination of its corners' motions), the
-//   smaller of the a- and b-sides, with the motion sampled at motionSteps
-//   substeps (as sampledMaxDisplacement). Intervals whose cover exceeds
+//   inequality in a moving frame: for any invertible affine R (the identity,
+//   or a bone's motion from a to t), e(t) <= ||R|| (e(a) + mL + mF), mX the
+//   largest |R^-1 P_v(t) - P_v(a)| over X's vertices (a point of a triangle
+//   moves by a convex combination of its corners' motions), taking the best
+//   frame and the smaller of the a- and b-sides, with the motion sampled at
+//   motionSteps substeps (as sampledMaxDisplacement). Intervals whose cover exceeds
 //   (1 + relativeTolerance) * max(e(a), e(b)) and absoluteTolerance * the
 //   rest diagonal are split at their midpoint (one more measured pose),
 //   worst first, until maxPoses poses are measured; `converged` says whether
