@@ -92,6 +92,11 @@ int main(int argc, char** argv) {
       const auto target =
           static_cast<std::size_t>(fraction * static_cast<double>(pm->maxTriangles()));
       const IndexedMesh level = pm->extract(target);
+      if (level.triangleCount() == 0) {
+        std::printf("| %s | %.0f%% | 0 | - | - | - | - | - | - | - | - |\n", model.name.c_str(),
+                    100.0 * fraction);
+        continue;
+      }
       const double start = threadSeconds();
       Result<AnimatedLevelError> bound = deformedLevelBound(
           model.mesh, model.skin, model.skeleton, model.clip, level, *skin, options);

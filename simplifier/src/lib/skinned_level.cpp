@@ -348,26 +348,31 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
     if (Result<double> e = measure(i + 1 == initial ? t1 : t); !e.ok()) return e.status();
   }
 
+  // Refinement: the bound is the worst interval's cover, so only the worst
+  // one is worth a pose; it is split until it is within tolerance of the
+  // largest error measured so far (then every other one is too).
   struct Interval {
     double a, ea, b, eb, cover;
     bool operator<(const Interval& o) const { return cover < o.cover; }  // worst on top
   };
   const double absolute = options.absoluteTolerance * result.diagonal;
-  const auto withinTolerance = [&](const Interval& i) {
-    return i.cover <= std::max((1.0 + options.relativeTolerance) * std::max(i.ea, i.eb), absolute);
+  double maxMeasured = 0.0;
+  for (const auto& entry : measured) maxMeasured = std::max(maxMeasured, entry.second);
+  const auto target = [&] {
+    return std::max((1.0 + options.relativeTolerance) * maxMeasured, absolute);
   };
-  std::priority_queue<Interval> open;  // intervals above tolerance
-  double bound = measured.begin()->second;
+  std::priority_queue<Interval> open;
+  double bound = maxMeasured;  // a single pose: its error
   const auto addInterval = [&](double a, double ea, double b, double eb) -> Status {
     Result<double> c = cover(a, ea, b, eb);
     if (!c.ok()) return c.status();
     const Interval interval{a, ea, b, eb, *c};
     // An interval too short to split in double precision stays as it is.
     const bool splittable = 0.5 * (a + b) > a && 0.5 * (a + b) < b;
-    if (!withinTolerance(interval) && splittable) {
+    if (splittable) {
       open.push(interval);
     } else {
-      if (!withinTolerance(interval)) result.converged = false;
+      if (interval.cover > target()) result.converged = false;
       bound = std::max(bound, interval.cover);
     }
     return Status::okStatus();
@@ -378,20 +383,21 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
       return s;
     }
   }
-  while (!open.empty()) {
+  while (!open.empty() && open.top().cover > target()) {
+    if (measured.size() >= options.maxPoses) {
+      result.converged = false;
+      break;
+    }
     const Interval worst = open.top();
-    if (measured.size() >= options.maxPoses) break;
     open.pop();
     const double mid = 0.5 * (worst.a + worst.b);
     Result<double> em = measure(mid);
     if (!em.ok()) return em.status();
+    maxMeasured = std::max(maxMeasured, *em);
     if (Status s = addInterval(worst.a, worst.ea, mid, *em); !s.ok()) return s;
     if (Status s = addInterval(mid, *em, worst.b, worst.eb); !s.ok()) return s;
   }
-  if (!open.empty()) {
-    result.converged = false;
-    bound = std::max(bound, open.top().cover);  // the worst one left
-  }
+  if (!open.empty()) bound = std::max(bound, open.top().cover);  // the worst one left
 
   result.bound = bound;
   result.poses = measured.size();

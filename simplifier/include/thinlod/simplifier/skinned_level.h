@@ -19,11 +19,12 @@
 //   largest |R^-1 P_v(t) - P_v(a)| over X's vertices (a point of a triangle
 //   moves by a convex combination of its corners' motions), taking the best
 //   frame and the smaller of the a- and b-sides, with the motion sampled at
-//   motionSteps substeps (as sampledMaxDisplacement). Intervals whose cover exceeds
-//   (1 + relativeTolerance) * max(e(a), e(b)) and absoluteTolerance * the
-//   rest diagonal are split at their midpoint (one more measured pose),
-//   worst first, until maxPoses poses are measured; `converged` says whether
-//   every interval met the tolerance. A level whose triangles are the full
+//   motionSteps substeps (as sampledMaxDisplacement). The bound is the
+//   worst interval's cover; while it exceeds (1 + relativeTolerance) times
+//   the largest measured error (and absoluteTolerance times the rest
+//   diagonal), the worst interval is split at its midpoint (one more
+//   measured pose), until maxPoses poses are measured: `converged` says
+//   whether the bound ended within that tolerance. A level whose triangles are the full
 //   mesh's (same positions and skins) is the same surface at every pose:
 //   bound 0, `identical`, nothing sampled.
 //   Errors (kInvalidArgument): a mesh fails validate or has no triangles,
@@ -67,7 +68,7 @@ struct AnimatedLevelError {
   double restError = 0.0;      // undeformed level vs undeformed full mesh (measured)
   double diagonal = 0.0;       // the full mesh's rest bbox diagonal
   std::size_t poses = 0;       // measured poses
-  bool converged = true;       // every interval within tolerance
+  bool converged = true;       // bound <= max((1 + tol) * maxAtPoses, absolute)
   bool identical = false;      // the level is the full mesh's surface: 0, proven
   std::size_t levelVertices = 0;  // vertices deformed per frame for the level
   std::size_t fullVertices = 0;   // ... for the full mesh
