@@ -12,6 +12,8 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -88,6 +90,27 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", model.name.c_str(), skin.status().toString().c_str());
       return 1;
     }
+    // Input vertices at the place of a TOM vertex's source but with another
+    // skin: the weld merged them, and tomSkin gives them the source's skin.
+    std::size_t otherSkin = 0;
+    {
+      std::map<std::array<float, 3>, anim::VertexSkin> sourceSkin;
+      for (std::uint32_t v = 0; v < pm->vertexCount(); ++v) {
+        const glm::vec3 p = model.mesh.positions[pm->sourceVertexOf(v)];
+        sourceSkin.emplace(std::array<float, 3>{p.x, p.y, p.z}, (*skin)[v]);
+      }
+      for (std::size_t v = 0; v < model.mesh.vertexCount(); ++v) {
+        const glm::vec3 p = model.mesh.positions[v];
+        const auto it = sourceSkin.find({p.x, p.y, p.z});
+        if (it == sourceSkin.end()) continue;
+        const anim::VertexSkin& a = it->second;
+        const anim::VertexSkin& b = model.skin[v];
+        if (a.boneA != b.boneA || a.boneB != b.boneB || a.weightB != b.weightB) ++otherSkin;
+      }
+    }
+    std::fprintf(stderr, "%s: %zu input vertices, %zu TOM vertices, %zu input vertices at a TOM "
+                 "vertex's place with another skin\n",
+                 model.name.c_str(), model.mesh.vertexCount(), pm->vertexCount(), otherSkin);
     for (const double fraction : {1.0, 0.5, 0.1}) {
       const auto target =
           static_cast<std::size_t>(fraction * static_cast<double>(pm->maxTriangles()));
