@@ -13,8 +13,8 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -57,8 +57,8 @@ int main(int argc, char** argv) {
     const anim::testing::ArticulatedFigure f = anim::testing::makeArticulatedFigure();
     models.push_back({"articulated figure", f.mesh, f.skeleton, f.skin, f.clip});
   }
-  for (const char* file : {"X/Testwuson.X", "glTF2/simple_skin/simple_skin.gltf",
-                           "FBX/animation_with_skeleton.fbx"}) {
+  for (const char* file :
+       {"X/Testwuson.X", "glTF2/simple_skin/simple_skin.gltf", "FBX/animation_with_skeleton.fbx"}) {
     Result<scene::SkinnedModel> m = scene::importSkinnedModel(modelsDir + "/" + file);
     if (!m.ok() || m->clips.empty()) {
       std::fprintf(stderr, "%s: %s\n", file, m.ok() ? "no clip" : m.status().toString().c_str());
@@ -69,14 +69,16 @@ int main(int argc, char** argv) {
 
   AnimatedErrorOptions options;
   options.surface.samplesPerMesh = samples;
-  std::printf("options: initialPoses %zu, maxPoses %zu, motionSteps %zu, relativeTolerance %.2f, "
-              "absoluteTolerance %.0e, %zu samples per mesh; errors in %% of the rest bbox "
-              "diagonal\n\n",
-              options.initialPoses, options.maxPoses, options.motionSteps,
-              options.relativeTolerance, options.absoluteTolerance, samples);
-  std::printf("| model | level | triangles | deformed vertices / total | rest error | bound "
-              "under animation | max at measured poses | poses (converged) | sampled true "
-              "error, 4x poses | bound / true | seconds (bound) |\n");
+  std::printf(
+      "options: initialPoses %zu, maxPoses %zu, motionSteps %zu, relativeTolerance %.2f, "
+      "absoluteTolerance %.0e, %zu samples per mesh; errors in %% of the rest bbox "
+      "diagonal\n\n",
+      options.initialPoses, options.maxPoses, options.motionSteps, options.relativeTolerance,
+      options.absoluteTolerance, samples);
+  std::printf(
+      "| model | level | triangles | deformed vertices / total | rest error | bound "
+      "under animation | max at measured poses | poses (converged) | sampled true "
+      "error, 4x poses | bound / true | seconds (bound) |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const Model& model : models) {
     Result<ProgressiveMesh> pm = ProgressiveMesh::build(model.mesh);
@@ -108,7 +110,8 @@ int main(int argc, char** argv) {
         if (a.boneA != b.boneA || a.boneB != b.boneB || a.weightB != b.weightB) ++otherSkin;
       }
     }
-    std::fprintf(stderr, "%s: %zu input vertices, %zu TOM vertices, %zu input vertices at a TOM "
+    std::fprintf(stderr,
+                 "%s: %zu input vertices, %zu TOM vertices, %zu input vertices at a TOM "
                  "vertex's place with another skin\n",
                  model.name.c_str(), model.mesh.vertexCount(), pm->vertexCount(), otherSkin);
     for (const double fraction : {1.0, 0.5, 0.1}) {
@@ -121,8 +124,8 @@ int main(int argc, char** argv) {
         continue;
       }
       const double start = threadSeconds();
-      Result<AnimatedLevelError> bound = deformedLevelBound(
-          model.mesh, model.skin, model.skeleton, model.clip, level, *skin, options);
+      Result<AnimatedLevelError> bound = deformedLevelBound(model.mesh, model.skin, model.skeleton,
+                                                            model.clip, level, *skin, options);
       const double seconds = threadSeconds() - start;
       if (!bound.ok()) {
         std::fprintf(stderr, "%s: %s\n", model.name.c_str(), bound.status().toString().c_str());
@@ -135,9 +138,8 @@ int main(int argc, char** argv) {
       double truth = 0.0;
       for (std::size_t i = 0; i < dense; ++i) {
         const double t = t1 * static_cast<double>(i) / static_cast<double>(dense - 1);
-        Result<double> e = deformedLevelErrorAt(model.mesh, model.skin, model.skeleton,
-                                                model.clip, level, *skin, t, options.wrap,
-                                                options.surface);
+        Result<double> e = deformedLevelErrorAt(model.mesh, model.skin, model.skeleton, model.clip,
+                                                level, *skin, t, options.wrap, options.surface);
         if (!e.ok()) {
           std::fprintf(stderr, "%s: %s\n", model.name.c_str(), e.status().toString().c_str());
           return 1;
@@ -148,13 +150,13 @@ int main(int argc, char** argv) {
       const auto percent = [&](double x) { return 100.0 * x / d; };
       char ratio[32] = "-";
       if (truth > 0.0) std::snprintf(ratio, sizeof(ratio), "%.2f", bound->bound / truth);
-      std::printf("| %s | %.0f%% | %zu | %zu / %zu | %.4f%% | %.4f%%%s | %.4f%% | %zu (%s) | "
-                  "%.4f%% (%zu poses) | %s | %.2f |\n",
-                  model.name.c_str(), 100.0 * fraction, level.triangleCount(),
-                  bound->levelVertices, bound->fullVertices, percent(bound->restError),
-                  percent(bound->bound), bound->identical ? " (identical)" : "",
-                  percent(bound->maxAtPoses), bound->poses, bound->converged ? "yes" : "no",
-                  percent(truth), dense, ratio, seconds);
+      std::printf(
+          "| %s | %.0f%% | %zu | %zu / %zu | %.4f%% | %.4f%%%s | %.4f%% | %zu (%s) | "
+          "%.4f%% (%zu poses) | %s | %.2f |\n",
+          model.name.c_str(), 100.0 * fraction, level.triangleCount(), bound->levelVertices,
+          bound->fullVertices, percent(bound->restError), percent(bound->bound),
+          bound->identical ? " (identical)" : "", percent(bound->maxAtPoses), bound->poses,
+          bound->converged ? "yes" : "no", percent(truth), dense, ratio, seconds);
       std::fflush(stdout);
     }
   }

@@ -54,8 +54,8 @@ ArticulatedFigure makeArticulatedFigure(const FigureShape& shape) {
     Bone bone;
     bone.name = "segment" + std::to_string(b);
     bone.parent = b - 1;
-    bone.restLocal = b == 0 ? glm::mat4(1.0f)
-                            : glm::translate(glm::mat4(1.0f), glm::vec3(s, 0.0f, 0.0f));
+    bone.restLocal =
+        b == 0 ? glm::mat4(1.0f) : glm::translate(glm::mat4(1.0f), glm::vec3(s, 0.0f, 0.0f));
     bone.inverseBind =
         glm::translate(glm::mat4(1.0f), glm::vec3(-s * static_cast<float>(b), 0.0f, 0.0f));
     f.skeleton.bones.push_back(bone);
@@ -85,7 +85,8 @@ ArticulatedFigure makeArticulatedFigure(const FigureShape& shape) {
         if (outsideRight) borderB.push_back(ring(r, a));
       }
     }
-    const Result<std::vector<float>> weights = pathLengthWeights(f.mesh, inRegion, borderA, borderB);
+    const Result<std::vector<float>> weights =
+        pathLengthWeights(f.mesh, inRegion, borderA, borderB);
     if (!weights.ok()) throw std::runtime_error(weights.status().toString());
     for (std::uint32_t v = 0; v < n; ++v) {
       if (inRegion[v]) f.skin[v] = {joint - 1, joint, (*weights)[v]};
@@ -107,9 +108,8 @@ ArticulatedFigure makeArticulatedFigure(const FigureShape& shape) {
   root.positions = {{0.0, glm::vec3(0.0f)},
                     {1.0, glm::vec3(travel, 0.4f * travel, 0.0f)},
                     {2.0, glm::vec3(0.0f)}};
-  root.rotations = {{0.0, glm::quat(1, 0, 0, 0)},
-                    {1.2, about(40.0f, {1, 0, 0})},
-                    {2.0, glm::quat(1, 0, 0, 0)}};
+  root.rotations = {
+      {0.0, glm::quat(1, 0, 0, 0)}, {1.2, about(40.0f, {1, 0, 0})}, {2.0, glm::quat(1, 0, 0, 0)}};
   BoneChannel elbow;
   elbow.bone = 1;
   elbow.rotations = {{0.0, glm::quat(1, 0, 0, 0)},

@@ -27,8 +27,8 @@ struct FigureShape {
   int ringsPerUnit = 20;  // rings of vertices per unit of length
   int around = 24;        // vertices per ring
   float radius = 0.25f;
-  float joint = 0.25f;    // half length of a joint's deformable region
-  float scale = 1.0f;     // every length (mesh, bones, clip translations) times this
+  float joint = 0.25f;        // half length of a joint's deformable region
+  float scale = 1.0f;         // every length (mesh, bones, clip translations) times this
   float bendDegrees = 70.0f;  // the joints' largest bend
   float rootTravel = 0.5f;    // the root's largest translation (before scale)
 };

@@ -35,14 +35,13 @@ ProgressiveMesh buildPm(const IndexedMesh& mesh) {
 }
 
 std::vector<glm::vec3> deformed(const std::vector<glm::vec3>& positions,
-                                const std::vector<VertexSkin>& skin,
-                                const anim::Skeleton& skeleton, const anim::AnimationClip& clip,
-                                double t) {
+                                const std::vector<VertexSkin>& skin, const anim::Skeleton& skeleton,
+                                const anim::AnimationClip& clip, double t) {
   std::vector<glm::vec3> out(positions.size());
-  anim::deform(positions, skin,
-               anim::skinningMatrices(skeleton,
-                                      anim::samplePose(skeleton, clip, t, ClipWrap::kLoop)),
-               {}, out);
+  anim::deform(
+      positions, skin,
+      anim::skinningMatrices(skeleton, anim::samplePose(skeleton, clip, t, ClipWrap::kLoop)), {},
+      out);
   return out;
 }
 
@@ -162,8 +161,7 @@ void expectBoundCoversDensePoses(const IndexedMesh& full, const std::vector<Vert
                                  const ProgressiveMesh& pm, const std::vector<VertexSkin>& skin,
                                  double fraction, const AnimatedErrorOptions& options,
                                  const std::string& what) {
-  const auto target =
-      static_cast<std::size_t>(fraction * static_cast<double>(pm.maxTriangles()));
+  const auto target = static_cast<std::size_t>(fraction * static_cast<double>(pm.maxTriangles()));
   const IndexedMesh level = pm.extract(target);
   Result<AnimatedLevelError> bound =
       deformedLevelBound(full, fullSkin, skeleton, clip, level, skin, options);
@@ -178,10 +176,9 @@ void expectBoundCoversDensePoses(const IndexedMesh& full, const std::vector<Vert
                                   4 * bound->poses, options.surface);
   EXPECT_GE(bound->bound, dense) << what << ": " << bound->poses << " poses";
   if (bound->converged) {
-    EXPECT_LE(bound->bound,
-              std::max((1.0 + options.relativeTolerance) * bound->maxAtPoses,
-                       options.absoluteTolerance * bound->diagonal) *
-                  (1.0 + 1e-12))
+    EXPECT_LE(bound->bound, std::max((1.0 + options.relativeTolerance) * bound->maxAtPoses,
+                                     options.absoluteTolerance * bound->diagonal) *
+                                (1.0 + 1e-12))
         << what;
   }
 }
@@ -211,8 +208,7 @@ TEST(SkinnedLevel, BoundCoversDensePosesOnTestwuson) {
   options.surface.samplesPerMesh = 1000;  // + every vertex and edge points
   for (const double fraction : {0.5, 0.1}) {
     expectBoundCoversDensePoses(model->mesh, model->skin, model->skeleton, model->clips[0], pm,
-                                *skin, fraction, options,
-                                "Testwuson " + std::to_string(fraction));
+                                *skin, fraction, options, "Testwuson " + std::to_string(fraction));
   }
 }
 
@@ -229,8 +225,8 @@ TEST(SkinnedLevel, RandomFiguresAtExtremeMagnitudes) {
     shape.bendDegrees = 170.0f * unit(random);
     shape.rootTravel = 3.0f * unit(random);
     const ArticulatedFigure f = makeArticulatedFigure(shape);
-    const std::string what = "trial " + std::to_string(trial) + " scale " +
-                             std::to_string(shape.scale);
+    const std::string what =
+        "trial " + std::to_string(trial) + " scale " + std::to_string(shape.scale);
     ASSERT_TRUE(f.clip.validate(f.skeleton, what).ok());
     const ProgressiveMesh pm = buildPm(f.mesh);
     Result<std::vector<VertexSkin>> skin = tomSkin(pm, f.mesh, f.skin, 3);

@@ -129,8 +129,8 @@ double relativeMotion(const MotionFrame& frame, const std::vector<glm::vec3>& no
                       const std::vector<glm::vec3>& then) {
   double worst = 0.0;
   for (std::size_t v = 0; v < now.size(); ++v) {
-    const glm::dvec3 d = glm::dvec3(frame.inverse * glm::dvec4(glm::dvec3(now[v]), 1.0)) -
-                         glm::dvec3(then[v]);
+    const glm::dvec3 d =
+        glm::dvec3(frame.inverse * glm::dvec4(glm::dvec3(now[v]), 1.0)) - glm::dvec3(then[v]);
     worst = std::max(worst, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
   }
   return worst;
@@ -227,9 +227,10 @@ Result<std::vector<VertexSkin>> tomSkin(const ProgressiveMesh& pm, const Indexed
   return skin;
 }
 
-Result<double> deformedLevelErrorAt(const IndexedMesh& full, const std::vector<VertexSkin>& fullSkin,
-                                    const anim::Skeleton& skeleton,
-                                    const anim::AnimationClip& clip, const IndexedMesh& level,
+Result<double> deformedLevelErrorAt(const IndexedMesh& full,
+                                    const std::vector<VertexSkin>& fullSkin,
+                                    const anim::Skeleton& skeleton, const anim::AnimationClip& clip,
+                                    const IndexedMesh& level,
                                     const std::vector<VertexSkin>& levelSkin, double seconds,
                                     anim::ClipWrap wrap, const SurfaceErrorOptions& surface) {
   if (Status s = checkInputs(full, fullSkin, skeleton, clip, level, levelSkin); !s.ok()) return s;
@@ -250,13 +251,10 @@ Result<double> deformedLevelErrorAt(const IndexedMesh& full, const std::vector<V
   return error->max();
 }
 
-Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
-                                              const std::vector<VertexSkin>& fullSkin,
-                                              const anim::Skeleton& skeleton,
-                                              const anim::AnimationClip& clip,
-                                              const IndexedMesh& level,
-                                              const std::vector<VertexSkin>& levelSkin,
-                                              const AnimatedErrorOptions& options) {
+Result<AnimatedLevelError> deformedLevelBound(
+    const IndexedMesh& full, const std::vector<VertexSkin>& fullSkin,
+    const anim::Skeleton& skeleton, const anim::AnimationClip& clip, const IndexedMesh& level,
+    const std::vector<VertexSkin>& levelSkin, const AnimatedErrorOptions& options) {
   if (Status s = checkInputs(full, fullSkin, skeleton, clip, level, levelSkin); !s.ok()) return s;
   const double t0 = options.t0;
   const double t1 = options.t1 < 0.0 ? clip.duration : options.t1;
@@ -278,9 +276,8 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
   result.fullVertices = full.vertexCount();
   result.diagonal = full.diameter();
   {
-    Result<SurfaceError> rest =
-        measureSurfaceError(geometry(full, full.positions), geometry(level, level.positions),
-                            options.surface);
+    Result<SurfaceError> rest = measureSurfaceError(
+        geometry(full, full.positions), geometry(level, level.positions), options.surface);
     if (!rest.ok()) return rest.status();
     result.restError = rest->max();
   }
@@ -342,9 +339,9 @@ Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
 
   const std::size_t initial = t1 > t0 ? options.initialPoses : 1;
   for (std::size_t i = 0; i < initial; ++i) {
-    const double t = initial == 1 ? t0
-                                  : t0 + (t1 - t0) * static_cast<double>(i) /
-                                             static_cast<double>(initial - 1);
+    const double t =
+        initial == 1 ? t0
+                     : t0 + (t1 - t0) * static_cast<double>(i) / static_cast<double>(initial - 1);
     if (Result<double> e = measure(i + 1 == initial ? t1 : t); !e.ok()) return e.status();
   }
 

@@ -62,14 +62,14 @@ struct AnimatedErrorOptions {
 };
 
 struct AnimatedLevelError {
-  double bound = 0.0;          // mesh units: covers every time of the window (see contract)
-  double maxAtPoses = 0.0;     // the largest measured error at a pose
-  double worstTime = 0.0;      // the pose of maxAtPoses
-  double restError = 0.0;      // undeformed level vs undeformed full mesh (measured)
-  double diagonal = 0.0;       // the full mesh's rest bbox diagonal
-  std::size_t poses = 0;       // measured poses
-  bool converged = true;       // bound <= max((1 + tol) * maxAtPoses, absolute)
-  bool identical = false;      // the level is the full mesh's surface: 0, proven
+  double bound = 0.0;             // mesh units: covers every time of the window (see contract)
+  double maxAtPoses = 0.0;        // the largest measured error at a pose
+  double worstTime = 0.0;         // the pose of maxAtPoses
+  double restError = 0.0;         // undeformed level vs undeformed full mesh (measured)
+  double diagonal = 0.0;          // the full mesh's rest bbox diagonal
+  std::size_t poses = 0;          // measured poses
+  bool converged = true;          // bound <= max((1 + tol) * maxAtPoses, absolute)
+  bool identical = false;         // the level is the full mesh's surface: 0, proven
   std::size_t levelVertices = 0;  // vertices deformed per frame for the level
   std::size_t fullVertices = 0;   // ... for the full mesh
   std::vector<double> poseTimes;  // measured poses, ascending
@@ -78,23 +78,20 @@ struct AnimatedLevelError {
 
 // `level` is any level of `full` (e.g. pm.extract(n)) with `levelSkin` its
 // vertices' skins (tomSkin(pm, ...): the first level.vertexCount() entries).
-Result<AnimatedLevelError> deformedLevelBound(const IndexedMesh& full,
-                                              const std::vector<anim::VertexSkin>& fullSkin,
-                                              const anim::Skeleton& skeleton,
-                                              const anim::AnimationClip& clip,
-                                              const IndexedMesh& level,
-                                              const std::vector<anim::VertexSkin>& levelSkin,
-                                              const AnimatedErrorOptions& options = {});
+Result<AnimatedLevelError> deformedLevelBound(
+    const IndexedMesh& full, const std::vector<anim::VertexSkin>& fullSkin,
+    const anim::Skeleton& skeleton, const anim::AnimationClip& clip, const IndexedMesh& level,
+    const std::vector<anim::VertexSkin>& levelSkin, const AnimatedErrorOptions& options = {});
 
 // The error of `level` at one pose (time `seconds` of the clip), measured
 // with measureSurfaceError between the deformed meshes; same checks as
 // deformedLevelBound. The tests' and the report's reference.
 Result<double> deformedLevelErrorAt(const IndexedMesh& full,
                                     const std::vector<anim::VertexSkin>& fullSkin,
-                                    const anim::Skeleton& skeleton,
-                                    const anim::AnimationClip& clip, const IndexedMesh& level,
-                                    const std::vector<anim::VertexSkin>& levelSkin,
-                                    double seconds, anim::ClipWrap wrap,
+                                    const anim::Skeleton& skeleton, const anim::AnimationClip& clip,
+                                    const IndexedMesh& level,
+                                    const std::vector<anim::VertexSkin>& levelSkin, double seconds,
+                                    anim::ClipWrap wrap,
                                     const SurfaceErrorOptions& surface = {20000, 1, true});
 
 }  // namespace thinlod::simplifier
