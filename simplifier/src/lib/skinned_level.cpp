@@ -102,202 +102,52 @@ double spectralNormBound(const glm::dmat3& l) {
 }
 
 // Frames of the candidate bones between the poses with skinning matrices
-// `from` and `to`: R_b = to_b * from_b^-1, frames[i + 1] for bones[i];
-// frames[0] is the identity. Singular or non-finite ones are not `valid`.
-struct CandidateFrame {
-  MotionFrame frame;
-  bool valid = true;
-};
-std::vector<CandidateFrame> motionFrames(const std::vector<glm::mat4>& from,
-                                         const std::vector<glm::mat4>& to,
-                                         const std::vector<std::uint32_t>& bones) {
-  std::vector<CandidateFrame> frames(bones.size() + 1);
-  for (std::size_t i = 0; i < bones.size(); ++i) {
-    const std::uint32_t b = bones[i];
-    CandidateFrame& c = frames[i + 1];
+// `from` and `to`: R_b = to_b * from_b^-1. Singular or non-finite ones are left
+// out; the identity is always a candidate.
+std::vector<MotionFrame> motionFrames(const std::vector<glm::mat4>& from,
+                                      const std::vector<glm::mat4>& to,
+                                      const std::vector<std::uint32_t>& bones) {
+  std::vector<MotionFrame> frames(1);
+  for (const std::uint32_t b : bones) {
     const glm::dmat4 r = glm::dmat4(to[b]) * glm::inverse(glm::dmat4(from[b]));
     const glm::dmat3 linear(r);
-    if (!(std::abs(glm::determinant(linear)) > 1e-12)) {
-      c.valid = false;
-      continue;
+    if (!(std::abs(glm::determinant(linear)) > 1e-12)) continue;
+    MotionFrame frame;
+    frame.inverse = glm::inverse(r);
+    frame.norm = spectralNormBound(linear);
+    bool finite = std::isfinite(frame.norm);
+    for (int c = 0; c < 4; ++c) {
+      for (int k = 0; k < 4; ++k) finite = finite && std::isfinite(frame.inverse[c][k]);
     }
-    c.frame.inverse = glm::inverse(r);
-    c.frame.norm = spectralNormBound(linear);
-    bool finite = std::isfinite(c.frame.norm);
-    for (int col = 0; col < 4; ++col) {
-      for (int k = 0; k < 4; ++k) finite = finite && std::isfinite(c.frame.inverse[col][k]);
-    }
-    c.valid = finite;
+    if (finite) frames.push_back(frame);
   }
   return frames;
 }
 
-// |R^-1 now_v - then_v| for every vertex.
-std::vector<double> residuals(const MotionFrame& frame, const std::vector<glm::vec3>& now,
-                              const std::vector<glm::vec3>& then) {
-  std::vector<double> out(now.size());
+// max_v |R^-1 now_v - then_v|.
+double relativeMotion(const MotionFrame& frame, const std::vector<glm::vec3>& now,
+                      const std::vector<glm::vec3>& then) {
+  double worst = 0.0;
   for (std::size_t v = 0; v < now.size(); ++v) {
     const glm::dvec3 d =
         glm::dvec3(frame.inverse * glm::dvec4(glm::dvec3(now[v]), 1.0)) - glm::dvec3(then[v]);
-    out[v] = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    worst = std::max(worst, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
   }
-  return out;
+  return worst;
 }
 
-// For every triangle of `mesh` (corners `corners`), the vertices of
-// `others` inside the triangle's bounding box grown by `radius` (CSR).
-struct Neighbourhoods {
-  std::vector<std::size_t> begin;  // per triangle, and one past the last
-  std::vector<std::uint32_t> vertices;
-};
-Neighbourhoods neighbourhoods(const IndexedMesh& mesh, const std::vector<glm::vec3>& corners,
-                              const std::vector<glm::vec3>& others, double radius) {
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
-  for (const glm::vec3& p : others) {
-    lo = glm::min(lo, glm::dvec3(p));
-    hi = glm::max(hi, glm::dvec3(p));
+// The best frame's bound from one measured pose: min over frames of
+// ||L|| * (e + motion of the level + motion of the full mesh).
+double boundFrom(double error, const std::vector<MotionFrame>& frames,
+                 const std::vector<glm::vec3>& levelNow, const std::vector<glm::vec3>& levelThen,
+                 const std::vector<glm::vec3>& fullNow, const std::vector<glm::vec3>& fullThen) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const MotionFrame& frame : frames) {
+    const double b = frame.norm * (error + relativeMotion(frame, levelNow, levelThen) +
+                                   relativeMotion(frame, fullNow, fullThen));
+    best = std::min(best, b);
   }
-  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 0.0});
-  // Cells of about the radius, at most 64 per axis.
-  const double cell = std::max({radius, extent / 64.0, std::numeric_limits<double>::min()});
-  const auto cellOf = [&](double x, double origin) {
-    return static_cast<std::int64_t>(std::clamp(std::floor((x - origin) / cell), 0.0, 64.0));
-  };
-  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return (x * 65 + y) * 65 + z;
-  };
-  std::map<std::int64_t, std::vector<std::uint32_t>> grid;
-  for (std::uint32_t v = 0; v < others.size(); ++v) {
-    const glm::dvec3 p(others[v]);
-    grid[key(cellOf(p.x, lo.x), cellOf(p.y, lo.y), cellOf(p.z, lo.z))].push_back(v);
-  }
-  Neighbourhoods out;
-  out.begin.reserve(mesh.triangleCount() + 1);
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    out.begin.push_back(out.vertices.size());
-    glm::dvec3 a(corners[mesh.indices[t]]), b(a);
-    for (int k = 1; k < 3; ++k) {
-      a = glm::min(a, glm::dvec3(corners[mesh.indices[t + static_cast<std::size_t>(k)]]));
-      b = glm::max(b, glm::dvec3(corners[mesh.indices[t + static_cast<std::size_t>(k)]]));
-    }
-    a -= glm::dvec3(radius);
-    b += glm::dvec3(radius);
-    for (std::int64_t x = cellOf(a.x, lo.x); x <= cellOf(b.x, lo.x); ++x) {
-      for (std::int64_t y = cellOf(a.y, lo.y); y <= cellOf(b.y, lo.y); ++y) {
-        for (std::int64_t z = cellOf(a.z, lo.z); z <= cellOf(b.z, lo.z); ++z) {
-          const auto it = grid.find(key(x, y, z));
-          if (it == grid.end()) continue;
-          for (const std::uint32_t v : it->second) {
-            const glm::dvec3 p(others[v]);
-            if (p.x >= a.x && p.y >= a.y && p.z >= a.z && p.x <= b.x && p.y <= b.y && p.z <= b.z) {
-              out.vertices.push_back(v);
-            }
-          }
-        }
-      }
-    }
-  }
-  out.begin.push_back(out.vertices.size());
-  return out;
-}
-
-double longestEdge(const IndexedMesh& mesh, const std::vector<glm::vec3>& positions) {
-  double longest = 0.0;
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    for (int k = 0; k < 3; ++k) {
-      const glm::dvec3 d =
-          glm::dvec3(positions[mesh.indices[t + static_cast<std::size_t>(k)]]) -
-          glm::dvec3(positions[mesh.indices[t + static_cast<std::size_t>((k + 1) % 3)]]);
-      longest = std::max(longest, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
-    }
-  }
-  return longest;
-}
-
-// The cover from one measured pose a (error e) to a time t, two ways; the
-// smaller one holds.
-// - Global: one frame for everything, min over the frames of
-//   ||R|| (e + max residual over the level + max residual over the full mesh).
-// - Local: a point p of level triangle T has its closest point at a on some
-//   full triangle whose corners lie in T's box grown by e + the full mesh's
-//   longest edge (N(T)); the frame may differ per triangle, so the forward
-//   term is max over T of min over T's bones' frames (and the identity) of
-//   ||R|| (e + max residual over T's corners + max over N(T)); the backward
-//   term the same from the full mesh's triangles to the level's vertices.
-//   A triangle whose grown box holds no vertex (e was sampled short) takes
-//   the other mesh's largest residual instead.
-struct SideAtPose {
-  std::vector<glm::vec3> level, full;  // deformed at pose a
-  double error = 0.0;
-  Neighbourhoods fullNearLevel, levelNearFull;
-};
-
-double coverFrom(const SideAtPose& side, const std::vector<CandidateFrame>& frames,
-                 const std::vector<int>& frameOfBone, const IndexedMesh& levelMesh,
-                 const std::vector<VertexSkin>& levelSkin, const IndexedMesh& fullMesh,
-                 const std::vector<VertexSkin>& fullSkin, const std::vector<glm::vec3>& levelNow,
-                 const std::vector<glm::vec3>& fullNow) {
-  std::vector<std::vector<double>> resLevel(frames.size()), resFull(frames.size());
-  std::vector<double> maxLevel(frames.size(), 0.0), maxFull(frames.size(), 0.0);
-  double global = std::numeric_limits<double>::infinity();
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    if (!frames[f].valid) continue;
-    resLevel[f] = residuals(frames[f].frame, levelNow, side.level);
-    resFull[f] = residuals(frames[f].frame, fullNow, side.full);
-    for (const double r : resLevel[f]) maxLevel[f] = std::max(maxLevel[f], r);
-    for (const double r : resFull[f]) maxFull[f] = std::max(maxFull[f], r);
-    global = std::min(global, frames[f].frame.norm * (side.error + maxLevel[f] + maxFull[f]));
-  }
-  // One direction of the local cover: triangles of `mesh` against the
-  // vertices of the other mesh near them.
-  const auto direction = [&](const IndexedMesh& mesh, const std::vector<VertexSkin>& skin,
-                             const std::vector<std::vector<double>>& own,
-                             const std::vector<std::vector<double>>& other,
-                             const std::vector<double>& otherMax, const Neighbourhoods& near) {
-    double worst = 0.0;
-    std::array<int, 7> candidates{};
-    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
-      std::size_t count = 0;
-      candidates[count++] = 0;
-      for (int k = 0; k < 3; ++k) {
-        const VertexSkin& s = skin[mesh.indices[3 * t + static_cast<std::size_t>(k)]];
-        for (const std::uint32_t bone : {s.boneA, s.rigid() ? s.boneA : s.boneB}) {
-          const int f = frameOfBone[bone];
-          if (f < 0 || !frames[static_cast<std::size_t>(f)].valid) continue;
-          if (std::find(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(count),
-                        f) == candidates.begin() + static_cast<std::ptrdiff_t>(count)) {
-            candidates[count++] = f;
-          }
-        }
-      }
-      double best = std::numeric_limits<double>::infinity();
-      for (std::size_t c = 0; c < count; ++c) {
-        const auto f = static_cast<std::size_t>(candidates[c]);
-        double corners = 0.0;
-        for (int k = 0; k < 3; ++k) {
-          corners = std::max(corners, own[f][mesh.indices[3 * t + static_cast<std::size_t>(k)]]);
-        }
-        double around = 0.0;
-        if (near.begin[t] == near.begin[t + 1]) {
-          around = otherMax[f];
-        } else {
-          for (std::size_t i = near.begin[t]; i < near.begin[t + 1]; ++i) {
-            around = std::max(around, other[f][near.vertices[i]]);
-          }
-        }
-        best = std::min(best, frames[f].frame.norm * (side.error + corners + around));
-        if (best <= side.error) break;
-      }
-      worst = std::max(worst, best);
-    }
-    return worst;
-  };
-  if (!frames[0].valid) return global;
-  const double forward =
-      direction(levelMesh, levelSkin, resLevel, resFull, maxFull, side.fullNearLevel);
-  const double backward =
-      direction(fullMesh, fullSkin, resFull, resLevel, maxLevel, side.levelNearFull);
-  return std::min(global, std::max(forward, backward));
+  return best;
 }
 
 // Positions and triangles only: deformed normals and uvs are not what is
@@ -465,39 +315,23 @@ Result<AnimatedLevelError> deformedLevelBound(
     return error->max();
   };
 
-  std::vector<int> frameOfBone(skeleton.bones.size(), -1);
-  for (std::size_t i = 0; i < skinBones.size(); ++i) {
-    frameOfBone[skinBones[i]] = static_cast<int>(i + 1);
-  }
-  const auto sideAt = [&](double t, double e, const std::vector<glm::mat4>& matrices,
-                          SideAtPose& side) -> Status {
-    if (Status s = deformBoth(matrices, t, side.full, side.level); !s.ok()) return s;
-    side.error = e;
-    side.fullNearLevel =
-        neighbourhoods(level, side.level, side.full, e + longestEdge(full, side.full));
-    side.levelNearFull =
-        neighbourhoods(full, side.full, side.level, e + longestEdge(level, side.level));
-    return Status::okStatus();
-  };
-
   // The cover of [a, b]: max over substeps of the smaller bound from either
   // end (the ends themselves: their measured errors).
-  SideAtPose sideA, sideB;
-  std::vector<glm::vec3> fullT, levelT;
+  std::vector<glm::vec3> fullA, levelA, fullB, levelB, fullT, levelT;
   const auto cover = [&](double a, double ea, double b, double eb) -> Result<double> {
     const std::vector<glm::mat4> matricesA = poser.matrices(a), matricesB = poser.matrices(b);
-    if (Status s = sideAt(a, ea, matricesA, sideA); !s.ok()) return s;
-    if (Status s = sideAt(b, eb, matricesB, sideB); !s.ok()) return s;
+    if (Status s = deformBoth(matricesA, a, fullA, levelA); !s.ok()) return s;
+    if (Status s = deformBoth(matricesB, b, fullB, levelB); !s.ok()) return s;
     double worst = std::max(ea, eb);
     const double parts = static_cast<double>(options.motionSteps + 1);
     for (std::size_t k = 1; k <= options.motionSteps; ++k) {
       const double t = a + (b - a) * static_cast<double>(k) / parts;
       const std::vector<glm::mat4> matricesT = poser.matrices(t);
       if (Status s = deformBoth(matricesT, t, fullT, levelT); !s.ok()) return s;
-      const double fromA = coverFrom(sideA, motionFrames(matricesA, matricesT, skinBones),
-                                     frameOfBone, level, levelSkin, full, fullSkin, levelT, fullT);
-      const double fromB = coverFrom(sideB, motionFrames(matricesB, matricesT, skinBones),
-                                     frameOfBone, level, levelSkin, full, fullSkin, levelT, fullT);
+      const double fromA = boundFrom(ea, motionFrames(matricesA, matricesT, skinBones), levelT,
+                                     levelA, fullT, fullA);
+      const double fromB = boundFrom(eb, motionFrames(matricesB, matricesT, skinBones), levelT,
+                                     levelB, fullT, fullB);
       worst = std::max(worst, std::min(fromA, fromB));
     }
     return worst;
