@@ -212,6 +212,26 @@ TEST(SkinnedLevel, BoundCoversDensePosesOnTestwuson) {
   }
 }
 
+TEST(SkinnedLevel, AWindowOfOneInstantIsThatPosesError) {
+  const ArticulatedFigure f = makeArticulatedFigure({6, 8});
+  const ProgressiveMesh pm = buildPm(f.mesh);
+  const std::vector<VertexSkin> skin = *tomSkin(pm, f.mesh, f.skin, 3);
+  const IndexedMesh level = pm.extract(pm.maxTriangles() / 4);
+  AnimatedErrorOptions options = testOptions();
+  options.t0 = options.t1 = 0.9;
+  Result<AnimatedLevelError> bound =
+      deformedLevelBound(f.mesh, f.skin, f.skeleton, f.clip, level, skin, options);
+  ASSERT_TRUE(bound.ok()) << bound.status().toString();
+  EXPECT_EQ(bound->poses, 1u);
+  Result<double> direct = deformedLevelErrorAt(f.mesh, f.skin, f.skeleton, f.clip, level, skin,
+                                               0.9, ClipWrap::kLoop, options.surface);
+  ASSERT_TRUE(direct.ok());
+  EXPECT_GT(*direct, 0.0);
+  EXPECT_EQ(bound->bound, *direct);
+  EXPECT_EQ(bound->maxAtPoses, *direct);
+  EXPECT_EQ(bound->worstTime, 0.9);
+}
+
 TEST(SkinnedLevel, RandomFiguresAtExtremeMagnitudes) {
   std::mt19937 random(18);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
