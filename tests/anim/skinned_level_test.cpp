@@ -206,7 +206,7 @@ TEST(SkinnedLevel, BoundCoversDensePosesOnTestwuson) {
   ASSERT_TRUE(skin.ok()) << skin.status().toString();
   AnimatedErrorOptions options = testOptions();
   options.surface.samplesPerMesh = 1000;  // + every vertex and edge points
-  options.maxPoses = 9;  // under the sanitizers this test is the subset's slowest
+  options.maxPoses = 9;                   // under the sanitizers this test is the subset's slowest
   for (const double fraction : {0.5, 0.1}) {
     expectBoundCoversDensePoses(model->mesh, model->skin, model->skeleton, model->clips[0], pm,
                                 *skin, fraction, options, "Testwuson " + std::to_string(fraction));
@@ -224,8 +224,8 @@ TEST(SkinnedLevel, AWindowOfOneInstantIsThatPosesError) {
       deformedLevelBound(f.mesh, f.skin, f.skeleton, f.clip, level, skin, options);
   ASSERT_TRUE(bound.ok()) << bound.status().toString();
   EXPECT_EQ(bound->poses, 1u);
-  Result<double> direct = deformedLevelErrorAt(f.mesh, f.skin, f.skeleton, f.clip, level, skin,
-                                               0.9, ClipWrap::kLoop, options.surface);
+  Result<double> direct = deformedLevelErrorAt(f.mesh, f.skin, f.skeleton, f.clip, level, skin, 0.9,
+                                               ClipWrap::kLoop, options.surface);
   ASSERT_TRUE(direct.ok());
   EXPECT_GT(*direct, 0.0);
   EXPECT_EQ(bound->bound, *direct);
