@@ -14,13 +14,23 @@
 // and for meshed the displacement of depth-mesh vertices on the same texel.
 // The error curve is measured once per model (service curve options) and
 // cached in MeshCurveCache::defaultDirectory().
+// Kinds service-simple / service-meshed: the daemon's own path,
+// SimplifierService::renderImpostor on a one-object scene of the model
+// (level choice, framing, capture, depth-mesh Draco encode; texture codec
+// raw, so no PNG encode), same eye, in the same run; `extra` holds the reply's
+// credited accuracy and the thread CPU ms per call.
 // (cpu_ms: process CPU time per call, all llvmpipe threads included; less
-// sensitive than wall time to other processes competing for the 2 cores).
+// sensitive than wall time to other processes competing for the 2 cores.
+// thread_ms in `extra`: the calling thread's CPU time only.)
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <glm/geometric.hpp>
 #include <map>
 #include <string>
@@ -28,6 +38,8 @@
 #include <vector>
 
 #include "thinlod/common/mesh/mesh_io.h"
+#include "thinlod/common/scene/scene_objects.h"
+#include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/simplifier/impostor.h"
 #include "thinlod/simplifier/impostor_level.h"
@@ -41,12 +53,12 @@ using namespace thinlod::simplifier;
 namespace {
 
 struct Summary {
-  double median = 0, min = 0, p90 = 0, cpu = 0;
+  double median = 0, min = 0, p90 = 0, cpu = 0, thread = 0;
 };
 
-double cpuMs() {
+double cpuMs(clockid_t clock = CLOCK_PROCESS_CPUTIME_ID) {
   timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  clock_gettime(clock, &t);
   return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
 }
 
@@ -64,6 +76,7 @@ Summary timeIt(int repetitions, F&& body) {
   std::vector<double> samples;
   body();  // warm-up: shader compile, first upload, target allocation
   const double cpuStart = cpuMs();
+  const double threadStart = cpuMs(CLOCK_THREAD_CPUTIME_ID);
   for (int i = 0; i < repetitions; ++i) {
     const auto start = std::chrono::steady_clock::now();
     body();
@@ -73,6 +86,7 @@ Summary timeIt(int repetitions, F&& body) {
   }
   Summary s = summarize(samples);
   s.cpu = (cpuMs() - cpuStart) / repetitions;
+  s.thread = (cpuMs(CLOCK_THREAD_CPUTIME_ID) - threadStart) / repetitions;
   return s;
 }
 
@@ -158,6 +172,55 @@ ChosenLevel chooseLevel(const IndexedMesh& mesh, const glm::vec3& eye) {
   return chosen;
 }
 
+// The daemon's path for `file`: a service whose default scene holds the
+// model alone (untransformed, so the same eye frames it the same way), its
+// curves cached where chooseLevel keeps them.
+struct ServiceCase {
+  std::filesystem::path directory;
+  std::unique_ptr<SimplifierService> service;
+  std::uint64_t objectId = 0;
+};
+ServiceCase serviceFor(const std::string& models, const std::string& file,
+                       render::Backend backend) {
+  ServiceCase c;
+  c.directory = std::filesystem::temp_directory_path() /
+                ("bench_impostor_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(c.directory);
+  const std::filesystem::path scenePath = c.directory / (file + ".wrl");
+  {
+    std::ofstream out(scenePath);
+    out << "#VRML V2.0 utf8\n"
+           "DirectionalLight { direction -0.3 -0.5 -1.0 }\n"
+           "Shape { appearance Appearance { material Material { diffuseColor 0.8 0.8 0.8 } }\n"
+           "  geometry Inline { url \""
+        << file << "\" } }\n";
+  }
+  scene::SceneLoadOptions load;
+  load.meshSearchPaths = {models};
+  Result<scene::Scene> loaded = scene::loadSceneFile(scenePath.string(), load);
+  Result<std::vector<scene::SceneObject>> objects =
+      loaded.ok() ? scene::collectSceneObjects(*loaded)
+                  : Result<std::vector<scene::SceneObject>>(loaded.status());
+  if (!objects.ok() || objects->size() != 1) {
+    std::fprintf(stderr, "service scene %s: %s\n", scenePath.c_str(),
+                 objects.ok() ? "not one object" : objects.status().toString().c_str());
+    std::exit(1);
+  }
+  c.objectId = objects->front().id;
+  ServiceOptions options;
+  options.modelSearchPaths = {models};
+  options.sceneRoot = c.directory.string();
+  options.defaultScenePath = scenePath.string();
+  options.curveCacheDir = MeshCurveCache::defaultDirectory().string();
+  options.backend = backend;
+  c.service = std::make_unique<SimplifierService>(options);
+  if (Status st = c.service->initializeRendering(); !st.ok()) {
+    std::fprintf(stderr, "service rendering: %s\n", st.toString().c_str());
+    std::exit(1);
+  }
+  return c;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -230,9 +293,9 @@ int main(int argc, char** argv) {
       });
       // Checked after timing: the object is there and the range contains the eye.
       if (simple.coverage <= 0.01) return 1;
-      std::printf("%s,%s,%zu,simple,256,%.3f,%.3f,%.3f,%.3f,%.3f,alpha=%.4frad\n", name, file,
-                  triangles, s.median, s.min, s.p90, s.cpu, simple.coverage,
-                  simple.validity.alpha());
+      std::printf("%s,%s,%zu,simple,256,%.3f,%.3f,%.3f,%.3f,%.3f,alpha=%.4frad thread_ms=%.3f\n",
+                  name, file, triangles, s.median, s.min, s.p90, s.cpu, simple.coverage,
+                  simple.validity.alpha(), s.thread);
 
       MeshedImpostor meshed;
       const Summary m = timeIt(repetitions, [&] {
@@ -246,10 +309,12 @@ int main(int argc, char** argv) {
       const ImpostorTimings& t = (*impostors)->lastTimings();
       std::printf(
           "%s,%s,%zu,meshed,256,%.3f,%.3f,%.3f,%.3f,%.3f,tris=%zu render=%.2fms mesh=%.2fms "
-          "alpha=%.4frad err=%.2e\n",
+          "(grid=%.2f simplify=%.2f check=%.2f: draw=%.2f silhouette=%.2f depth_error=%.2f) "
+          "thread_ms=%.3f alpha=%.4frad err=%.2e\n",
           name, file, triangles, m.median, m.min, m.p90, m.cpu, meshed.coverage,
-          meshed.mesh.triangleCount(), t.renderMs, t.meshMs, meshed.validity.alpha(),
-          meshed.meshDepthError);
+          meshed.mesh.triangleCount(), t.renderMs, t.meshMs, t.gridMs, t.simplifyMs, t.checkMs,
+          t.checkDrawMs, t.checkSilhouetteMs, t.checkDepthErrorMs, m.thread,
+          meshed.validity.alpha(), meshed.meshDepthError);
 
       // The same captures from the chosen level (GPU copy cached by the renderer).
       if (levels.find(file) == levels.end()) levels[file] = chooseLevel(*part.mesh, eye);
@@ -267,9 +332,10 @@ int main(int argc, char** argv) {
         simpleLevel = std::move(result).value();
       });
       std::printf(
-          "%s,%s,%zu,simple-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,level_error=%.3e "
+          "%s,%s,%zu,simple-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,thread_ms=%.3f level_error=%.3e "
           "tolerance=%.3e level_error_texels=%.3f %s\n",
           name, file, levelTriangles, sl.median, sl.min, sl.p90, sl.cpu, simpleLevel.coverage,
+          sl.thread,
           chosen.error, chosen.tolerance,
           chosen.tolerance > 0 ? chosen.error / chosen.tolerance : 0.0,
           differenceText(simple.texture, simpleLevel.texture).c_str());
@@ -286,13 +352,50 @@ int main(int argc, char** argv) {
       const Displacement moved = vertexDisplacement(meshed.mesh, meshedLevel.mesh, 256);
       std::printf(
           "%s,%s,%zu,meshed-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,render=%.2fms mesh=%.2fms "
-          "(grid=%.2f simplify=%.2f check=%.2f) tris=%zu %s "
+          "(grid=%.2f simplify=%.2f check=%.2f: draw=%.2f silhouette=%.2f depth_error=%.2f) "
+          "thread_ms=%.3f tris=%zu %s "
           "vertex_moved_max=%.3e p99=%.3e mean=%.3e matched=%zu/%zu radius=%.3e\n",
           name, file, levelTriangles, ml.median, ml.min, ml.p90, ml.cpu, meshedLevel.coverage,
-          tl.renderMs, tl.meshMs, tl.gridMs, tl.simplifyMs, tl.checkMs,
-          meshedLevel.mesh.triangleCount(),
+          tl.renderMs, tl.meshMs, tl.gridMs, tl.simplifyMs, tl.checkMs, tl.checkDrawMs,
+          tl.checkSilhouetteMs, tl.checkDepthErrorMs, ml.thread, meshedLevel.mesh.triangleCount(),
           differenceText(meshed.texture, meshedLevel.texture).c_str(), moved.max, moved.p99,
           moved.mean, moved.matched, moved.vertices, sphere.radius);
+
+      // The daemon's path (its own context; ours is made current again after).
+      ServiceCase service = serviceFor(models, file, backend);
+      for (auto kind : {protocol::RepresentationKind::kSimpleImpostor,
+                        protocol::RepresentationKind::kMeshedImpostor}) {
+        protocol::ImpostorRequest request;
+        request.requestId = 1;
+        request.objectIds = {service.objectId};
+        request.eye = eye;
+        request.textureWidth = request.textureHeight = 256;
+        request.kind = kind;
+        request.accuracyBound = ImpostorOptions().maxAngularError;
+        request.textureCodec = protocol::TextureCodec::kRawRgba8;
+        protocol::ImpostorResult reply;
+        const Summary r = timeIt(repetitions, [&] {
+          ++request.requestId;
+          reply = service.service->renderImpostor(request);
+          if (!reply.status.ok()) {
+            std::fprintf(stderr, "service: %s\n", reply.status.toString().c_str());
+            std::exit(1);
+          }
+        });
+        const bool meshedKind = kind == protocol::RepresentationKind::kMeshedImpostor;
+        std::printf("%s,%s,%zu,%s,256,%.3f,%.3f,%.3f,%.3f,,thread_ms=%.3f accuracy=%.1f "
+                    "tris=%u levels_extracted=%llu\n",
+                    name, file, triangles, meshedKind ? "service-meshed" : "service-simple",
+                    r.median, r.min, r.p90, r.cpu, r.thread, reply.representation.accuracy,
+                    reply.representation.triangleCount,
+                    static_cast<unsigned long long>(service.service->stats().impostorLevelsExtracted));
+      }
+      service.service.reset();
+      std::filesystem::remove_all(service.directory);
+      if (Status st = (*context)->makeCurrent(); !st.ok()) {
+        std::fprintf(stderr, "%s\n", st.toString().c_str());
+        return 1;
+      }
     }
     (*impostors).reset();
   }

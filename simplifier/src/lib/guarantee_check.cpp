@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace thinlod::simplifier {
@@ -93,6 +94,87 @@ std::vector<double> squaredDistanceTo(const CoverageMask& mask) {
   return grid;
 }
 
+// Largest squared distance from a pixel covered in `from` only to the nearest
+// covered pixel of `to` (non-empty), found by searching growing square rings
+// around each such pixel; nullopt once more than `budget` pixels were
+// visited. A ring of Chebyshev radius r holds no pixel nearer than r, so a
+// pixel's search ends when r * r reaches its best, or as soon as it finds a
+// pixel no farther than the largest distance found so far (that pixel can no
+// longer raise the maximum). Exact: squared distances are integers.
+std::optional<double> searchLargestSquaredDistance(const CoverageMask& from, const CoverageMask& to,
+                                                   std::size_t budget) {
+  const int w = from.width;
+  const int h = from.height;
+  const std::uint8_t* target = to.covered.data();
+  long long worst = 0;
+  std::size_t visited = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (from.covered[i] == 0 || target[i] != 0) continue;
+      long long best = std::numeric_limits<long long>::max();
+      auto consider = [&](int u, int v) {
+        if (target[static_cast<std::size_t>(v) * w + u] == 0) return;
+        const long long dx = u - x;
+        const long long dy = v - y;
+        best = std::min(best, dx * dx + dy * dy);
+      };
+      for (long long r = 1; r * r < best && best > worst; ++r) {
+        const int ri = static_cast<int>(r);
+        const int x0 = std::max(0, x - ri);
+        const int x1 = std::min(w - 1, x + ri);
+        const int y0 = std::max(0, y - ri + 1);
+        const int y1 = std::min(h - 1, y + ri - 1);
+        if (x - ri < 0 && x + ri >= w && y - ri < 0 && y + ri >= h) break;  // past every edge
+        if (y - ri >= 0) {
+          for (int u = x0; u <= x1; ++u) consider(u, y - ri);
+          visited += static_cast<std::size_t>(x1 - x0 + 1);
+        }
+        if (y + ri < h) {
+          for (int u = x0; u <= x1; ++u) consider(u, y + ri);
+          visited += static_cast<std::size_t>(x1 - x0 + 1);
+        }
+        if (y0 <= y1) {
+          if (x - ri >= 0) {
+            for (int v = y0; v <= y1; ++v) consider(x - ri, v);
+            visited += static_cast<std::size_t>(y1 - y0 + 1);
+          }
+          if (x + ri < w) {
+            for (int v = y0; v <= y1; ++v) consider(x + ri, v);
+            visited += static_cast<std::size_t>(y1 - y0 + 1);
+          }
+        }
+        if (visited > budget) return std::nullopt;
+      }
+      worst = std::max(worst, best);
+    }
+  }
+  return static_cast<double>(worst);
+}
+
+// Largest distance (pixels) from a pixel covered in `from` only to the
+// nearest covered pixel of `to`: 0 without such pixels, +infinity when `to`
+// is empty; the bounded search first, the full transform when it would visit
+// more than `budget` pixels (dense or distant differences).
+double largestDistance(const CoverageMask& from, const CoverageMask& to, std::size_t onlyInFrom,
+                       std::size_t inTo, std::size_t budget) {
+  if (onlyInFrom == 0) return 0.0;
+  if (inTo == 0) return kInf;
+  if (budget > 0) {
+    const std::optional<double> searched = searchLargestSquaredDistance(from, to, budget);
+    if (searched) return std::sqrt(*searched);
+  }
+  // Each transform is only computed when some pixel needs it (a meshed
+  // impostor's shown mask lies inside its capture's, so it never has extra
+  // pixels).
+  const std::vector<double> toTarget = squaredDistanceTo(to);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < toTarget.size(); ++i) {
+    if (from.covered[i] != 0 && to.covered[i] == 0) worst = std::max(worst, toTarget[i]);
+  }
+  return std::sqrt(worst);
+}
+
 }  // namespace
 
 std::size_t CoverageMask::coveredCount() const {
@@ -101,7 +183,8 @@ std::size_t CoverageMask::coveredCount() const {
 }
 
 Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
-                                              const CoverageMask& shown) {
+                                              const CoverageMask& shown,
+                                              double searchVisitsPerPixel) {
   auto sized = [](const CoverageMask& m) {
     return m.width > 0 && m.height > 0 &&
            m.covered.size() == static_cast<std::size_t>(m.width) * m.height;
@@ -116,32 +199,26 @@ Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
                       std::to_string(shown.covered.size()) + " values)");
   }
   SilhouetteDistance result;
-  // Each distance transform is only computed when some pixel needs it (a
-  // meshed impostor's shown mask lies inside its capture's, so it never has
-  // extra pixels: half the cost of its check, same result).
   const std::size_t n = reference.covered.size();
+  const double budgetVisits = searchVisitsPerPixel > 0.0 ? searchVisitsPerPixel * double(n) : 0.0;
+  const std::size_t searchBudget =
+      budgetVisits >= double(std::numeric_limits<std::size_t>::max() / 2)
+          ? std::numeric_limits<std::size_t>::max() / 2
+          : static_cast<std::size_t>(budgetVisits);
+  std::size_t referenceCount = 0;
+  std::size_t shownCount = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const bool inReference = reference.covered[i] != 0;
     const bool inShown = shown.covered[i] != 0;
+    referenceCount += inReference;
+    shownCount += inShown;
     result.missingCount += inReference && !inShown;
     result.extraCount += inShown && !inReference;
   }
-  if (result.missingCount > 0) {
-    const std::vector<double> toShown = squaredDistanceTo(shown);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (reference.covered[i] != 0 && shown.covered[i] == 0) {
-        result.missingPixels = std::max(result.missingPixels, std::sqrt(toShown[i]));
-      }
-    }
-  }
-  if (result.extraCount > 0) {
-    const std::vector<double> toReference = squaredDistanceTo(reference);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (shown.covered[i] != 0 && reference.covered[i] == 0) {
-        result.extraPixels = std::max(result.extraPixels, std::sqrt(toReference[i]));
-      }
-    }
-  }
+  result.missingPixels =
+      largestDistance(reference, shown, result.missingCount, shownCount, searchBudget);
+  result.extraPixels =
+      largestDistance(shown, reference, result.extraCount, referenceCount, searchBudget);
   return result;
 }
 

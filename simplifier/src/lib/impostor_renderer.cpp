@@ -319,6 +319,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   std::size_t covered = 0;
   std::size_t missed = 0;
   if (impostor.mesh.triangleCount() > 0) {
+    const auto drawStart = Clock::now();
     auto handle = renderer_->uploadMesh(impostor.mesh);
     if (!handle.ok()) return handle.status();
     render::Material plain;
@@ -330,6 +331,8 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     if (drawn.ok()) drawn = target_->readDepth(meshDepth);
     renderer_->deleteMesh(*handle);
     THINLOD_RETURN_IF_ERROR(drawn);
+    timings_.checkDrawMs = millisecondsSince(drawStart);
+    const auto silhouetteStart = Clock::now();
     const glm::mat4 inverse = glm::inverse(f.camera.projection * f.camera.view);
     auto unproject = [&](int x, int y, float d) {
       const glm::vec4 ndc(2.0f * (x + 0.5f) / n - 1.0f, 1.0f - 2.0f * (y + 0.5f) / n,
@@ -353,6 +356,8 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     impostor.silhouetteLossTexels = std::isfinite(loss->missingPixels)
                                         ? loss->missingPixels
                                         : std::sqrt(2.0) * n;  // nothing shown: all of it lost
+    timings_.checkSilhouetteMs = millisecondsSince(silhouetteStart);
+    const auto depthErrorStart = Clock::now();
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * n + x;
@@ -367,6 +372,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
         meshError = std::max(meshError, error);
       }
     }
+    timings_.checkDepthErrorMs = millisecondsSince(depthErrorStart);
   } else {
     for (float d : depthScratch_) covered += d < 1.0f;
     missed = covered;

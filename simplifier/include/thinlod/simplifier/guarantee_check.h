@@ -65,11 +65,20 @@ struct SilhouetteDistance {
   double pixels() const { return missingPixels > extraPixels ? missingPixels : extraPixels; }
 };
 
-// Exact Euclidean distances (Felzenszwalb-Huttenlocher transform, O(pixels)).
-// Masks of different or zero size: kInvalidArgument. One mask empty and the
-// other not: the distances towards the empty one are +infinity.
-Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
-                                              const CoverageMask& shown);
+// Exact Euclidean distances. Few differing pixels near the other mask (the
+// common case: a depth mesh losing a thin band of its capture's silhouette)
+// are measured by searching rings around each of them, stopping once a pixel
+// can no longer raise the maximum; when that search would visit more than
+// `searchVisitsPerPixel` x the mask's pixels, the distances come from the
+// exact transform instead (Felzenszwalb-Huttenlocher, O(pixels)). Both give
+// the same values (integer squared distances); 0 always transforms, +infinity
+// always searches (tests compare the two). Masks of different or zero size:
+// kInvalidArgument. One mask empty and the other not: the distances towards
+// the empty one are +infinity.
+inline constexpr double kSilhouetteSearchVisitsPerPixel = 2.0;
+Result<SilhouetteDistance> silhouetteDistance(
+    const CoverageMask& reference, const CoverageMask& shown,
+    double searchVisitsPerPixel = kSilhouetteSearchVisitsPerPixel);
 
 // A square camera at `eye` aimed at `center` whose view holds the ball of
 // radius `reach` around it (with 10 % margin), with the fewest pixels (in
