@@ -1,6 +1,7 @@
 // bench_impostor: times 256x256 simple and meshed impostors of shared models
 // on each offscreen back-end, with an empty-frame baseline measured
-// in the same run. Not a test. Usage: bench_impostor [repetitions] [models dir]
+// in the same run. Not a test.
+// Usage: bench_impostor [repetitions] [models dir] [model,model,...]
 // Prints CSV: backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra
 // Models: the cow, the bunny (69k triangles) and two other large meshes
 // (horse 97k, Nefertiti 100k). Meshed impostors use the service's settings
@@ -226,6 +227,18 @@ ServiceCase serviceFor(const std::string& models, const std::string& file,
 int main(int argc, char** argv) {
   const int repetitions = argc > 1 ? std::max(3, std::atoi(argv[1])) : 21;
   const std::string models = argc > 2 ? argv[2] : std::string(THINLOD_SHARED_DIR) + "/models";
+  // Optional third argument: the models to capture, comma-separated (a
+  // profile of one of them); every one named must load.
+  std::vector<std::string> files = {"cow.obj", "stanford-bunny.obj", "horse.ply", "nefertiti.obj"};
+  if (argc > 3) {
+    files.clear();
+    std::string list = argv[3];
+    for (std::size_t start = 0; start <= list.size();) {
+      const std::size_t comma = std::min(list.find(',', start), list.size());
+      if (comma > start) files.push_back(list.substr(start, comma - start));
+      start = comma + 1;
+    }
+  }
   std::printf("backend,model,triangles,kind,size,median_ms,min_ms,p90_ms,cpu_ms,coverage,extra\n");
   std::map<std::string, ChosenLevel> levels;  // per model, shared by the back-ends
   for (render::Backend backend : {render::Backend::kEgl, render::Backend::kOsMesa}) {
@@ -243,7 +256,8 @@ int main(int argc, char** argv) {
     MeshedImpostorOptions meshedOptions;  // as service_impostor.cpp sets them for 256 texels
     meshedOptions.gridStep = 256 / 32;
     meshedOptions.targetTriangles = ServiceOptions{}.meshedImpostorTriangles;
-    for (const char* file : {"cow.obj", "stanford-bunny.obj", "horse.ply", "nefertiti.obj"}) {
+    for (const std::string& fileName : files) {
+      const char* file = fileName.c_str();
       auto loaded = loadMeshFile(models + "/" + file);
       if (!loaded.ok()) {
         std::fprintf(stderr, "%s\n", loaded.status().toString().c_str());

@@ -95,57 +95,52 @@ std::vector<double> squaredDistanceTo(const CoverageMask& mask) {
 }
 
 // Largest squared distance from a pixel covered in `from` only to the nearest
-// covered pixel of `to` (non-empty), found by searching growing square rings
-// around each such pixel; nullopt once more than `budget` pixels were
-// visited. A ring of Chebyshev radius r holds no pixel nearer than r, so a
-// pixel's search ends when r * r reaches its best, or as soon as it finds a
-// pixel no farther than the largest distance found so far (that pixel can no
-// longer raise the maximum). Exact: squared distances are integers.
+// covered pixel of `to` (non-empty), or nullopt once the search visited more
+// than `budget` pixels. Separable like the transform (the squared distance to
+// the nearest site is min over columns u of (x - u)^2 + g(u, y)^2, with g the
+// distance to the nearest site in column u), but the second step is a search
+// outwards from each differing pixel only: it ends when (x - u)^2 alone
+// reaches the best found, or as soon as the best is no farther than the
+// largest distance found so far (the pixel can no longer raise the maximum).
+// Exact: everything is an integer.
 std::optional<double> searchLargestSquaredDistance(const CoverageMask& from, const CoverageMask& to,
-                                                   std::size_t budget) {
+                                                   std::size_t budget,
+                                                   std::vector<std::int32_t>& column) {
   const int w = from.width;
   const int h = from.height;
-  const std::uint8_t* target = to.covered.data();
+  constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max() / 4;
+  column.resize(static_cast<std::size_t>(w) * h);
+  // g(x, y): rows top-down then bottom-up, each a contiguous pass.
+  for (int x = 0; x < w; ++x) column[x] = to.covered[x] ? 0 : kNone;
+  for (int y = 1; y < h; ++y) {
+    const std::int32_t* above = column.data() + static_cast<std::size_t>(y - 1) * w;
+    std::int32_t* row = column.data() + static_cast<std::size_t>(y) * w;
+    const std::uint8_t* site = to.covered.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) row[x] = site[x] ? 0 : std::min(kNone, above[x] + 1);
+  }
+  for (int y = h - 2; y >= 0; --y) {
+    const std::int32_t* below = column.data() + static_cast<std::size_t>(y + 1) * w;
+    std::int32_t* row = column.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) row[x] = std::min(row[x], below[x] + 1);
+  }
+  auto squared = [](long long a) { return a * a; };
   long long worst = 0;
   std::size_t visited = 0;
   for (int y = 0; y < h; ++y) {
+    const std::int32_t* g = column.data() + static_cast<std::size_t>(y) * w;
+    const std::size_t rowStart = static_cast<std::size_t>(y) * w;
     for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      if (from.covered[i] == 0 || target[i] != 0) continue;
-      long long best = std::numeric_limits<long long>::max();
-      auto consider = [&](int u, int v) {
-        if (target[static_cast<std::size_t>(v) * w + u] == 0) return;
-        const long long dx = u - x;
-        const long long dy = v - y;
-        best = std::min(best, dx * dx + dy * dy);
-      };
-      for (long long r = 1; r * r < best && best > worst; ++r) {
-        const int ri = static_cast<int>(r);
-        const int x0 = std::max(0, x - ri);
-        const int x1 = std::min(w - 1, x + ri);
-        const int y0 = std::max(0, y - ri + 1);
-        const int y1 = std::min(h - 1, y + ri - 1);
-        if (x - ri < 0 && x + ri >= w && y - ri < 0 && y + ri >= h) break;  // past every edge
-        if (y - ri >= 0) {
-          for (int u = x0; u <= x1; ++u) consider(u, y - ri);
-          visited += static_cast<std::size_t>(x1 - x0 + 1);
-        }
-        if (y + ri < h) {
-          for (int u = x0; u <= x1; ++u) consider(u, y + ri);
-          visited += static_cast<std::size_t>(x1 - x0 + 1);
-        }
-        if (y0 <= y1) {
-          if (x - ri >= 0) {
-            for (int v = y0; v <= y1; ++v) consider(x - ri, v);
-            visited += static_cast<std::size_t>(y1 - y0 + 1);
-          }
-          if (x + ri < w) {
-            for (int v = y0; v <= y1; ++v) consider(x + ri, v);
-            visited += static_cast<std::size_t>(y1 - y0 + 1);
-          }
-        }
-        if (visited > budget) return std::nullopt;
+      if (from.covered[rowStart + x] == 0 || to.covered[rowStart + x] != 0) continue;
+      long long best = g[x] < kNone ? squared(g[x]) : std::numeric_limits<long long>::max();
+      for (int k = 1; squared(k) < best && best > worst; ++k) {
+        const bool left = x - k >= 0;
+        const bool right = x + k < w;
+        if (!left && !right) break;
+        if (left && g[x - k] < kNone) best = std::min(best, squared(k) + squared(g[x - k]));
+        if (right && g[x + k] < kNone) best = std::min(best, squared(k) + squared(g[x + k]));
+        visited += 2;
       }
+      if (visited > budget) return std::nullopt;
       worst = std::max(worst, best);
     }
   }
@@ -155,13 +150,14 @@ std::optional<double> searchLargestSquaredDistance(const CoverageMask& from, con
 // Largest distance (pixels) from a pixel covered in `from` only to the
 // nearest covered pixel of `to`: 0 without such pixels, +infinity when `to`
 // is empty; the bounded search first, the full transform when it would visit
-// more than `budget` pixels (dense or distant differences).
+// more than `budget` pixels (many differing pixels far from `to`).
 double largestDistance(const CoverageMask& from, const CoverageMask& to, std::size_t onlyInFrom,
                        std::size_t inTo, std::size_t budget) {
   if (onlyInFrom == 0) return 0.0;
   if (inTo == 0) return kInf;
   if (budget > 0) {
-    const std::optional<double> searched = searchLargestSquaredDistance(from, to, budget);
+    std::vector<std::int32_t> column;
+    const std::optional<double> searched = searchLargestSquaredDistance(from, to, budget, column);
     if (searched) return std::sqrt(*searched);
   }
   // Each transform is only computed when some pixel needs it (a meshed
