@@ -13,6 +13,7 @@
 // the full-mesh capture of the same run in `extra`: max / mean absolute
 // RGBA difference, coverage-mismatch texels (of texels covered in either),
 // and for meshed the displacement of depth-mesh vertices on the same texel.
+// Meshed rows give their parts (ImpostorTimings, wall ms, mean over the calls).
 // The error curve is measured once per model (service curve options) and
 // cached in MeshCurveCache::defaultDirectory().
 // Kinds service-simple / service-meshed: the daemon's own path,
@@ -90,6 +91,37 @@ Summary timeIt(int repetitions, F&& body) {
   s.thread = (cpuMs(CLOCK_THREAD_CPUTIME_ID) - threadStart) / repetitions;
   return s;
 }
+
+// Part timers (wall ms) averaged over the calls they were added for, the
+// first (timeIt's warm-up) left out.
+struct TimingMean {
+  ImpostorTimings sum;
+  int calls = 0;
+  bool warmedUp = false;
+  void add(const ImpostorTimings& t) {
+    if (!warmedUp) {
+      warmedUp = true;
+      return;
+    }
+    sum.renderMs += t.renderMs;
+    sum.meshMs += t.meshMs;
+    sum.gridMs += t.gridMs;
+    sum.simplifyMs += t.simplifyMs;
+    sum.checkMs += t.checkMs;
+    sum.checkDrawMs += t.checkDrawMs;
+    sum.checkSilhouetteMs += t.checkSilhouetteMs;
+    sum.checkDepthErrorMs += t.checkDepthErrorMs;
+    ++calls;
+  }
+  ImpostorTimings mean() const {
+    ImpostorTimings m = sum;
+    const double k = calls > 0 ? 1.0 / calls : 0.0;
+    for (double* v : {&m.renderMs, &m.meshMs, &m.gridMs, &m.simplifyMs, &m.checkMs,
+                      &m.checkDrawMs, &m.checkSilhouetteMs, &m.checkDepthErrorMs})
+      *v *= k;
+    return m;
+  }
+};
 
 // Depth-mesh vertices of `level` against those of `full` on the same texel
 // (matched by uv: each grid node sits on one texel).
@@ -312,6 +344,7 @@ int main(int argc, char** argv) {
                   simple.validity.alpha(), s.thread);
 
       MeshedImpostor meshed;
+      TimingMean meshedParts;
       const Summary m = timeIt(repetitions, [&] {
         auto result = (*impostors)->renderMeshed(scene, eye, meshedOptions);
         if (!result.ok()) {
@@ -319,8 +352,9 @@ int main(int argc, char** argv) {
           std::exit(1);
         }
         meshed = std::move(result).value();
+        meshedParts.add((*impostors)->lastTimings());
       });
-      const ImpostorTimings& t = (*impostors)->lastTimings();
+      const ImpostorTimings t = meshedParts.mean();
       std::printf(
           "%s,%s,%zu,meshed,256,%.3f,%.3f,%.3f,%.3f,%.3f,tris=%zu render=%.2fms mesh=%.2fms "
           "(grid=%.2f simplify=%.2f check=%.2f: draw=%.2f silhouette=%.2f depth_error=%.2f) "
@@ -354,6 +388,7 @@ int main(int argc, char** argv) {
           chosen.tolerance > 0 ? chosen.error / chosen.tolerance : 0.0,
           differenceText(simple.texture, simpleLevel.texture).c_str());
       MeshedImpostor meshedLevel;
+      TimingMean levelParts;
       const Summary ml = timeIt(repetitions, [&] {
         auto result = (*impostors)->renderMeshed(levelScene, eye, meshedOptions);
         if (!result.ok()) {
@@ -361,8 +396,9 @@ int main(int argc, char** argv) {
           std::exit(1);
         }
         meshedLevel = std::move(result).value();
+        levelParts.add((*impostors)->lastTimings());
       });
-      const ImpostorTimings& tl = (*impostors)->lastTimings();
+      const ImpostorTimings tl = levelParts.mean();
       const Displacement moved = vertexDisplacement(meshed.mesh, meshedLevel.mesh, 256);
       std::printf(
           "%s,%s,%zu,meshed-level,256,%.3f,%.3f,%.3f,%.3f,%.3f,render=%.2fms mesh=%.2fms "

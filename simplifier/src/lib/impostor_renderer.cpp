@@ -327,7 +327,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     const render::DrawItem item{*handle, glm::mat4(1.0f), plain};
     Status drawn = renderer_->beginFrame(*target_, glm::vec4(0.0f));
     if (drawn.ok()) drawn = renderer_->draw(&item, 1, f.camera, render::Lighting());
-    std::vector<float> meshDepth;
+    std::vector<float>& meshDepth = meshDepthScratch_;
     if (drawn.ok()) drawn = target_->readDepth(meshDepth);
     renderer_->deleteMesh(*handle);
     THINLOD_RETURN_IF_ERROR(drawn);

@@ -251,6 +251,7 @@ class ImpostorRenderer {
   std::unordered_map<const RgbaImage*, CachedTexture> textureCache_;
   ImpostorTimings timings_;
   std::vector<float> depthScratch_;
+  std::vector<float> meshDepthScratch_;  // the depth mesh's own depth (meshed check)
   std::vector<glm::vec3> pointScratch_;
   std::vector<unsigned char> referencedScratch_;
 };
