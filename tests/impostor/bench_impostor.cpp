@@ -20,7 +20,8 @@
 // SimplifierService::renderImpostor on a one-object scene of the model
 // (level choice, framing, capture, depth-mesh Draco encode; texture codec
 // raw, so no PNG encode), same eye, in the same run; `extra` holds the reply's
-// credited accuracy and the thread CPU ms per call.
+// credited accuracy and the thread CPU ms per call. gather-full-points /
+// frame-full-points: two CPU steps of that path on the full mesh alone.
 // (cpu_ms: process CPU time per call, all llvmpipe threads included; less
 // sensitive than wall time to other processes competing for the 2 cores.
 // thread_ms in `extra`: the calling thread's CPU time only.)
@@ -410,6 +411,30 @@ int main(int argc, char** argv) {
           tl.checkSilhouetteMs, tl.checkDepthErrorMs, ml.thread, meshedLevel.mesh.triangleCount(),
           differenceText(meshed.texture, meshedLevel.texture).c_str(), moved.max, moved.p99,
           moved.mean, moved.matched, moved.vertices, sphere.radius);
+
+      // Two CPU steps of the service path on the full mesh: gathering the
+      // referenced vertices in world space (what it did per request before
+      // keeping them with the scene) and framing them (still per request:
+      // it sets the texel size, hence the level).
+      std::vector<glm::vec3> framingPoints;
+      const Summary gather = timeIt(repetitions, [&] {
+        framingPoints.clear();
+        std::vector<unsigned char> referenced(part.mesh->vertexCount(), 0);
+        for (std::uint32_t index : part.mesh->indices) referenced[index] = 1;
+        for (std::size_t v = 0; v < referenced.size(); ++v) {
+          if (referenced[v]) {
+            framingPoints.push_back(glm::vec3(part.model * glm::vec4(part.mesh->positions[v], 1.0f)));
+          }
+        }
+      });
+      std::printf("%s,%s,%zu,gather-full-points,256,%.3f,%.3f,%.3f,%.3f,,thread_ms=%.3f points=%zu\n",
+                  name, file, triangles, gather.median, gather.min, gather.p90, gather.cpu,
+                  gather.thread, framingPoints.size());
+      const Summary framed = timeIt(repetitions, [&] {
+        if (!frameImpostor(framingPoints, eye, ImpostorOptions()).ok()) std::exit(1);
+      });
+      std::printf("%s,%s,%zu,frame-full-points,256,%.3f,%.3f,%.3f,%.3f,,thread_ms=%.3f\n", name,
+                  file, triangles, framed.median, framed.min, framed.p90, framed.cpu, framed.thread);
 
       // The daemon's path (its own context; ours is made current again after).
       ServiceCase service = serviceFor(models, file, backend);
