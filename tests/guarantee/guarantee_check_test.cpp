@@ -34,12 +34,15 @@ double bruteDirected(const CoverageMask& from, const CoverageMask& to) {
     for (int x = 0; x < from.width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * from.width + x;
       if (!from.covered[i] || to.covered[i]) continue;
-      double best = std::numeric_limits<double>::infinity();
+      long long best = -1;  // squared; -1: no covered pixel in `to`
       for (int v = 0; v < to.height; ++v)
         for (int u = 0; u < to.width; ++u)
-          if (to.covered[static_cast<std::size_t>(v) * to.width + u])
-            best = std::min(best, std::hypot(double(u - x), double(v - y)));
-      worst = std::max(worst, best);
+          if (to.covered[static_cast<std::size_t>(v) * to.width + u]) {
+            const long long d2 = (long long)(u - x) * (u - x) + (long long)(v - y) * (v - y);
+            if (best < 0 || d2 < best) best = d2;
+          }
+      worst = std::max(worst, best < 0 ? std::numeric_limits<double>::infinity()
+                                       : std::sqrt(static_cast<double>(best)));
     }
   }
   return worst;
@@ -122,6 +125,83 @@ TEST(SilhouetteDistance, MatchesBruteForceOnRandomMasks) {
     } else {
       EXPECT_NEAR(d->extraPixels, extra, 1e-9) << trial;
     }
+  }
+}
+
+// The ring search, the transform, and the default (search, falling back to
+// the transform past its budget; a tiny budget falls back mid-search) must
+// give the same values, and the brute-force ones.
+void expectAllPathsMatchBruteForce(const CoverageMask& a, const CoverageMask& b, int trial) {
+  const double missing = bruteDirected(a, b);
+  const double extra = bruteDirected(b, a);
+  auto transformed = silhouetteDistance(a, b, 0.0);
+  ASSERT_TRUE(transformed.ok());
+  for (double visits : {1e-4, kSilhouetteSearchVisitsPerPixel,
+                        std::numeric_limits<double>::infinity()}) {
+    auto d = silhouetteDistance(a, b, visits);
+    ASSERT_TRUE(d.ok());
+    EXPECT_EQ(d->missingPixels, transformed->missingPixels) << trial << " visits " << visits;
+    EXPECT_EQ(d->extraPixels, transformed->extraPixels) << trial << " visits " << visits;
+    EXPECT_EQ(d->missingCount, transformed->missingCount) << trial;
+    EXPECT_EQ(d->extraCount, transformed->extraCount) << trial;
+  }
+  if (std::isinf(missing)) {
+    EXPECT_TRUE(std::isinf(transformed->missingPixels)) << trial;
+  } else {
+    EXPECT_NEAR(transformed->missingPixels, missing, 1e-9) << trial;
+  }
+  if (std::isinf(extra)) {
+    EXPECT_TRUE(std::isinf(transformed->extraPixels)) << trial;
+  } else {
+    EXPECT_NEAR(transformed->extraPixels, extra, 1e-9) << trial;
+  }
+}
+
+TEST(SilhouetteDistance, SearchAndTransformAgreeOnRandomMasks) {
+  std::mt19937 rng(2011);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int w = 1 + static_cast<int>(rng() % 40);
+    const int h = 1 + static_cast<int>(rng() % 30);
+    const double density = (rng() % 100) / 100.0;
+    CoverageMask a = blank(w, h);
+    CoverageMask b = blank(w, h);
+    std::bernoulli_distribution pa(density), pb(density * (rng() % 3) * 0.5);
+    for (auto& c : a.covered) c = pa(rng);
+    for (auto& c : b.covered) c = pb(rng);
+    expectAllPathsMatchBruteForce(a, b, trial);
+  }
+}
+
+// What the meshed check measures: a wide silhouette (an ellipse across the
+// mask) and the same with a few pixels, bites and one distant island changed.
+TEST(SilhouetteDistance, SparseDifferencesOnWideMasksMatchBruteForce) {
+  std::mt19937 rng(77);
+  for (int trial = 0; trial < 16; ++trial) {
+    const int w = 200 + static_cast<int>(rng() % 240);
+    const int h = 24 + static_cast<int>(rng() % 48);
+    CoverageMask reference = blank(w, h);
+    const double cx = w * 0.5, cy = h * 0.5, rx = w * 0.4, ry = h * 0.4;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const double u = (x - cx) / rx, v = (y - cy) / ry;
+        reference.covered[static_cast<std::size_t>(y) * w + x] = u * u + v * v <= 1.0;
+      }
+    CoverageMask shown = reference;
+    const int flips = 1 + static_cast<int>(rng() % 40);
+    for (int k = 0; k < flips; ++k) {  // single pixels anywhere
+      const std::size_t i = rng() % shown.covered.size();
+      shown.covered[i] = !shown.covered[i];
+    }
+    const int bites = static_cast<int>(rng() % 4);
+    for (int k = 0; k < bites; ++k) {  // small rectangles off the rim (missing)
+      const int x0 = static_cast<int>(cx + rx * 0.9) - static_cast<int>(rng() % 6);
+      const int y0 = static_cast<int>(cy) - static_cast<int>(rng() % 6);
+      fillRect(shown, std::max(0, x0), std::max(0, y0), std::min(w, x0 + 1 + int(rng() % 8)),
+               std::min(h, y0 + 1 + int(rng() % 8)), 0);
+    }
+    if (trial % 3 == 0) fillRect(shown, 0, 0, 2, 2);  // an island far from the ellipse (extra)
+    expectAllPathsMatchBruteForce(reference, shown, trial);
+    expectAllPathsMatchBruteForce(shown, reference, 100 + trial);
   }
 }
 

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace thinlod::simplifier {
@@ -93,6 +94,83 @@ std::vector<double> squaredDistanceTo(const CoverageMask& mask) {
   return grid;
 }
 
+// Largest squared distance from a pixel covered in `from` only to the nearest
+// covered pixel of `to` (non-empty), or nullopt once the search visited more
+// than `budget` pixels. Separable like the transform (the squared distance to
+// the nearest site is min over columns u of (x - u)^2 + g(u, y)^2, with g the
+// distance to the nearest site in column u), but the second step is a search
+// outwards from each differing pixel only: it ends when (x - u)^2 alone
+// reaches the best found, or as soon as the best is no farther than the
+// largest distance found so far (the pixel can no longer raise the maximum).
+// Exact: everything is an integer.
+std::optional<double> searchLargestSquaredDistance(const CoverageMask& from, const CoverageMask& to,
+                                                   std::size_t budget,
+                                                   std::vector<std::int32_t>& column) {
+  const int w = from.width;
+  const int h = from.height;
+  constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max() / 4;
+  column.resize(static_cast<std::size_t>(w) * h);
+  // g(x, y): rows top-down then bottom-up, each a contiguous pass.
+  for (int x = 0; x < w; ++x) column[x] = to.covered[x] ? 0 : kNone;
+  for (int y = 1; y < h; ++y) {
+    const std::int32_t* above = column.data() + static_cast<std::size_t>(y - 1) * w;
+    std::int32_t* row = column.data() + static_cast<std::size_t>(y) * w;
+    const std::uint8_t* site = to.covered.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) row[x] = site[x] ? 0 : std::min(kNone, above[x] + 1);
+  }
+  for (int y = h - 2; y >= 0; --y) {
+    const std::int32_t* below = column.data() + static_cast<std::size_t>(y + 1) * w;
+    std::int32_t* row = column.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) row[x] = std::min(row[x], below[x] + 1);
+  }
+  auto squared = [](long long a) { return a * a; };
+  long long worst = 0;
+  std::size_t visited = 0;
+  for (int y = 0; y < h; ++y) {
+    const std::int32_t* g = column.data() + static_cast<std::size_t>(y) * w;
+    const std::size_t rowStart = static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      if (from.covered[rowStart + x] == 0 || to.covered[rowStart + x] != 0) continue;
+      long long best = g[x] < kNone ? squared(g[x]) : std::numeric_limits<long long>::max();
+      for (int k = 1; squared(k) < best && best > worst; ++k) {
+        const bool left = x - k >= 0;
+        const bool right = x + k < w;
+        if (!left && !right) break;
+        if (left && g[x - k] < kNone) best = std::min(best, squared(k) + squared(g[x - k]));
+        if (right && g[x + k] < kNone) best = std::min(best, squared(k) + squared(g[x + k]));
+        visited += 2;
+      }
+      if (visited > budget) return std::nullopt;
+      worst = std::max(worst, best);
+    }
+  }
+  return static_cast<double>(worst);
+}
+
+// Largest distance (pixels) from a pixel covered in `from` only to the
+// nearest covered pixel of `to`: 0 without such pixels, +infinity when `to`
+// is empty; the bounded search first, the full transform when it would visit
+// more than `budget` pixels (many differing pixels far from `to`).
+double largestDistance(const CoverageMask& from, const CoverageMask& to, std::size_t onlyInFrom,
+                       std::size_t inTo, std::size_t budget) {
+  if (onlyInFrom == 0) return 0.0;
+  if (inTo == 0) return kInf;
+  if (budget > 0) {
+    std::vector<std::int32_t> column;
+    const std::optional<double> searched = searchLargestSquaredDistance(from, to, budget, column);
+    if (searched) return std::sqrt(*searched);
+  }
+  // Each transform is only computed when some pixel needs it (a meshed
+  // impostor's shown mask lies inside its capture's, so it never has extra
+  // pixels).
+  const std::vector<double> toTarget = squaredDistanceTo(to);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < toTarget.size(); ++i) {
+    if (from.covered[i] != 0 && to.covered[i] == 0) worst = std::max(worst, toTarget[i]);
+  }
+  return std::sqrt(worst);
+}
+
 }  // namespace
 
 std::size_t CoverageMask::coveredCount() const {
@@ -101,7 +179,8 @@ std::size_t CoverageMask::coveredCount() const {
 }
 
 Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
-                                              const CoverageMask& shown) {
+                                              const CoverageMask& shown,
+                                              double searchVisitsPerPixel) {
   auto sized = [](const CoverageMask& m) {
     return m.width > 0 && m.height > 0 &&
            m.covered.size() == static_cast<std::size_t>(m.width) * m.height;
@@ -116,32 +195,26 @@ Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
                       std::to_string(shown.covered.size()) + " values)");
   }
   SilhouetteDistance result;
-  // Each distance transform is only computed when some pixel needs it (a
-  // meshed impostor's shown mask lies inside its capture's, so it never has
-  // extra pixels: half the cost of its check, same result).
   const std::size_t n = reference.covered.size();
+  const double budgetVisits = searchVisitsPerPixel > 0.0 ? searchVisitsPerPixel * double(n) : 0.0;
+  const std::size_t searchBudget =
+      budgetVisits >= double(std::numeric_limits<std::size_t>::max() / 2)
+          ? std::numeric_limits<std::size_t>::max() / 2
+          : static_cast<std::size_t>(budgetVisits);
+  std::size_t referenceCount = 0;
+  std::size_t shownCount = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const bool inReference = reference.covered[i] != 0;
     const bool inShown = shown.covered[i] != 0;
+    referenceCount += inReference;
+    shownCount += inShown;
     result.missingCount += inReference && !inShown;
     result.extraCount += inShown && !inReference;
   }
-  if (result.missingCount > 0) {
-    const std::vector<double> toShown = squaredDistanceTo(shown);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (reference.covered[i] != 0 && shown.covered[i] == 0) {
-        result.missingPixels = std::max(result.missingPixels, std::sqrt(toShown[i]));
-      }
-    }
-  }
-  if (result.extraCount > 0) {
-    const std::vector<double> toReference = squaredDistanceTo(reference);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (shown.covered[i] != 0 && reference.covered[i] == 0) {
-        result.extraPixels = std::max(result.extraPixels, std::sqrt(toReference[i]));
-      }
-    }
-  }
+  result.missingPixels =
+      largestDistance(reference, shown, result.missingCount, shownCount, searchBudget);
+  result.extraPixels =
+      largestDistance(shown, reference, result.extraCount, referenceCount, searchBudget);
   return result;
 }
 

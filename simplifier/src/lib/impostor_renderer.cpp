@@ -319,6 +319,7 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
   std::size_t covered = 0;
   std::size_t missed = 0;
   if (impostor.mesh.triangleCount() > 0) {
+    const auto drawStart = Clock::now();
     auto handle = renderer_->uploadMesh(impostor.mesh);
     if (!handle.ok()) return handle.status();
     render::Material plain;
@@ -326,15 +327,21 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     const render::DrawItem item{*handle, glm::mat4(1.0f), plain};
     Status drawn = renderer_->beginFrame(*target_, glm::vec4(0.0f));
     if (drawn.ok()) drawn = renderer_->draw(&item, 1, f.camera, render::Lighting());
-    std::vector<float> meshDepth;
+    std::vector<float>& meshDepth = meshDepthScratch_;
     if (drawn.ok()) drawn = target_->readDepth(meshDepth);
     renderer_->deleteMesh(*handle);
     THINLOD_RETURN_IF_ERROR(drawn);
+    timings_.checkDrawMs = millisecondsSince(drawStart);
+    const auto silhouetteStart = Clock::now();
     const glm::mat4 inverse = glm::inverse(f.camera.projection * f.camera.view);
-    auto unproject = [&](int x, int y, float d) {
-      const glm::vec4 ndc(2.0f * (x + 0.5f) / n - 1.0f, 1.0f - 2.0f * (y + 0.5f) / n,
-                          2.0f * d - 1.0f, 1.0f);
-      const glm::vec4 world = inverse * ndc;
+    // inverse * (nx, ny, nz, 1) as glm evaluates it, (m0 nx + m1 ny) + (m2 nz
+    // + m3), with the pixel's part computed once for both depths and the ndc
+    // coordinates once per column / row: the same floats as unprojecting
+    // each depth whole, for half the multiplications.
+    std::vector<float> ndcX(static_cast<std::size_t>(n));
+    for (int x = 0; x < n; ++x) ndcX[x] = 2.0f * (x + 0.5f) / n - 1.0f;
+    auto unprojectAt = [&](const glm::vec4& pixelPart, float d) {
+      const glm::vec4 world = pixelPart + (inverse[2] * (2.0f * d - 1.0f) + inverse[3]);
       return glm::vec3(world) / world.w;
     };
     CoverageMask captured;
@@ -353,7 +360,11 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
     impostor.silhouetteLossTexels = std::isfinite(loss->missingPixels)
                                         ? loss->missingPixels
                                         : std::sqrt(2.0) * n;  // nothing shown: all of it lost
+    timings_.checkSilhouetteMs = millisecondsSince(silhouetteStart);
+    const auto depthErrorStart = Clock::now();
     for (int y = 0; y < n; ++y) {
+      const float ndcY = 1.0f - 2.0f * (y + 0.5f) / n;
+      const glm::vec4 rowPart = inverse[1] * ndcY;
       for (int x = 0; x < n; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * n + x;
         if (!(depthScratch_[i] < 1.0f)) continue;
@@ -362,11 +373,13 @@ Result<MeshedImpostor> ImpostorRenderer::renderMeshed(const ImpostorScene& scene
           ++missed;
           continue;
         }
-        const double error =
-            glm::length(unproject(x, y, depthScratch_[i]) - unproject(x, y, meshDepth[i]));
+        const glm::vec4 pixelPart = inverse[0] * ndcX[x] + rowPart;
+        const double error = glm::length(unprojectAt(pixelPart, depthScratch_[i]) -
+                                         unprojectAt(pixelPart, meshDepth[i]));
         meshError = std::max(meshError, error);
       }
     }
+    timings_.checkDepthErrorMs = millisecondsSince(depthErrorStart);
   } else {
     for (float d : depthScratch_) covered += d < 1.0f;
     missed = covered;

@@ -71,6 +71,24 @@ protocol::ConicRange toWire(const ConicRange& range) {
 
 }  // namespace
 
+namespace service_detail {
+
+const std::vector<glm::vec3>& LoadedScene::framingPointsOf(const scene::SceneObject& object) const {
+  auto known = framingPoints.find(object.id);
+  if (known != framingPoints.end()) return known->second;
+  std::vector<glm::vec3>& points = framingPoints[object.id];
+  std::vector<unsigned char> referenced(object.fullMesh->vertexCount(), 0);
+  for (std::uint32_t index : object.fullMesh->indices) referenced[index] = 1;
+  for (std::size_t v = 0; v < referenced.size(); ++v) {
+    if (!referenced[v]) continue;
+    points.push_back(
+        glm::vec3(object.objectToWorld * glm::vec4(object.fullMesh->positions[v], 1.0f)));
+  }
+  return points;
+}
+
+}  // namespace service_detail
+
 std::shared_ptr<const RgbaImage> SimplifierService::Impl::textureOf(
     const scene::SceneObject& object, const IndexedMesh& mesh) {
   if (object.shape == nullptr || mesh.uvs.empty()) return nullptr;
@@ -183,20 +201,17 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
   base.up = request.orientation * glm::vec3(0.0f, 1.0f, 0.0f);
   base.fixedCenter = request.frameCenter;
   base.fixedSize = glm::vec2(request.frameWidth, request.frameHeight);
-  std::vector<glm::vec3> points;
+  std::vector<glm::vec3> points;  // several objects: their points together
   std::vector<BoundingSphere> spheres;
   for (const scene::SceneObject* object : objects) {
     spheres.push_back(object->worldSphere);
-    std::vector<unsigned char> referenced(object->fullMesh->vertexCount(), 0);
-    for (std::uint32_t index : object->fullMesh->indices) referenced[index] = 1;
-    for (std::size_t v = 0; v < referenced.size(); ++v) {
-      if (!referenced[v]) continue;
-      const glm::vec3 p =
-          glm::vec3(object->objectToWorld * glm::vec4(object->fullMesh->positions[v], 1.0f));
-      points.push_back(p);
+    if (objects.size() > 1) {
+      const std::vector<glm::vec3>& world = loaded->framingPointsOf(*object);
+      points.insert(points.end(), world.begin(), world.end());
     }
   }
-  Result<ImpostorFraming> framing = frameImpostor(points, request.eye, base);
+  Result<ImpostorFraming> framing = frameImpostor(
+      objects.size() > 1 ? points : loaded->framingPointsOf(*objects.front()), request.eye, base);
   if (!framing.ok()) return framing.status();
   // The smallest texel footprint on the objects (impostor_level.h says why
   // one texel); 0 when levels are switched off: every object at full resolution.

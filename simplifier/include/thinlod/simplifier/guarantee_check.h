@@ -65,11 +65,24 @@ struct SilhouetteDistance {
   double pixels() const { return missingPixels > extraPixels ? missingPixels : extraPixels; }
 };
 
-// Exact Euclidean distances (Felzenszwalb-Huttenlocher transform, O(pixels)).
-// Masks of different or zero size: kInvalidArgument. One mask empty and the
-// other not: the distances towards the empty one are +infinity.
-Result<SilhouetteDistance> silhouetteDistance(const CoverageMask& reference,
-                                              const CoverageMask& shown);
+// Exact Euclidean distances. First a search: the distance of each pixel to
+// the nearest covered one in its own column (two integer passes), then, from
+// each differing pixel only, outwards along its row until no nearer pixel can
+// exist or the pixel can no longer raise the maximum; O(pixels + the
+// differing pixels' distances), the common case (a depth mesh losing a band
+// of its capture's silhouette, a few texels wide). When that row search
+// would visit more than `searchVisitsPerPixel` x the mask's pixels (many
+// differing pixels far from the other mask), the distances come from the
+// exact transform instead (Felzenszwalb-Huttenlocher, O(pixels), about ten
+// times the work of one visit per pixel). Both give the same values (integer
+// squared distances); 0 always transforms, +infinity always searches (tests
+// compare the two). Masks of different or zero size: kInvalidArgument. One
+// mask empty and the other not: the distances towards the empty one are
+// +infinity.
+inline constexpr double kSilhouetteSearchVisitsPerPixel = 4.0;
+Result<SilhouetteDistance> silhouetteDistance(
+    const CoverageMask& reference, const CoverageMask& shown,
+    double searchVisitsPerPixel = kSilhouetteSearchVisitsPerPixel);
 
 // A square camera at `eye` aimed at `center` whose view holds the ball of
 // radius `reach` around it (with 10 % margin), with the fewest pixels (in

@@ -207,6 +207,12 @@ struct ImpostorTimings {
   double gridMs = 0.0;
   double simplifyMs = 0.0;
   double checkMs = 0.0;
+  // checkMs in parts: upload + draw of the depth mesh and its depth
+  // readback; the coverage masks and their silhouette distance; the
+  // per-pixel depth error (unprojection of both depths).
+  double checkDrawMs = 0.0;
+  double checkSilhouetteMs = 0.0;
+  double checkDepthErrorMs = 0.0;
 };
 
 class ImpostorRenderer {
@@ -245,6 +251,7 @@ class ImpostorRenderer {
   std::unordered_map<const RgbaImage*, CachedTexture> textureCache_;
   ImpostorTimings timings_;
   std::vector<float> depthScratch_;
+  std::vector<float> meshDepthScratch_;  // the depth mesh's own depth (meshed check)
   std::vector<glm::vec3> pointScratch_;
   std::vector<unsigned char> referencedScratch_;
 };
