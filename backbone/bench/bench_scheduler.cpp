@@ -18,6 +18,7 @@
 
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/backbone/synthetic_scene.h"
+#include "thinlod/common/core/cpu_time.h"
 
 using namespace thinlod;
 using namespace thinlod::backbone;
@@ -28,13 +29,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 bool g_verbose = false;  // per-step lines on stderr (--verbose)
 std::string g_only;      // run only this scaling config (--only; empty: all)
 bool wanted(const char* config) { return g_only.empty() || g_only == config; }
-
-// CPU time of this thread: the machine is shared, wall time is noisy.
-double now() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 SchedulerConfig paperConfig() {
   SchedulerConfig c;  // section 4: 0.1 m/s observer, ~1 s lifetime
@@ -180,9 +174,9 @@ StepTimes runFlight(const SchedulingScene& generated, const Scheduler& scheduler
     // Outside the cube, drifting along x at 0.1 m/s, looking at the centre.
     const glm::dvec3 p(-0.4 * worldSize + 0.01 * s, 0.1 * worldSize, 0.9 * worldSize);
     const ViewerState v = viewer(p, -p, 0.1 * s, static_cast<std::uint64_t>(s));
-    const double t0 = now();
+    const double t0 = threadCpuSeconds();
     auto plan = scheduler.plan(scene, v, budget, state);
-    const double micros = (now() - t0) * 1e6;
+    const double micros = (threadCpuSeconds() - t0) * 1e6;
     if (!plan.ok()) {
       std::fprintf(stderr, "plan failed: %s\n", plan.status().toString().c_str());
       std::exit(1);
@@ -192,9 +186,9 @@ StepTimes runFlight(const SchedulingScene& generated, const Scheduler& scheduler
           (residentBytes() - residentBefore) / std::max<double>(1.0, double(scene.objects.size()));
     double referenceMicros = 0.0;
     if (reference) {
-      const double r0 = now();
+      const double r0 = threadCpuSeconds();
       auto slow = reference->plan(referenceScene, v, budget, referenceState);
-      referenceMicros = (now() - r0) * 1e6;
+      referenceMicros = (threadCpuSeconds() - r0) * 1e6;
       if (!slow.ok()) {
         std::fprintf(stderr, "reference plan failed: %s\n", slow.status().toString().c_str());
         std::exit(1);
@@ -402,9 +396,9 @@ void comparison(int scenes) {
     bool ok = true;
     for (std::size_t s = 0; s < n; ++s) {
       PlannerState state;
-      const double t0 = now();
+      const double t0 = threadCpuSeconds();
       auto plan = all[s]->plan(scene, v, budget, state);
-      const double micros = (now() - t0) * 1e6;
+      const double micros = (threadCpuSeconds() - t0) * 1e6;
       if (!plan.ok()) {
         ok = false;  // brute force: the cheapest plan is over budget
         break;
@@ -423,9 +417,9 @@ void comparison(int scenes) {
       auto first = second[f]->plan(copy, v, budget, state);
       if (!first.ok()) continue;
       deliver(copy, *first, leafOf);
-      const double t0 = now();
+      const double t0 = threadCpuSeconds();
       auto again = second[f]->plan(copy, viewer({0, 0, 6.0}, {0, 0, -1}, 0.1, 1), budget, state);
-      const double micros = (now() - t0) * 1e6;
+      const double micros = (threadCpuSeconds() - t0) * 1e6;
       if (!again.ok()) continue;
       const double ratio = again->achievedMinAccuracy / best;
       steady[f].ratio += ratio;

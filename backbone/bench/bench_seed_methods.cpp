@@ -28,6 +28,7 @@
 #include "span_of_level_changed.h"
 #include "thinlod/backbone/scheduler.h"
 #include "thinlod/backbone/synthetic_scene.h"
+#include "thinlod/common/core/cpu_time.h"
 
 using namespace thinlod;
 using namespace thinlod::backbone;
@@ -36,12 +37,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double now() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 // Same projected-area measure as the schedulers (allocation_schedulers.h):
 // the solid angle of the bounding sphere whose surface is D away.
@@ -186,22 +181,22 @@ bool multiTypeExperiment(int frames, double budget, int repeats, const std::stri
     }
     SlcConfig config;  // the paper's: nearest-first d, sum 2^l
     Result<SlcSelection> chosen = Status(ErrorCode::kInternal, "not run");
-    double t0 = now();
+    double t0 = threadCpuSeconds();
     for (int r = 0; r < repeats; ++r) chosen = selectBySpanOfLevelChanged(input, budget, config);
-    const double heap = (now() - t0) * 1e6 / repeats;
+    const double heap = (threadCpuSeconds() - t0) * 1e6 / repeats;
     if (!chosen.ok()) {
       std::fprintf(stderr, "frame %d: %s\n", f, chosen.status().toString().c_str());
       return false;
     }
     std::vector<std::uint32_t> scanned;
-    t0 = now();
+    t0 = threadCpuSeconds();
     for (int r = 0; r < repeats; ++r) scanned = linearScanSelection(input, budget);
-    const double scan = (now() - t0) * 1e6 / repeats;
+    const double scan = (threadCpuSeconds() - t0) * 1e6 / repeats;
     mismatches += scanned != chosen->levelIndex;
     Result<AslodAllocation> allocation = Status(ErrorCode::kInternal, "not run");
-    t0 = now();
+    t0 = threadCpuSeconds();
     for (int r = 0; r < repeats; ++r) allocation = allocateAslod(aslodInput, budget, AslodConfig{});
-    const double aslodTime = (now() - t0) * 1e6 / repeats;
+    const double aslodTime = (threadCpuSeconds() - t0) * 1e6 / repeats;
     double aslodFaces = 0.0;
     if (allocation.ok()) {
       // Each object renders its finest LOD with at most its allocation.

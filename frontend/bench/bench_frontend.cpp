@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "raw_gl_baseline.h"
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/mesh_renderer.h"
@@ -54,14 +55,6 @@ using Clock = std::chrono::steady_clock;
 constexpr int kWidth = 640;
 constexpr int kHeight = 480;
 constexpr int kTextureSize = 256;
-
-// Process CPU time (all threads, so llvmpipe's rasterizer threads count):
-// steadier than wall time when other processes compete for the cores.
-double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) / 1e6;
-}
 
 double loadAverage() {
   double load = -1.0;
@@ -454,30 +447,30 @@ int main(int argc, char** argv) {
   for (int f = 0; f < frames; ++f) {
     const render::Camera camera = cameraAt(f);
     auto frontendVariant = [&] {
-      const double cpuStart = cpuMs();
+      const double cpuStart = processCpuSeconds() * 1e3;
       const FrameReport report =
           orDie(frontend->renderFrame(camera, lighting, frontendFrame), "frontend frame");
-      frontendCpuMs.push_back(cpuMs() - cpuStart);
+      frontendCpuMs.push_back(processCpuSeconds() * 1e3 - cpuStart);
       frontendMs.push_back(report.timing.totalMs);
       frontendCalls = report.drawCalls;
       frontendTriangles = report.triangles;
     };
     auto bareVariant = [&] {
-      const double cpuStart = cpuMs();
+      const double cpuStart = processCpuSeconds() * 1e3;
       const Clock::time_point start = Clock::now();
       orDie(bareRenderer->beginFrame(*bareTarget, glm::vec4(0, 0, 0, 1)), "bare begin");
       orDie(bareRenderer->draw(&bareItem, 1, camera, lighting), "bare draw");
       orDie(bareTarget->readColor(bareFrame), "bare readback");
       bareMs.push_back(msSince(start));
-      bareCpuMs.push_back(cpuMs() - cpuStart);
+      bareCpuMs.push_back(processCpuSeconds() * 1e3 - cpuStart);
     };
     auto rawVariant = [&] {
       if (rawGl == nullptr) return;
-      const double cpuStart = cpuMs();
+      const double cpuStart = processCpuSeconds() * 1e3;
       const Clock::time_point rawStart = Clock::now();
       rawGl->renderFrame(camera.projection * camera.view, rawFrame);
       rawMs.push_back(msSince(rawStart));
-      rawCpuMs.push_back(cpuMs() - cpuStart);
+      rawCpuMs.push_back(processCpuSeconds() * 1e3 - cpuStart);
     };
     // The order rotates frame by frame, so no variant always runs right after
     // the same other one (caches, the rasteriser threads' wake-up).
@@ -540,7 +533,7 @@ int main(int argc, char** argv) {
       orDie(r.submit(std::move(batch)), "submit burst");
       int after = 0;
       for (int f = 0; after < 5 && f < 1000; ++f) {
-        const double cpuStart = cpuMs();
+        const double cpuStart = processCpuSeconds() * 1e3;
         const FrameReport report =
             orDie(r.renderFrame(cameraAt(f), lighting, frontendFrame), "burst frame");
         ++result.frames;
@@ -549,7 +542,7 @@ int main(int argc, char** argv) {
         } else {
           result.fastestAtFrameMs[f] = std::min(result.fastestAtFrameMs[f], report.timing.totalMs);
         }
-        result.worstCpuMs = std::max(result.worstCpuMs, cpuMs() - cpuStart);
+        result.worstCpuMs = std::max(result.worstCpuMs, processCpuSeconds() * 1e3 - cpuStart);
         result.worstMs = std::max(result.worstMs, report.timing.totalMs);
         result.worstExtraMs =
             std::max(result.worstExtraMs, report.timing.uploadMs + report.timing.commitMs);

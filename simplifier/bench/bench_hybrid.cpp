@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/simplifier/hybrid_graph.h"
@@ -32,13 +33,6 @@ struct Config {
   std::string name;
   HybridOptions options;
 };
-
-// Thread CPU time: the machine is shared, wall time would measure the others.
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 double unitsAt(const std::vector<HybridCurveStep>& steps, double error) {
   double units = steps.front().units;
@@ -107,9 +101,9 @@ int main(int argc, char** argv) {
     for (const Config& c : configs) {
       std::cerr << model.name << ": " << c.name << "\n";
       const auto start = std::chrono::steady_clock::now();
-      const double cpuStart = threadSeconds();
+      const double cpuStart = threadCpuSeconds();
       Result<HybridGraph> g = buildHybridGraph(model.mesh, c.options);
-      const double cpu = threadSeconds() - cpuStart;
+      const double cpu = threadCpuSeconds() - cpuStart;
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!g.ok()) {

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/regions.h"
@@ -36,13 +37,6 @@ using namespace thinlod;
 using namespace thinlod::simplifier;
 
 namespace {
-
-// Thread CPU time: the machine is shared, wall time would measure the others.
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Model {
   std::string name;
@@ -178,12 +172,12 @@ int main(int argc, char** argv) {
   std::printf("# bench_regions output\n\n");
   for (const Model& model : models) {
     std::cerr << model.name << ": build\n";
-    double t0 = threadSeconds();
+    double t0 = threadCpuSeconds();
     Result<ProgressiveMesh> whole = ProgressiveMesh::build(model.mesh);
-    const double wholeSeconds = threadSeconds() - t0;
-    t0 = threadSeconds();
+    const double wholeSeconds = threadCpuSeconds() - t0;
+    t0 = threadCpuSeconds();
     Result<RegionMesh> regions = buildRegions(model, BorderRule::kLowerIdSide);
-    const double regionSeconds = threadSeconds() - t0;
+    const double regionSeconds = threadCpuSeconds() - t0;
     if (!whole.ok() || !regions.ok()) {
       std::cerr << (whole.ok() ? regions.status() : whole.status()).toString() << "\n";
       return 1;
@@ -250,13 +244,13 @@ int main(int argc, char** argv) {
     IndexedMesh out, scratch;
     AssembleStats stats;
     std::size_t triangles = 0;
-    t0 = threadSeconds();
+    t0 = threadCpuSeconds();
     for (const auto& levels : frameLevels) {
       if (!regions->assembleInto(levels, out, &stats).ok()) return 1;
       triangles += out.triangleCount();
     }
-    const double assembleSeconds = threadSeconds() - t0;
-    t0 = threadSeconds();
+    const double assembleSeconds = threadCpuSeconds() - t0;
+    t0 = threadCpuSeconds();
     std::size_t bareTriangles = 0;
     for (const auto& levels : frameLevels) {
       for (std::size_t r = 0; r < regions->regionCount(); ++r) {
@@ -270,15 +264,15 @@ int main(int argc, char** argv) {
         bareTriangles += scratch.triangleCount();
       }
     }
-    const double bareSeconds = threadSeconds() - t0;
-    t0 = threadSeconds();
+    const double bareSeconds = threadCpuSeconds() - t0;
+    t0 = threadCpuSeconds();
     for (const auto& levels : frameLevels) {
       std::size_t total = 0;
       for (std::size_t r = 0; r < levels.size(); ++r)
         total += regions->triangleCountAt(r, levels[r]);
       whole->extractInto(total, scratch);
     }
-    const double wholeExtractSeconds = threadSeconds() - t0;
+    const double wholeExtractSeconds = threadCpuSeconds() - t0;
     const double perFrame = 1e6 / frames;
     std::printf(
         "\nPer frame (%d frames, random per-region levels, seed 42; mean %.0f triangles, %.0f "

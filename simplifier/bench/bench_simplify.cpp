@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/surface_error.h"
@@ -48,19 +49,10 @@ namespace {
 using thinlod::IndexedMesh;
 using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
-// Thread CPU time: the machine is shared with other builds, and CPU time of
-// the benchmarking thread is the load-insensitive figure (every method runs
-// single-threaded on this thread).
-double threadMilliseconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
 double millisecondsOf(const std::function<void()>& work) {
-  const double start = threadMilliseconds();
+  const double start = thinlod::threadCpuSeconds() * 1e3;
   work();
-  return threadMilliseconds() - start;
+  return thinlod::threadCpuSeconds() * 1e3 - start;
 }
 
 // Median over `samples` of the mean time of `runsPerSample` back-to-back runs.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "articulated_figure.h"
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/scene/skinned_import.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 #include "thinlod/simplifier/skinned_level.h"
@@ -27,12 +28,6 @@ using namespace thinlod;
 using namespace thinlod::simplifier;
 
 namespace {
-
-double threadSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 struct Model {
   std::string name;
@@ -123,10 +118,10 @@ int main(int argc, char** argv) {
                     100.0 * fraction);
         continue;
       }
-      const double start = threadSeconds();
+      const double start = threadCpuSeconds();
       Result<AnimatedLevelError> bound = deformedLevelBound(model.mesh, model.skin, model.skeleton,
                                                             model.clip, level, *skin, options);
-      const double seconds = threadSeconds() - start;
+      const double seconds = threadCpuSeconds() - start;
       if (!bound.ok()) {
         std::fprintf(stderr, "%s: %s\n", model.name.c_str(), bound.status().toString().c_str());
         return 1;

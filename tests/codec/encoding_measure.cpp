@@ -13,6 +13,7 @@
 
 #include "test_meshes.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/cpu_time.h"
 
 namespace {
 
@@ -22,11 +23,9 @@ using namespace thinlod::codec;
 double medianMillis(const std::function<void()>& work) {
   std::vector<double> times;
   for (int i = 0; i < 9; ++i) {
-    timespec start{}, stop{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+    const double start = thinlod::threadCpuSeconds();
     work();
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
-    times.push_back((stop.tv_sec - start.tv_sec) * 1e3 + (stop.tv_nsec - start.tv_nsec) * 1e-6);
+    times.push_back((thinlod::threadCpuSeconds() - start) * 1e3);
   }
   std::sort(times.begin(), times.end());
   return times[times.size() / 2];

@@ -40,6 +40,7 @@
 #include <utility>
 #include <vector>
 
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
@@ -59,11 +60,6 @@ struct Summary {
   double median = 0, min = 0, p90 = 0, cpu = 0, thread = 0;
 };
 
-double cpuMs(clockid_t clock = CLOCK_PROCESS_CPUTIME_ID) {
-  timespec t{};
-  clock_gettime(clock, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
 
 Summary summarize(std::vector<double> samples) {
   std::sort(samples.begin(), samples.end());
@@ -78,8 +74,8 @@ template <typename F>
 Summary timeIt(int repetitions, F&& body) {
   std::vector<double> samples;
   body();  // warm-up: shader compile, first upload, target allocation
-  const double cpuStart = cpuMs();
-  const double threadStart = cpuMs(CLOCK_THREAD_CPUTIME_ID);
+  const double cpuStart = processCpuSeconds() * 1e3;
+  const double threadStart = threadCpuSeconds() * 1e3;
   for (int i = 0; i < repetitions; ++i) {
     const auto start = std::chrono::steady_clock::now();
     body();
@@ -88,8 +84,8 @@ Summary timeIt(int repetitions, F&& body) {
             .count());
   }
   Summary s = summarize(samples);
-  s.cpu = (cpuMs() - cpuStart) / repetitions;
-  s.thread = (cpuMs(CLOCK_THREAD_CPUTIME_ID) - threadStart) / repetitions;
+  s.cpu = (processCpuSeconds() * 1e3 - cpuStart) / repetitions;
+  s.thread = (threadCpuSeconds() * 1e3 - threadStart) / repetitions;
   return s;
 }
 

@@ -33,6 +33,7 @@
 
 #include "thinlod/common/codec/encoding.h"
 #include "thinlod/common/codec/texture_refresh.h"
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/core/trace.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
@@ -54,19 +55,13 @@ struct Args {
   bool allDistances = false;
 };
 
-double threadMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
 template <typename F>
 double medianMs(int repeats, F&& body) {
   std::vector<double> samples;
   for (int i = 0; i < repeats; ++i) {
-    const double start = threadMs();
+    const double start = threadCpuSeconds() * 1e3;
     body();
-    samples.push_back(threadMs() - start);
+    samples.push_back(threadCpuSeconds() * 1e3 - start);
   }
   std::sort(samples.begin(), samples.end());
   return samples[samples.size() / 2];

@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/common/render/mesh_batch.h"
 #include "thinlod/common/render/mesh_renderer.h"
 
@@ -20,12 +21,6 @@ using namespace thinlod;
 using namespace thinlod::render;
 
 namespace {
-
-double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
 
 struct Timing {
   double median, min, p90, cpu;
@@ -35,7 +30,7 @@ template <typename F>
 Timing timeFrames(int repetitions, F&& frame) {
   frame();
   std::vector<double> samples;
-  const double cpuStart = cpuMs();
+  const double cpuStart = processCpuSeconds() * 1e3;
   for (int i = 0; i < repetitions; ++i) {
     const auto start = std::chrono::steady_clock::now();
     frame();
@@ -43,7 +38,7 @@ Timing timeFrames(int repetitions, F&& frame) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
   }
-  const double cpu = (cpuMs() - cpuStart) / repetitions;
+  const double cpu = (processCpuSeconds() * 1e3 - cpuStart) / repetitions;
   std::sort(samples.begin(), samples.end());
   return {samples[samples.size() / 2], samples.front(), samples[samples.size() * 9 / 10], cpu};
 }

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "test_meshes.h"
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/simplifier/mesh_curve.h"
 
 namespace {
@@ -18,21 +19,14 @@ namespace {
 using namespace thinlod;
 using namespace thinlod::simplifier;
 
-// Thread CPU time: insensitive to other processes on a busy machine.
-double cpuNow() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
 struct Stopwatch {
   std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
-  double cpu = cpuNow();
+  double cpu = threadCpuSeconds() * 1e3;
   double wallMs() const {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall)
         .count();
   }
-  double cpuMs() const { return cpuNow() - cpu; }
+  double cpuMs() const { return threadCpuSeconds() * 1e3 - cpu; }
 };
 
 void printCurve(const char* name, const AccuracyCurve& curve) {

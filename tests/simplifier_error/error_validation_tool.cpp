@@ -23,16 +23,10 @@
 #include <vector>
 
 #include "test_meshes.h"
+#include "thinlod/common/core/cpu_time.h"
 #include "thinlod/simplifier/surface_error.h"
 
 namespace {
-
-// CPU time of this thread: insensitive to other processes on a busy machine.
-double threadCpuMillis() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
 
 using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
@@ -102,10 +96,10 @@ int main(int argc, char** argv) {
     }
     for (int run = 0; run < 5; ++run) {
       const auto start = std::chrono::steady_clock::now();
-      const double cpuStart = threadCpuMillis();
+      const double cpuStart = thinlod::threadCpuSeconds() * 1e3;
       auto result = thinlod::simplifier::measureSurfaceError(*original, simplified, options);
       const auto stop = std::chrono::steady_clock::now();
-      cpuMillis.push_back(threadCpuMillis() - cpuStart);
+      cpuMillis.push_back(thinlod::threadCpuSeconds() * 1e3 - cpuStart);
       if (!result.ok()) {
         std::fprintf(stderr, "%s\n", result.status().toString().c_str());
         return 1;
