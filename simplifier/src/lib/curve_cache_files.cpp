@@ -14,6 +14,20 @@ Result<std::string> readCacheFile(const std::filesystem::path& path) {
   return readFileBounded(path.string(), kMaxCacheFileBytes);
 }
 
+Status checkCacheHeader(const nlohmann::json& document, const char* format, int version,
+                        const std::string& expectedKey, const std::string& what) {
+  if (document.at("format").get<std::string>() != format)
+    return Status(ErrorCode::kParseError, what + ": format is not " + format);
+  const int stored = document.at("version").get<int>();
+  if (stored != version) {
+    return Status(ErrorCode::kVersionMismatch, what + ": version " + std::to_string(stored) +
+                                                   ", expected " + std::to_string(version));
+  }
+  if (document.at("key").get<std::string>() != expectedKey)
+    return Status(ErrorCode::kParseError, what + ": key mismatch");
+  return Status();
+}
+
 Status writeFileAtomically(const std::filesystem::path& path, const std::string& text) {
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,14 @@ class KeyHasher {
 
 // The file's text, at most kMaxCacheFileBytes (readFileBounded).
 Result<std::string> readCacheFile(const std::filesystem::path& path);
+
+// The header every cache file's JSON object carries: "format", "version"
+// and "key". kParseError ("<what>: format is not ..." / "key mismatch") for
+// another format or key, kVersionMismatch ("<what>: version V, expected E")
+// for another version. A missing or mistyped field throws nlohmann's
+// exception, which the parsers catch as a parse error.
+Status checkCacheHeader(const nlohmann::json& document, const char* format, int version,
+                        const std::string& expectedKey, const std::string& what);
 
 // Writes to a unique temporary name, then renames over the target: readers
 // never see a half-written file; concurrent writers race benignly.

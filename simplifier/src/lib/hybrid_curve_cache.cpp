@@ -111,16 +111,8 @@ Result<std::vector<HybridMeasuredLevel>> parseHybridLevels(const std::string& te
   const Json document = Json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (document.is_discarded() || !document.is_object()) return parseError("not a JSON object");
   try {
-    if (document.at("format").get<std::string>() != kFormatName) {
-      return parseError("format is not " + std::string(kFormatName));
-    }
-    const int version = document.at("version").get<int>();
-    if (version != kHybridCurveFormatVersion) {
-      return Status(ErrorCode::kVersionMismatch, "hybrid curve cache: version " +
-                                                     std::to_string(version) + ", expected " +
-                                                     std::to_string(kHybridCurveFormatVersion));
-    }
-    if (document.at("key").get<std::string>() != expectedKey) return parseError("key mismatch");
+    THINLOD_RETURN_IF_ERROR(
+        curve_cache::checkCacheHeader(document, kFormatName, kHybridCurveFormatVersion, expectedKey, "hybrid curve cache"));
     const Json& rungs = document.at("rungs");
     if (!rungs.is_array()) return parseError("rungs is not an array");
     // geometricLadder gives at most `levels` targets, plus the input.

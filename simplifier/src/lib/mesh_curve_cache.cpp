@@ -138,16 +138,8 @@ Result<MeshCurves> parseMeshCurves(const std::string& text, const std::string& e
   const Json document = Json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (document.is_discarded() || !document.is_object()) return parseError("not a JSON object");
   try {
-    if (document.at("format").get<std::string>() != kFormatName) {
-      return parseError("format is not " + std::string(kFormatName));
-    }
-    const int version = document.at("version").get<int>();
-    if (version != kMeshCurveFormatVersion) {
-      return Status(ErrorCode::kVersionMismatch, "mesh curve cache: version " +
-                                                     std::to_string(version) + ", expected " +
-                                                     std::to_string(kMeshCurveFormatVersion));
-    }
-    if (document.at("key").get<std::string>() != expectedKey) return parseError("key mismatch");
+    THINLOD_RETURN_IF_ERROR(
+        curve_cache::checkCacheHeader(document, kFormatName, kMeshCurveFormatVersion, expectedKey, "mesh curve cache"));
 
     MeshCurves curves;
     std::vector<AccuracySample> triangleSamples;
