@@ -3,7 +3,9 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <fstream>
+#include <stdexcept>
 #include <system_error>
 
 #include "thinlod/common/core/file_bytes.h"
@@ -12,6 +14,15 @@ namespace thinlod::simplifier::curve_cache {
 
 Result<std::string> readCacheFile(const std::filesystem::path& path) {
   return readFileBounded(path.string(), kMaxCacheFileBytes);
+}
+
+double nonNegativeField(const nlohmann::json& object, const char* field) {
+  const double value = object.at(field).get<double>();
+  if (!std::isfinite(value) || value < 0.0) {
+    throw std::runtime_error(std::string("field ") + field +
+                             " is not a finite non-negative number");
+  }
+  return value;
 }
 
 Status checkCacheHeader(const nlohmann::json& document, const char* format, int version,

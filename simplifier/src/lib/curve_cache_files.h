@@ -60,6 +60,10 @@ class KeyHasher {
 // The file's text, at most kMaxCacheFileBytes (readFileBounded).
 Result<std::string> readCacheFile(const std::filesystem::path& path);
 
+// object[field] as a finite number >= 0; throws (as nlohmann does for a
+// missing or mistyped field) otherwise, so a parser's catch reports it.
+double nonNegativeField(const nlohmann::json& object, const char* field);
+
 // The header every cache file's JSON object carries: "format", "version"
 // and "key". kParseError ("<what>: format is not ..." / "key mismatch") for
 // another format or key, kVersionMismatch ("<what>: version V, expected E")

@@ -21,15 +21,6 @@ Status parseError(const std::string& message) {
   return Status(ErrorCode::kParseError, "hybrid curve cache: " + message);
 }
 
-double finiteField(const Json& object, const char* field) {
-  const double value = object.at(field).get<double>();
-  if (!std::isfinite(value) || value < 0.0) {
-    throw std::runtime_error(std::string("field ") + field +
-                             " is not a finite non-negative number");
-  }
-  return value;
-}
-
 std::string rungText(std::size_t i) { return "rung " + std::to_string(i); }
 
 }  // namespace
@@ -125,14 +116,14 @@ Result<std::vector<HybridMeasuredLevel>> parseHybridLevels(const std::string& te
     for (const Json& r : rungs) {
       if (!r.is_object()) return parseError(rungText(out.size()) + " is not an object");
       HybridMeasuredLevel level;
-      level.step.error = finiteField(r, "error");
-      level.step.units = finiteField(r, "units");
+      level.step.error = curve_cache::nonNegativeField(r, "error");
+      level.step.units = curve_cache::nonNegativeField(r, "units");
       if (!r.at("triangles").is_number_unsigned() || !r.at("points").is_number_unsigned()) {
         return parseError(rungText(out.size()) + ": counts are not unsigned integers");
       }
       level.step.triangles = r.at("triangles").get<std::size_t>();
       level.step.points = r.at("points").get<std::size_t>();
-      level.measuredError = finiteField(r, "measuredError");
+      level.measuredError = curve_cache::nonNegativeField(r, "measuredError");
       out.push_back(level);
     }
     THINLOD_RETURN_IF_ERROR(validateHybridLevels(out, graph, levels));

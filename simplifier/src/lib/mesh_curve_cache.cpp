@@ -31,15 +31,6 @@ Status parseError(const std::string& message) {
   return Status(ErrorCode::kParseError, "mesh curve cache: " + message);
 }
 
-double finiteNumber(const Json& object, const char* field) {
-  const double value = object.at(field).get<double>();
-  if (!std::isfinite(value) || value < 0.0) {
-    throw std::runtime_error(std::string("field ") + field +
-                             " is not a finite non-negative number");
-  }
-  return value;
-}
-
 Result<AccuracyCurve> curveFromJson(const Json& value, const char* name) {
   if (value.is_null()) return AccuracyCurve();
   std::vector<CurveTriple> triples;
@@ -148,15 +139,15 @@ Result<MeshCurves> parseMeshCurves(const std::string& text, const std::string& e
       CurveLevel level;
       level.requestedTriangles = l.at("requestedTriangles").get<std::size_t>();
       level.triangles = l.at("triangles").get<std::size_t>();
-      level.relativeMaxError = finiteNumber(l, "relativeMaxError");
-      level.relativeHausdorffError = finiteNumber(l, "relativeHausdorffError");
-      level.relativeTextureError = finiteNumber(l, "relativeTextureError");
-      level.relativeTextureMaxError = finiteNumber(l, "relativeTextureMaxError");
-      level.relativeMeanError = finiteNumber(l, "relativeMeanError");
-      level.accuracy = finiteNumber(l, "accuracy");
+      level.relativeMaxError = curve_cache::nonNegativeField(l, "relativeMaxError");
+      level.relativeHausdorffError = curve_cache::nonNegativeField(l, "relativeHausdorffError");
+      level.relativeTextureError = curve_cache::nonNegativeField(l, "relativeTextureError");
+      level.relativeTextureMaxError = curve_cache::nonNegativeField(l, "relativeTextureMaxError");
+      level.relativeMeanError = curve_cache::nonNegativeField(l, "relativeMeanError");
+      level.accuracy = curve_cache::nonNegativeField(l, "accuracy");
       level.encodedBytes = l.at("encodedBytes").get<std::size_t>();
       level.positionBits = l.at("positionBits").get<int>();
-      level.encodedAccuracy = finiteNumber(l, "encodedAccuracy");
+      level.encodedAccuracy = curve_cache::nonNegativeField(l, "encodedAccuracy");
       if (level.triangles == 0 || level.triangles > level.requestedTriangles ||
           !(level.accuracy > 0.0) ||
           (!curves.levels.empty() && level.triangles <= curves.levels.back().triangles)) {
