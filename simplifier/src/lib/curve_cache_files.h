@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/status.h"
 
 namespace thinlod::simplifier::curve_cache {
@@ -41,6 +42,15 @@ class KeyHasher {
   void vector(const std::vector<T>& v) {
     number(v.size());
     if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  // Every attribute of the mesh, in one order for every cache (a new
+  // attribute of IndexedMesh is added here once).
+  void mesh(const IndexedMesh& m) {
+    vector(m.positions);
+    vector(m.normals);
+    vector(m.uvs);
+    vector(m.colors);
+    vector(m.indices);
   }
   std::string hex() const {
     static const char* kDigits = "0123456789abcdef";

@@ -40,11 +40,7 @@ std::string hybridCurveCacheKey(const IndexedMesh& original, const HybridOptions
   h.number(static_cast<std::uint64_t>(error.samplesPerMesh));
   h.number(error.seed);
   h.number(error.includeVerticesAndEdges);
-  h.vector(original.positions);
-  h.vector(original.normals);
-  h.vector(original.uvs);
-  h.vector(original.colors);
-  h.vector(original.indices);
+  h.mesh(original);
   return h.hex();
 }
 

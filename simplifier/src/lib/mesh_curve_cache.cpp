@@ -93,11 +93,7 @@ std::string meshCurveCacheKey(const IndexedMesh& original, const std::string& pr
   h.number(options.encode.texcoordBits);
   h.number(options.encode.encodeSpeed);
   h.number(options.encode.decodeSpeed);
-  h.vector(original.positions);
-  h.vector(original.normals);
-  h.vector(original.uvs);
-  h.vector(original.colors);
-  h.vector(original.indices);
+  h.mesh(original);
   return h.hex();
 }
 
