@@ -152,6 +152,52 @@ TEST(Budgets, BelowTheCheapestPlanTheLeastVisibleObjectsAreDropped) {
   EXPECT_EQ(plan->dropped.size(), 4u);
 }
 
+TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
+  // The nearest object has nothing at the frontend and its cheapest mesh
+  // (5 triangles at 200 B each = 1000 B) exceeds a 400 B/s link over the 1 s
+  // lifetime; the three farther ones hold copies, which cost no link bytes.
+  // Only the nearest is dropped: dropping a held copy makes no room on the
+  // link and would blank what the frontend already shows.
+  SceneBuilder b;
+  const int root = b.group(-1);
+  for (int i = 0; i < 4; ++i)
+    b.leaf(root, {{0, 0, -5.0 - 10.0 * i}, 0.5}, {meshOption(5, 100, 50, 1000, 200.0)});
+  SchedulingScene scene = b.build();
+  for (std::uint32_t object = 1; object < 4; ++object) {
+    RepresentationCopy& copy = scene.options[scene.objects[object].firstOption].atFrontend;
+    copy.present = true;
+    copy.id = 100 + object;
+    copy.relativeAccuracy = 20.0;
+    copy.triangles = 400.0;
+    copy.encodedBytes = 80000.0;
+    copy.validity = ConicRange::everywhere();
+  }
+  updateSubtreeVersions(scene);
+  auto scheduler = curveScheduler(exactConfig());
+  PlannerState state;
+  Budget budget;
+  budget.maxLinkBytesPerSecond = 400.0;
+  auto plan = scheduler->plan(scene, viewerAt({0, 0, 0}, {0, 0, -1}), budget, state);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  EXPECT_EQ(plan->dropped, (std::vector<std::uint32_t>{0}));
+  EXPECT_EQ(plan->linkBytesThisStep, 0.0);
+  EXPECT_TRUE(plan->removals.empty());
+  std::vector<std::uint32_t> kept;
+  for (const ObjectDecision& d : plan->decisions)
+    if (d.action == ObjectAction::kKeep) kept.push_back(d.object);
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(kept, (std::vector<std::uint32_t>{1, 2, 3}));
+  // The same with a polygon budget too (the pair): the copies' 1200
+  // triangles fit 2000, so again only the link overruns.
+  budget.maxTriangles = 2000.0;
+  PlannerState both;
+  plan = scheduler->plan(scene, viewerAt({0, 0, 0}, {0, 0, -1}), budget, both);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  EXPECT_EQ(plan->dropped, (std::vector<std::uint32_t>{0}));
+  EXPECT_LE(plan->predictedTriangles, 2000.0);
+  EXPECT_TRUE(plan->removals.empty());
+}
+
 TEST(FixedAccuracy, EveryVisibleObjectMeetsTheTargetOrIsReported) {
   SceneBuilder b;
   const int root = b.group(-1);

@@ -612,26 +612,57 @@ bool JointSolver::feasible(double accuracy) {
 
 std::size_t JointSolver::dropUntilFeasible(const ViewerState& viewer) {
   if (feasible(0.0)) return 0;
+  // feasible(0) left every leaf's cheapest cost at accuracy 0 in
+  // minTriangles_/minLink_ (at 0 every LOD level qualifies). A leaf costing
+  // nothing in each budget the cheapest plan overruns cannot make room:
+  // dropping it only blanks it. The typical one holds a frontend copy (no
+  // link bytes) while the link cannot carry anything new (a cut link), and
+  // dropping it would take a picture the client already has off the screen.
+  // So only leaves that cost something in an overrun budget are dropped;
+  // when no budget overruns alone (the pair does), every leaf may be.
+  const std::uint32_t root = static_cast<std::uint32_t>(root_);
+  const bool trianglesShort = budget_.useTriangles && !(minTriangles_[root] <= budget_.triangles);
+  const bool linkShort = budget_.useLink && !(minLink_[root] <= budget_.linkBytes);
   std::vector<std::uint32_t> leaves;
+  std::vector<std::uint32_t> freeLeaves;
   std::vector<double> priority(nodes_.size(), 0.0);
   const ViewCone cone(viewer);
   for (std::uint32_t k = 0; k < nodes_.size(); ++k) {
     const Node& n = nodes_[k];
     if (n.kind != SceneNodeKind::kLeaf || n.candidateCount == 0) continue;
-    leaves.push_back(k);
+    const bool helps = (!trianglesShort && !linkShort) ||
+                       (trianglesShort && !(minTriangles_[k] <= 0.0)) ||
+                       (linkShort && !(minLink_[k] <= 0.0));
+    (helps ? leaves : freeLeaves).push_back(k);
     priority[k] = cone.keepPriority(scene_.nodes[n.sceneNode].bounds, n.diameter, n.distance);
   }
-  std::sort(leaves.begin(), leaves.end(), [&](std::uint32_t a, std::uint32_t b) {
+  // The free leaves go after every other in the order below, so the search
+  // reaches them only if dropping all the others still does not fit (not
+  // expected: their cheapest costs are 0 in the overrun budgets).
+  const std::size_t helpful = leaves.size();
+  auto byPriority = [&](std::uint32_t a, std::uint32_t b) {
     if (priority[a] != priority[b]) return priority[a] < priority[b];
     return nodes_[a].sceneNode < nodes_[b].sceneNode;
-  });
+  };
+  std::sort(leaves.begin(), leaves.end(), byPriority);
+  std::sort(freeLeaves.begin(), freeLeaves.end(), byPriority);
+  leaves.insert(leaves.end(), freeLeaves.begin(), freeLeaves.end());
   auto apply = [&](std::size_t count) {
     for (std::size_t i = 0; i < leaves.size(); ++i) nodes_[leaves[i]].dropped = i < count;
     refreshAccuracyBounds();
   };
-  // Dropping more never costs more: binary search the fewest drops.
+  // Dropping more never costs more: binary search the fewest drops, first
+  // among the leaves that cost something in an overrun budget.
   std::size_t lo = 0;  // infeasible
   std::size_t hi = leaves.size();
+  if (helpful < leaves.size()) {
+    apply(helpful);
+    if (feasible(0.0)) {
+      hi = helpful;
+    } else {
+      lo = helpful;
+    }
+  }
   while (hi - lo > 1) {
     const std::size_t mid = lo + (hi - lo) / 2;
     apply(mid);

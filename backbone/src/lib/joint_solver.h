@@ -45,7 +45,9 @@ class JointSolver {
   double highestAccuracy() const;
   bool feasible(double accuracy);
   // Drops the least visible leaves (lowest keepPriority, scheduler_common.h)
-  // until the cheapest plan fits; returns how many.
+  // until the cheapest plan fits; returns how many. Leaves that cost nothing
+  // in every budget the cheapest plan overruns (a held copy when the link is
+  // what overruns) are dropped only if dropping all the others is not enough.
   std::size_t dropUntilFeasible(const ViewerState& viewer);
   // The largest feasible accuracy <= cap, or nullopt when even the cheapest
   // plan does not fit. `hint` (optional) narrows the bisection.
