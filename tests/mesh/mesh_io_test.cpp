@@ -394,6 +394,57 @@ TEST(MeshIo, ObjCarriageReturnWithoutLineFeedIsRejected) {
   EXPECT_EQ(crlf->mesh.triangleCount(), 1u);
 }
 
+// Fuzz finding (session 10 campaign, fuzz/corpus/mesh/crash-obj-vertex-beyond-float.obj;
+// OpenMesh assert, an out-of-bounds normal write in Release): OpenMesh reads
+// coordinates as floats with operator>>, which fails beyond FLT_MAX and
+// drops the vertex, so a face checked against our count indexed past its
+// vertices. Numbers beyond the float range are refused in every text format.
+TEST(MeshIo, NumbersBeyondTheFloatRangeAreRejected) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 1e39 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 4//1\n";
+  Result<LoadedMesh> r = loadMeshFromMemory(obj, "obj", "big.obj");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(contains(r.status().message(), "big.obj:3: vertex has a number beyond the float range"))
+      << r.status().message();
+  Result<LoadedMesh> normal =
+      loadMeshFromMemory("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 -4e38\nf 1//1 2//1 3//1\n", "obj",
+                         "n.obj");
+  ASSERT_FALSE(normal.ok());
+  EXPECT_TRUE(contains(normal.status().message(), "n.obj:4: normal has a number beyond the float range"))
+      << normal.status().message();
+  Result<LoadedMesh> off =
+      loadMeshFromMemory("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1e300 0\n3 0 1 2\n", "off", "big.off");
+  ASSERT_FALSE(off.ok());
+  EXPECT_TRUE(contains(off.status().message(), "beyond the float range")) << off.status().message();
+  // The largest float itself is in range and loads.
+  Result<LoadedMesh> edge = loadMeshFromMemory(
+      "v 0 0 0\nv 3.4028234e38 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "edge.obj");
+  ASSERT_TRUE(edge.ok()) << edge.status().toString();
+  EXPECT_EQ(edge->mesh.triangleCount(), 1u);
+}
+
+// Fuzz finding (session 10 campaign, fuzz/corpus/mesh/crash-obj-vertical-tab-before-vertex.obj;
+// OpenMesh assert, an out-of-bounds texture-coordinate write in Release):
+// OpenMesh skips a line that starts with a vertical tab or form feed after
+// spaces and tabs, so such a vertex existed for the pre-check only.
+TEST(MeshIo, ObjLinesStartingWithVerticalTabOrFormFeedAreRejected) {
+  for (const char* lead : {"\v", "\f", " \v", "\t\f"}) {
+    const std::string obj = std::string("v 0 0 0\nv 1 0 0\n") + lead +
+                            "v 0 1 0\nv 0 0 1\nvt 0 0\nf 1/1 2/1 4/1\n";
+    Result<LoadedMesh> r = loadMeshFromMemory(obj, "obj", "ws.obj");
+    ASSERT_FALSE(r.ok()) << "lead of " << std::strlen(lead) << " characters";
+    EXPECT_TRUE(contains(r.status().message(),
+                         "ws.obj:3: line starts with a vertical tab or form feed"))
+        << r.status().message();
+  }
+  // White space alone is a blank line, and a vertical tab between words is
+  // a separator for both readers.
+  Result<LoadedMesh> blank =
+      loadMeshFromMemory("v 0 0 0\n\f\nv 1 0 0\nv\v0 1 0\nf 1 2 3\n", "obj", "blank.obj");
+  ASSERT_TRUE(blank.ok()) << blank.status().toString();
+  EXPECT_EQ(blank->mesh.triangleCount(), 1u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

@@ -87,6 +87,17 @@ Status checkFiniteNumbers(const std::vector<std::string_view>& tokens, std::size
       return lineError(name, line,
                        std::string(what) + " has a non-finite coordinate " + quoted(tokens[i]));
     }
+    // OpenMesh's readers parse floats with operator>>, which fails on a
+    // value beyond the float range and leaves the element out, so face
+    // references checked against our count went past its vertices (an
+    // out-of-bounds normal write; fuzz campaign of session 10, seed
+    // fuzz/corpus/mesh/crash-obj-vertex-beyond-float.obj). The mesh stores
+    // floats anyway.
+    if (std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max())) {
+      return lineError(name, line,
+                       std::string(what) + " has a number beyond the float range " +
+                           quoted(tokens[i]));
+    }
   }
   return Status();
 }
@@ -172,6 +183,16 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
     if (tokens.empty() || tokens[0][0] == '#') continue;
     const std::string_view key = tokens[0];
     const int ln = scanner.lineNumber();
+    // OpenMesh trims spaces and tabs only and then skips a line that starts
+    // with any other white space, so "\vv 0 1 0" was a vertex to us and none
+    // to it, and a face checked against our count wrote a texture
+    // coordinate past its vertices (fuzz campaign of session 10, seed
+    // fuzz/corpus/mesh/crash-obj-vertical-tab-before-vertex.obj). Refused,
+    // naming the line; white space alone stays a blank line.
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (line[first] == '\v' || line[first] == '\f') {
+      return lineError(name, ln, "line starts with a vertical tab or form feed");
+    }
     if (key == "v") {
       THINLOD_RETURN_IF_ERROR(checkFiniteNumbers(tokens, 1, 3, name, ln, "vertex"));
       THINLOD_RETURN_IF_ERROR(checkObjVertexColour(tokens, name, ln));
