@@ -198,6 +198,70 @@ TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
   EXPECT_TRUE(plan->removals.empty());
 }
 
+TEST(Budgets, ExpiredCopiesStayOnScreenWhileTheTrianglesFit) {
+  // As above, but the held copies' validity (a ball 100 m away) no longer
+  // covers the predicted region, so no leaf has anything eligible that the
+  // 400 B/s link can carry. The frontend's copies stay (kept, absolute
+  // accuracy 0, below the target) instead of blanking the screen; with a
+  // polygon budget only as many as fit, the most visible first.
+  SceneBuilder b;
+  const int root = b.group(-1);
+  for (int i = 0; i < 4; ++i)
+    b.leaf(root, {{0, 0, -5.0 - 10.0 * i}, 0.5}, {meshOption(5, 100, 50, 1000, 200.0)});
+  SchedulingScene scene = b.build();
+  for (std::uint32_t object = 1; object < 4; ++object) {
+    RepresentationCopy& copy = scene.options[scene.objects[object].firstOption].atFrontend;
+    copy.present = true;
+    copy.id = 100 + object;
+    copy.relativeAccuracy = 20.0;
+    copy.triangles = 400.0;
+    copy.encodedBytes = 80000.0;
+    copy.validity = ConicRange::ball({100.0, 0.0, 0.0}, 1.0);
+  }
+  updateSubtreeVersions(scene);
+  auto scheduler = curveScheduler(exactConfig());
+  const ViewerState viewer = viewerAt({0, 0, 0}, {0, 0, -1});
+  Budget budget;
+  budget.maxLinkBytesPerSecond = 400.0;
+  PlannerState state;
+  auto plan = scheduler->plan(scene, viewer, budget, state);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  EXPECT_EQ(plan->dropped, (std::vector<std::uint32_t>{0}));
+  EXPECT_EQ(plan->linkBytesThisStep, 0.0);
+  EXPECT_TRUE(plan->removals.empty());
+  EXPECT_EQ(plan->stats.expiredCopiesKept, 3u);
+  std::vector<std::uint32_t> kept;
+  for (const ObjectDecision& d : plan->decisions) {
+    if (d.action != ObjectAction::kKeep) continue;
+    kept.push_back(d.object);
+    EXPECT_EQ(d.source, CandidateSource::kFrontendCopy);
+    EXPECT_EQ(d.absoluteAccuracy, 0.0);  // nothing is guaranteed outside its validity
+    EXPECT_TRUE(d.belowTarget);
+    EXPECT_EQ(d.triangles, 400.0);
+  }
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(kept, (std::vector<std::uint32_t>{1, 2, 3}));
+  std::vector<std::uint32_t> below = plan->belowTarget;
+  std::sort(below.begin(), below.end());
+  EXPECT_EQ(below, (std::vector<std::uint32_t>{1, 2, 3}));
+  EXPECT_EQ(plan->predictedTriangles, 1200.0);
+
+  // 900 triangles hold two copies: the two nearest stay, the farthest is
+  // dropped and its copy removed.
+  budget.maxTriangles = 900.0;
+  PlannerState capped;
+  plan = scheduler->plan(scene, viewer, budget, capped);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  EXPECT_LE(plan->predictedTriangles, 900.0);
+  EXPECT_EQ(plan->stats.expiredCopiesKept, 2u);
+  std::vector<std::uint32_t> dropped = plan->dropped;
+  std::sort(dropped.begin(), dropped.end());
+  EXPECT_EQ(dropped, (std::vector<std::uint32_t>{0, 3}));
+  ASSERT_EQ(plan->removals.size(), 1u);
+  EXPECT_EQ(plan->removals[0].object, 3u);
+
+}
+
 TEST(FixedAccuracy, EveryVisibleObjectMeetsTheTargetOrIsReported) {
   SceneBuilder b;
   const int root = b.group(-1);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "frame_time_model.h"
@@ -205,6 +206,38 @@ TEST(TimeCriticalScheduler, ImpossibleFrameBudgetDropsTheLeastVisible) {
   for (const ObjectDecision& d : plan->decisions)
     if (d.action != ObjectAction::kRemove) worstKept = std::min(worstKept, visibility(d.object));
   for (std::uint32_t o : plan->dropped) EXPECT_LE(visibility(o), worstKept * (1.0 + 1e-9));
+}
+
+// Expired copies (finishPlan) fill triangle room only; under a frame-time
+// budget a dropped object's held copy is removed, so the modelled time holds.
+TEST(TimeCriticalScheduler, DroppedObjectsLoseTheirExpiredCopiesUnderAFrameTimeBudget) {
+  SchedulingScene s = scene(5, 60);
+  for (const SceneObject& object : s.objects) {
+    RepresentationCopy& copy = s.options[object.firstOption].atFrontend;
+    copy.present = true;
+    copy.id = 1000 + object.firstOption;
+    copy.relativeAccuracy = 1.0;
+    copy.triangles = 10.0;
+    copy.encodedBytes = 2000.0;
+    copy.validity = ConicRange::ball({1000.0, 0.0, 0.0}, 1.0);  // expired everywhere here
+  }
+  updateSubtreeVersions(s);
+  TimeCriticalConfig tc;
+  tc.costs = llvmpipeLike();
+  tc.frameBudgetSeconds = 1.2e-3;
+  auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
+  PlannerState state;
+  const ViewerState viewer = viewerAt({0.0, 0.0, 80.0}, {0.0, 0.0, -1.0});
+  auto plan = scheduler->plan(s, viewer, noPolygonCap(), state);
+  ASSERT_TRUE(plan.ok()) << plan.status().toString();
+  ASSERT_FALSE(plan->dropped.empty());
+  EXPECT_EQ(plan->stats.expiredCopiesKept, 0u);
+  EXPECT_LE(modelledSeconds(s, *plan, viewer, tc.costs, standing()), 1.2e-3 * (1.0 + 1e-9));
+  for (std::uint32_t o : plan->dropped) {
+    const bool removed = std::any_of(plan->removals.begin(), plan->removals.end(),
+                                     [&](const Removal& r) { return r.object == o; });
+    EXPECT_TRUE(removed) << "object " << o;
+  }
 }
 
 TEST(TimeCriticalScheduler, StandingViewerKeepsItsLoadFromStepToStep) {

@@ -948,6 +948,7 @@ PoseOutcome BackboneCore::finishPose() {
   const backbone::Plan& plan = *plan_;
   out.planned = true;
   out.row = plan.row;
+  out.expiredCopiesKept = plan.stats.expiredCopiesKept;
   out.row.requests = requestsThisPose_;
   out.row.schedulingMicroseconds = schedulingMicrosecondsThisPose_;
   out.update.targetAccuracy =

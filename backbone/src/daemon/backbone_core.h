@@ -158,6 +158,7 @@ struct PoseOutcome {
   std::uint64_t linkBytes = 0;        // shaped bytes of this update
   std::uint64_t linkRate = 0;         // the shaper's rate at this pose (bytes/s; 0: no link budget)
   double frontendTriangles = 0.0;     // after the update is applied
+  std::uint32_t expiredCopiesKept = 0;  // PlanStats::expiredCopiesKept of the final plan
 };
 
 class BackboneCore {

@@ -483,10 +483,11 @@ class Daemon {
       const auto& row = outcome.row;
       spdlog::info(
           "event=plan frame={} target={:.4g} triangles={:.0f} requests={} sends={} keeps={} "
-          "adds={} removes={} frontend_triangles={:.0f} link_bytes={} plans={} ms={:.2f}",
+          "expired_kept={} adds={} removes={} frontend_triangles={:.0f} link_bytes={} plans={} "
+          "ms={:.2f}",
           pose.sequence, row.targetAccuracy, row.predictedTriangles, row.requests, row.sends,
-          row.keeps, outcome.adds, outcome.removes, outcome.frontendTriangles, outcome.linkBytes,
-          outcome.plans, ms);
+          row.keeps, outcome.expiredCopiesKept, outcome.adds, outcome.removes,
+          outcome.frontendTriangles, outcome.linkBytes, outcome.plans, ms);
     }
     if (outcome.linkRate != 0 && outcome.linkRate != lastLinkRate_) {
       spdlog::info("event=link_rate frame={} bytes_per_s={}", pose.sequence, outcome.linkRate);

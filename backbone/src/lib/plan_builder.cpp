@@ -3,6 +3,7 @@
 #include <cstring>
 #include <glm/geometric.hpp>
 
+#include "scheduler_common.h"
 #include "selection.h"
 
 namespace thinlod::backbone {
@@ -252,7 +253,7 @@ double recentLinkBytes(const PlannerStateImpl& state, double now, double window)
 }
 
 void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
-                double targetAccuracy, Plan& plan) {
+                double targetAccuracy, std::optional<double> expiredCopyRoom, Plan& plan) {
   PlannerStateImpl& state = ctx.state;
   const double now = ctx.viewer.timeSeconds;
   plan.region = ctx.region;
@@ -272,15 +273,11 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
   std::uint32_t keeps = 0;
   std::uint32_t sends = 0;
   const double belowLimit = targetAccuracy * (1.0 - 1e-9);
+  std::vector<const LeafSelection*> unrendered;
 
   for (LeafSelection& s : selections) {
     if (!s.rendered) {
-      if (s.dropped) {
-        plan.dropped.push_back(s.object);
-      } else {
-        plan.belowTarget.push_back(s.object);  // nothing eligible: cannot reach the target
-      }
-      removeAllCopies(ctx, s.object, plan, true);
+      unrendered.push_back(&s);
       continue;
     }
     rendered.push_back(s.object);
@@ -363,6 +360,66 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
       }
     }
     plan.decisions.push_back(d);
+  }
+
+  // Unrendered leaves keep an expired copy where the triangles allow (a picture
+  // the client already has beats a blank one: a link cut below the size of
+  // any new representation otherwise empties the screen as the viewer moves
+  // out of the held copies' regions); the rest lose their copies.
+  if (expiredCopyRoom && unrendered.size() > 1) {
+    const ViewCone cone(ctx.viewer);
+    auto priority = [&](const LeafSelection* s) {
+      return s->distance > 0.0 ? cone.keepPriority(ctx.scene.nodes[s->node].bounds, s->diameter,
+                                                   s->distance)
+                               : 0.0;
+    };
+    std::stable_sort(unrendered.begin(), unrendered.end(),
+                     [&](const LeafSelection* a, const LeafSelection* b) {
+                       return priority(a) > priority(b);
+                     });
+  }
+  double room = expiredCopyRoom ? *expiredCopyRoom - triangles : -kInf;
+  for (const LeafSelection* s : unrendered) {
+    const SceneObject& obj = ctx.scene.objects[s->object];
+    std::int32_t kept = -1;
+    for (std::uint32_t k = 0; k < obj.optionCount && kept < 0; ++k) {
+      const RepresentationCopy& copy = ctx.scene.options[obj.firstOption + k].atFrontend;
+      if (copy.present && copy.triangles <= room) kept = static_cast<std::int32_t>(obj.firstOption + k);
+    }
+    if (kept < 0) {
+      if (s->dropped) {
+        plan.dropped.push_back(s->object);
+      } else {
+        plan.belowTarget.push_back(s->object);  // nothing eligible: cannot reach the target
+      }
+      removeAllCopies(ctx, s->object, plan, true);
+      continue;
+    }
+    const RepresentationOption& option = ctx.scene.options[static_cast<std::uint32_t>(kept)];
+    ObjectDecision d;
+    d.object = s->object;
+    d.action = ObjectAction::kKeep;
+    d.option = kept;
+    d.kind = option.kind;
+    d.source = CandidateSource::kFrontendCopy;
+    d.relativeAccuracy = option.atFrontend.relativeAccuracy;
+    d.absoluteAccuracy = 0.0;
+    d.triangles = option.atFrontend.triangles;
+    d.belowTarget = true;
+    plan.belowTarget.push_back(s->object);
+    plan.decisions.push_back(d);
+    for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
+      const std::uint32_t index = obj.firstOption + k;
+      const RepresentationCopy& copy = ctx.scene.options[index].atFrontend;
+      if (copy.present && index != static_cast<std::uint32_t>(kept))
+        plan.removals.push_back({s->object, index, copy.id});
+    }
+    room -= d.triangles;
+    triangles += d.triangles;
+    minAccuracy = 0.0;
+    ++keeps;
+    rendered.push_back(s->object);
+    ++plan.stats.expiredCopiesKept;
   }
 
   // Objects that lost their representation since the previous plan (culled

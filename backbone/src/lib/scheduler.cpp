@@ -90,7 +90,14 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
   const double target = selection.targetAccuracy.value_or(lowestRenderedAccuracy(selection.leaves));
 
   PlanContext context{scene, seen, viewer, region, state};
-  finishPlan(context, selection.leaves, target, plan);
+  // Expired copies fill only triangle room the polygon budget leaves. A method
+  // with a frame-cost model keeps none: its budget is modelled time, which
+  // this frame cannot check (active-set's frame-time mode may come from its
+  // own config, not from Budget::maxFrameSeconds).
+  std::optional<double> expiredCopyRoom;
+  if (!method_->modelsFrameTime())
+    expiredCopyRoom = budget.maxTriangles.value_or(std::numeric_limits<double>::infinity());
+  finishPlan(context, selection.leaves, target, expiredCopyRoom, plan);
   // The selections are consumed: keep their storage for the next step.
   state.spareSelections = std::move(selection.leaves);
   plan.row.schedulingMicroseconds =

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "planner_state_impl.h"
@@ -71,7 +72,15 @@ struct PlanContext {
 
 // Fills every field of `plan` except stats fields the scheduler set and
 // scheduler/mode/target; selections are consumed in order.
+//
+// Expired copies: a visible leaf the selection does not render (dropped, or
+// nothing eligible) whose frontend still holds a copy keeps that copy, most
+// visible leaf first, while its triangles fit in `expiredCopyRoom` (the
+// triangle budget left by the rendered leaves; nullopt: never keep one). Such
+// a copy costs no link bytes, is kept (ObjectAction::kKeep) with absolute
+// accuracy 0 (its validity no longer covers the region, so nothing is
+// guaranteed) and is listed in Plan::belowTarget, not Plan::dropped.
 void finishPlan(const PlanContext& context, std::vector<LeafSelection>& selections,
-                double targetAccuracy, Plan& plan);
+                double targetAccuracy, std::optional<double> expiredCopyRoom, Plan& plan);
 
 }  // namespace thinlod::backbone

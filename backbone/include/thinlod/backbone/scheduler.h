@@ -112,6 +112,7 @@ struct PlanStats {
   std::uint32_t undecidedAccuracies = 0;  // > 0: pass limit hit, result may be below optimal
   std::uint32_t hysteresisKeeps = 0;      // copies kept although a cheaper one was chosen
   std::uint32_t budgetFillUpgrades = 0;   // leaves raised above the target by the budget fill
+  std::uint32_t expiredCopiesKept = 0;    // unrendered leaves keeping a copy past its validity
   // Triangles of the selection when the budget fill began (accuracy-curve,
   // fill on; 0 otherwise): the plan's predictedTriangles is at least this.
   double trianglesBeforeFill = 0.0;
