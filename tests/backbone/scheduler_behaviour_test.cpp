@@ -152,12 +152,10 @@ TEST(Budgets, BelowTheCheapestPlanTheLeastVisibleObjectsAreDropped) {
   EXPECT_EQ(plan->dropped.size(), 4u);
 }
 
-TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
-  // The nearest object has nothing at the frontend and its cheapest mesh
-  // (5 triangles at 200 B each = 1000 B) exceeds a 400 B/s link over the 1 s
-  // lifetime; the three farther ones hold copies, which cost no link bytes.
-  // Only the nearest is dropped: dropping a held copy makes no room on the
-  // link and would blank what the frontend already shows.
+// Four objects in a row ahead of the viewer (5, 15, 25, 35 m), each one mesh
+// of 5-100 triangles at 200 B per triangle; the three farther ones hold a
+// 400-triangle frontend copy with `validity`, the nearest holds nothing.
+SchedulingScene fourInARowThreeHeld(const ConicRange& validity) {
   SceneBuilder b;
   const int root = b.group(-1);
   for (int i = 0; i < 4; ++i)
@@ -170,9 +168,19 @@ TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
     copy.relativeAccuracy = 20.0;
     copy.triangles = 400.0;
     copy.encodedBytes = 80000.0;
-    copy.validity = ConicRange::everywhere();
+    copy.validity = validity;
   }
   updateSubtreeVersions(scene);
+  return scene;
+}
+
+TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
+  // The nearest object has nothing at the frontend and its cheapest mesh
+  // (5 triangles at 200 B each = 1000 B) exceeds a 400 B/s link over the 1 s
+  // lifetime; the three farther ones hold copies, which cost no link bytes.
+  // Only the nearest is dropped: dropping a held copy makes no room on the
+  // link and would blank what the frontend already shows.
+  SchedulingScene scene = fourInARowThreeHeld(ConicRange::everywhere());
   auto scheduler = curveScheduler(exactConfig());
   PlannerState state;
   Budget budget;
@@ -204,21 +212,7 @@ TEST(Budgets, ExpiredCopiesStayOnScreenWhileTheTrianglesFit) {
   // 400 B/s link can carry. The frontend's copies stay (kept, absolute
   // accuracy 0, below the target) instead of blanking the screen; with a
   // polygon budget only as many as fit, the most visible first.
-  SceneBuilder b;
-  const int root = b.group(-1);
-  for (int i = 0; i < 4; ++i)
-    b.leaf(root, {{0, 0, -5.0 - 10.0 * i}, 0.5}, {meshOption(5, 100, 50, 1000, 200.0)});
-  SchedulingScene scene = b.build();
-  for (std::uint32_t object = 1; object < 4; ++object) {
-    RepresentationCopy& copy = scene.options[scene.objects[object].firstOption].atFrontend;
-    copy.present = true;
-    copy.id = 100 + object;
-    copy.relativeAccuracy = 20.0;
-    copy.triangles = 400.0;
-    copy.encodedBytes = 80000.0;
-    copy.validity = ConicRange::ball({100.0, 0.0, 0.0}, 1.0);
-  }
-  updateSubtreeVersions(scene);
+  SchedulingScene scene = fourInARowThreeHeld(ConicRange::ball({100.0, 0.0, 0.0}, 1.0));
   auto scheduler = curveScheduler(exactConfig());
   const ViewerState viewer = viewerAt({0, 0, 0}, {0, 0, -1});
   Budget budget;
