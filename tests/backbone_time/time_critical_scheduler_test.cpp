@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 
 #include "frame_time_model.h"
@@ -64,6 +65,15 @@ double modelledSeconds(const SchedulingScene& s, const Plan& plan, const ViewerS
   return t;
 }
 
+// The optimiser's 5 ms time box (any-time, paper 4.1) makes a step's result
+// depend on how fast the machine is: the tests of what it converges to run
+// without it (the box itself: ActiveSet.ZeroTimeBoxReturnsTheFeasibleStartPoint).
+TimeCriticalConfig untimed() {
+  TimeCriticalConfig tc;
+  tc.timeBoxSeconds = std::numeric_limits<double>::infinity();
+  return tc;
+}
+
 // Budget has no frame-time field yet and needs some budget: a polygon cap
 // that never binds.
 Budget noPolygonCap() {
@@ -75,7 +85,7 @@ Budget noPolygonCap() {
 TEST(TimeCriticalScheduler, HoldsThePolygonBudgetAndUsesIt) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  auto scheduler = makeTimeCriticalScheduler(standing(), {}).value();
+  auto scheduler = makeTimeCriticalScheduler(standing(), untimed()).value();
   double used = 0.0;
   double offered = 0.0;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
@@ -101,7 +111,7 @@ TEST(TimeCriticalScheduler, HoldsTheFrameTimeBudget) {
   for (double budgetMs : {2.0, 5.0, 10.0, 30.0}) {
     for (std::uint64_t seed = 1; seed <= 8; ++seed) {
       SchedulingScene s = scene(seed, 120);
-      TimeCriticalConfig tc;
+      TimeCriticalConfig tc = untimed();
       tc.frameBudgetSeconds = budgetMs * 1e-3;
       tc.costs = costs;
       auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
@@ -127,6 +137,7 @@ TEST(TimeCriticalScheduler, HoldsTheBudgetsFrameTimeField) {
   const FrameCostConstants costs = llvmpipeLike();
   SchedulerOptions options;
   options.config = standing();
+  options.timeCritical = untimed();
   options.timeCritical.costs = costs;
   auto scheduler = makeScheduler("active-set", options).value();
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
@@ -166,7 +177,7 @@ TEST(TimeCriticalScheduler, FrameBudgetWithABindingPolygonCapHoldsBoth) {
   const FrameCostConstants costs = llvmpipeLike();
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     SchedulingScene s = scene(seed, 120);
-    TimeCriticalConfig tc;
+    TimeCriticalConfig tc = untimed();
     tc.frameBudgetSeconds = 30e-3;
     tc.costs = costs;
     auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
@@ -184,7 +195,7 @@ TEST(TimeCriticalScheduler, FrameBudgetWithABindingPolygonCapHoldsBoth) {
 
 TEST(TimeCriticalScheduler, ImpossibleFrameBudgetDropsTheLeastVisible) {
   SchedulingScene s = scene(5, 60);
-  TimeCriticalConfig tc;
+  TimeCriticalConfig tc = untimed();
   tc.costs = llvmpipeLike();
   tc.frameBudgetSeconds = 1.2e-3;  // 1 ms fixed, 0.2 ms for objects: 10 setups at most
   auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
@@ -222,7 +233,7 @@ TEST(TimeCriticalScheduler, DroppedObjectsLoseTheirExpiredCopiesUnderAFrameTimeB
     copy.validity = ConicRange::ball({1000.0, 0.0, 0.0}, 1.0);  // expired everywhere here
   }
   updateSubtreeVersions(s);
-  TimeCriticalConfig tc;
+  TimeCriticalConfig tc = untimed();
   tc.costs = llvmpipeLike();
   tc.frameBudgetSeconds = 1.2e-3;
   auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
@@ -242,7 +253,7 @@ TEST(TimeCriticalScheduler, DroppedObjectsLoseTheirExpiredCopiesUnderAFrameTimeB
 
 TEST(TimeCriticalScheduler, StandingViewerKeepsItsLoadFromStepToStep) {
   SchedulingScene s = scene(9, 100);
-  auto scheduler = makeTimeCriticalScheduler(standing(), {}).value();
+  auto scheduler = makeTimeCriticalScheduler(standing(), untimed()).value();
   PlannerState state;
   Budget budget;
   budget.maxTriangles = 20000.0;
@@ -267,7 +278,7 @@ TEST(TimeCriticalScheduler, ADriftingViewerKeepsItsCopiesWithinTheBand) {
   int kept[2] = {0, 0};
   for (int withBand = 0; withBand < 2; ++withBand) {
     SchedulingScene s = scene(9, 100);
-    TimeCriticalConfig tc;
+    TimeCriticalConfig tc = untimed();
     tc.keepCopyAccuracyShare = withBand ? 0.15 : 0.0;
     auto scheduler = makeTimeCriticalScheduler(standing(), tc).value();
     PlannerState state;
@@ -309,7 +320,7 @@ TEST(TimeCriticalScheduler, AcuityFavoursTheObjectInFocus) {
   SchedulingScene s = b.build();
   SchedulerConfig config = standing();
   config.maxViewDistance = 1000.0;
-  auto scheduler = makeTimeCriticalScheduler(config, {}).value();
+  auto scheduler = makeTimeCriticalScheduler(config, untimed()).value();
   PlannerState state;
   Budget budget;
   budget.maxTriangles = 3000.0;
@@ -334,7 +345,7 @@ TEST(TimeCriticalScheduler, RegisteredByNameAndAlias) {
 }
 
 TEST(TimeCriticalScheduler, RefusesBudgetsItCannotHonour) {
-  auto polygon = makeTimeCriticalScheduler(standing(), {}).value();
+  auto polygon = makeTimeCriticalScheduler(standing(), untimed()).value();
   Budget none;
   EXPECT_EQ(polygon->accepts(none).code(), ErrorCode::kUnsupported);
   Budget link;
