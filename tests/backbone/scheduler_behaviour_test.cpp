@@ -153,8 +153,9 @@ TEST(Budgets, BelowTheCheapestPlanTheLeastVisibleObjectsAreDropped) {
 }
 
 // Four objects in a row ahead of the viewer (5, 15, 25, 35 m), each one mesh
-// of 5-100 triangles at 200 B per triangle; the three farther ones hold a
-// 400-triangle frontend copy with `validity`, the nearest holds nothing.
+// of 100-1000 triangles (relative accuracy 5-50) at 200 B per triangle; the
+// three farther ones hold a 400-triangle frontend copy with `validity`, the
+// nearest holds nothing.
 SchedulingScene fourInARowThreeHeld(const ConicRange& validity) {
   SceneBuilder b;
   const int root = b.group(-1);
@@ -176,8 +177,8 @@ SchedulingScene fourInARowThreeHeld(const ConicRange& validity) {
 
 TEST(Budgets, ALinkTooSlowForAnythingNewKeepsTheCopiesTheFrontendHolds) {
   // The nearest object has nothing at the frontend and its cheapest mesh
-  // (5 triangles at 200 B each = 1000 B) exceeds a 400 B/s link over the 1 s
-  // lifetime; the three farther ones hold copies, which cost no link bytes.
+  // (100 triangles at 200 B each = 20 000 B) exceeds a 400 B/s link over the
+  // 1 s lifetime; the three farther ones hold copies, which cost no link bytes.
   // Only the nearest is dropped: dropping a held copy makes no room on the
   // link and would blank what the frontend already shows.
   SchedulingScene scene = fourInARowThreeHeld(ConicRange::everywhere());
@@ -254,6 +255,63 @@ TEST(Budgets, ExpiredCopiesStayOnScreenWhileTheTrianglesFit) {
   ASSERT_EQ(plan->removals.size(), 1u);
   EXPECT_EQ(plan->removals[0].object, 3u);
 
+}
+
+TEST(Budgets, ALinkBurstLetsRepresentationsLargerThanALifetimesBytesGo) {
+  // Ten objects ahead, nothing at the frontend, each mesh at least 1000 B (5
+  // triangles at 200 B) against a 400 B/s link and a 1 s lifetime: the
+  // one-lifetime window (400 B) carries none of them. With the shaper's 8000 B
+  // burst the window is 20 s: representations go while the last 20 s hold at
+  // most 8000 B, which the token bucket admits (any span T within 8000 + 400 T).
+  SceneBuilder b;
+  const int root = b.group(-1);
+  for (int i = 0; i < 10; ++i)
+    b.leaf(root, {{0.3 * i, 0, -5.0 - 2.0 * i}, 0.5}, {meshOption(5, 5, 50, 50, 200.0)});
+  auto scheduler = curveScheduler(exactConfig());
+  Budget budget;
+  budget.maxLinkBytesPerSecond = 400.0;
+  {
+    SchedulingScene scene = b.build();
+    PlannerState state;
+    auto plan = scheduler->plan(scene, viewerAt({0, 0, 0}, {0, 0, -1}), budget, state);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    EXPECT_EQ(plan->linkBytesThisStep, 0.0);
+    EXPECT_EQ(plan->dropped.size(), 10u);
+  }
+  budget.linkBurstBytes = 8000.0;
+  SchedulingScene scene = b.build();
+  PlannerState state;
+  std::vector<std::pair<double, double>> sent;  // (time, bytes)
+  for (int step = 0; step < 40; ++step) {
+    const double t = 1.0 * step;
+    auto plan = scheduler->plan(scene, viewerAt({0, 0, 0}, {0, 0, -1}, t, step), budget, state);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    sent.emplace_back(t, plan->linkBytesThisStep);
+    applyPlan(scene, *plan);
+    if (step == 0) {
+      EXPECT_GT(plan->linkBytesThisStep, 0.0);  // something goes at once
+    }
+  }
+  // Every window of 20 s holds at most the burst; every span at most the
+  // token bucket's burst + rate x span.
+  double total = 0.0;
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    double window = 0.0;
+    for (std::size_t j = i; j < sent.size(); ++j) {
+      window += sent[j].second;
+      const double span = sent[j].first - sent[i].first;
+      if (span < 20.0) EXPECT_LE(window, 8000.0 + 1e-6) << "from " << i << " to " << j;
+      EXPECT_LE(window, 8000.0 + 400.0 * span + 1e-6);
+    }
+    total += sent[i].second;
+  }
+  EXPECT_GE(total, 10 * 1000.0);  // every object got a representation in the end
+  for (std::uint32_t object = 0; object < 10; ++object) {
+    bool held = false;
+    for (std::uint32_t k = 0; k < scene.objects[object].optionCount; ++k)
+      held = held || scene.options[scene.objects[object].firstOption + k].atFrontend.present;
+    EXPECT_TRUE(held) << "object " << object;
+  }
 }
 
 TEST(FixedAccuracy, EveryVisibleObjectMeetsTheTargetOrIsReported) {

@@ -825,6 +825,11 @@ backbone::Budget BackboneCore::budgetAtPose() const {
     budget.maxLinkBytesPerSecond =
         linkRateAt(options_.linkSchedule, double(nowNs) * 1e-9, options_.budget.maxLinkBytesPerSecond);
   }
+  // An explicit --link-burst is the shaper's bucket: the scheduler may plan up
+  // to it (Budget::linkBurstBytes). The default bucket (at least 64 KiB) is
+  // slack for the shaper only; the scheduler keeps its one-lifetime window.
+  if (budget.maxLinkBytesPerSecond && options_.linkBurstBytes > 0.0)
+    budget.linkBurstBytes = options_.linkBurstBytes;
   return budget;
 }
 

@@ -105,7 +105,8 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("frontend-polygon-cap", &s.core.hardPolygonCap,
                     "never let the frontend hold more than --budget-polygons (=false to allow)");
   runtime.addOption("link-burst", &s.core.linkBurstBytes,
-                    "link shaper burst in bytes (0: max(budget-link * lifetime, 64 KiB))");
+                    "link shaper burst in bytes (0: max(budget-link * lifetime, 64 KiB)); "
+                    "given, the scheduler may plan up to it (window burst / budget-link)");
   runtime.addOption("link-schedule", &s.linkSchedule,
                     "file of \"TIME_S RATE_BYTES_PER_S\" lines: the link's rate from each trace "
                     "time on (needs --budget-link for the time before; docs/backbone.md, Link)");

@@ -201,7 +201,7 @@ const std::vector<PendingCopy>* pendingFor(const PlannerStateImpl& state, std::u
 }
 
 void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const SchedulerConfig& config,
-               const ViewerState& viewer) {
+               const ViewerState& viewer, double linkWindow) {
   const std::uint64_t fp = fingerprint(config);
   if (state.nodeCount != scene.nodes.size() || state.objectCount != scene.objects.size() ||
       state.configFingerprint != fp) {
@@ -236,7 +236,7 @@ void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const Sche
     if (list.size() != before) ++state.pendingGeneration;
     it = list.empty() ? state.pending.erase(it) : std::next(it);
   }
-  const double window = config.plannedLifetime;
+  const double window = linkWindow;
   // Settled entries carry their send time, so the log is not in time order.
   state.linkLog.erase(
       std::remove_if(state.linkLog.begin(), state.linkLog.end(),

@@ -68,7 +68,7 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
   if (scene.nodes.empty()) return Status(ErrorCode::kInvalidArgument, "scheduling scene: no nodes");
   THINLOD_RETURN_IF_ERROR(accepts(budget));
   PlannerStateImpl& state = outer.impl();
-  beginStep(state, scene, config_, viewer);
+  beginStep(state, scene, config_, viewer, linkWindowSeconds(budget, config_));
 
   SchedulerConfig seen = config_;
   if (!method_->predictsMotion()) {

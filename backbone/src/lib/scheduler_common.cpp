@@ -25,6 +25,9 @@ Status validateBudget(const Budget& budget) {
       !(std::isfinite(*budget.maxLinkBytesPerSecond) && *budget.maxLinkBytesPerSecond >= 0))
     return Status(ErrorCode::kInvalidArgument,
                   "Budget.maxLinkBytesPerSecond must be finite and >= 0");
+  if (budget.linkBurstBytes &&
+      !(std::isfinite(*budget.linkBurstBytes) && *budget.linkBurstBytes >= 0))
+    return Status(ErrorCode::kInvalidArgument, "Budget.linkBurstBytes must be finite and >= 0");
   if (budget.fixedAccuracy && !(std::isfinite(*budget.fixedAccuracy) && *budget.fixedAccuracy > 0))
     return Status(ErrorCode::kInvalidArgument, "Budget.fixedAccuracy must be finite and > 0");
   return Status::okStatus();
@@ -55,6 +58,13 @@ const char* modeName(const Budget& budget) {
   return kNames[code];
 }
 
+double linkWindowSeconds(const Budget& budget, const SchedulerConfig& config) {
+  const double lifetime = config.plannedLifetime;
+  if (!budget.linkBurstBytes || !budget.maxLinkBytesPerSecond || !(*budget.maxLinkBytesPerSecond > 0))
+    return lifetime;
+  return std::max(lifetime, *budget.linkBurstBytes / *budget.maxLinkBytesPerSecond);
+}
+
 JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,
                        const ViewerState& viewer, const SchedulerConfig& config) {
   JointBudget hard;
@@ -64,7 +74,7 @@ JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,
   }
   if (budget.maxLinkBytesPerSecond) {
     hard.useLink = true;
-    const double window = config.plannedLifetime;
+    const double window = linkWindowSeconds(budget, config);
     const double sent = recentLinkBytes(state, viewer.timeSeconds, window);
     hard.linkBytes = std::max(0.0, *budget.maxLinkBytesPerSecond * window - sent);
   }

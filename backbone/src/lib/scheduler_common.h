@@ -9,8 +9,13 @@
 namespace thinlod::backbone {
 
 const char* modeName(const Budget& budget);
-// The budgets of this step as hard caps; link in bytes over the window
-// (plannedLifetime), minus what was sent in the window already.
+// The link window W: plannedLifetime, or burst / rate when the budget's
+// linkBurstBytes is larger than a lifetime's bytes. Every window of length W
+// then carries at most rate x W, which the shaper's token bucket of that
+// burst admits (any longer span T is within burst + rate x T).
+double linkWindowSeconds(const Budget& budget, const SchedulerConfig& config);
+// The budgets of this step as hard caps; link in bytes over the window W,
+// minus what was sent in the window already.
 JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,
                        const ViewerState& viewer, const SchedulerConfig& config);
 JointBudget reserveShare(const JointBudget& budget, double share);

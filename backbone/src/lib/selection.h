@@ -55,9 +55,9 @@ LeafSelection makeSelection(std::uint32_t node, std::uint32_t object,
 
 // Book-keeping before planning: resets caches when the scene shape or the
 // config changed, retires confirmed/expired in-flight requests, trims the link
-// log to the window.
+// log to `linkWindow` (linkWindowSeconds() of the step's budget).
 void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const SchedulerConfig& config,
-               const ViewerState& viewer);
+               const ViewerState& viewer, double linkWindow);
 // Bytes sent in (now - window, now].
 double recentLinkBytes(const PlannerStateImpl& state, double now, double window);
 const std::vector<PendingCopy>* pendingFor(const PlannerStateImpl& state, std::uint32_t object);

@@ -40,6 +40,11 @@ namespace thinlod::backbone {
 struct Budget {
   std::optional<double> maxTriangles;
   std::optional<double> maxLinkBytesPerSecond;
+  // The link shaper's bucket (bytes; with maxLinkBytesPerSecond). Larger
+  // than rate x plannedLifetime, it widens the link window to burst / rate:
+  // a representation bigger than one lifetime's bytes can then go once the
+  // window has room (docs/scheduling.md, "Link accounting").
+  std::optional<double> linkBurstBytes;
   std::optional<double> fixedAccuracy;  // rad^-1
   // The modelled frame time at the frontend (seconds; Gobbetti-Bouvier). Only
   // methods with a frame-cost model take it (active-set); others answer
