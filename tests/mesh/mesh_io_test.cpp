@@ -445,6 +445,28 @@ TEST(MeshIo, ObjLinesStartingWithVerticalTabOrFormFeedAreRejected) {
   EXPECT_EQ(blank->mesh.triangleCount(), 1u);
 }
 
+// OpenMesh reads the OBJ lines the pre-check rewrote from its checked tokens
+// (PrecheckResult::rewritten), not the file: comments, groups, materials,
+// tabs, vertical tabs between words and CR LF line ends change nothing.
+TEST(MeshIo, ObjDecorationsLoadTheSameMeshAsThePlainFile) {
+  const std::string plain =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+      "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  const std::string decorated =
+      "# a quad\r\nmtllib none.mtl\r\no quad\r\nv 0 0 0 # origin\r\nv\t1 0 0\r\n"
+      "  v 1\v1 0\r\nv 0 1 0\r\ng front\r\nvt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvt 0 1\r\n"
+      "vn 0 0 1\r\nusemtl red\r\ns 1\r\nf 1/1/1 2/2/1 3/3/1\r\n\r\nf -4/-4/-1 -2/-2/-1 -1/-1/-1\r\n";
+  Result<LoadedMesh> a = loadMeshFromMemory(plain, "obj", "plain.obj");
+  Result<LoadedMesh> b = loadMeshFromMemory(decorated, "obj", "decorated.obj");
+  ASSERT_TRUE(a.ok()) << a.status().toString();
+  ASSERT_TRUE(b.ok()) << b.status().toString();
+  EXPECT_EQ(a->mesh.positions, b->mesh.positions);
+  EXPECT_EQ(a->mesh.normals, b->mesh.normals);
+  EXPECT_EQ(a->mesh.uvs, b->mesh.uvs);
+  EXPECT_EQ(a->mesh.indices, b->mesh.indices);
+  EXPECT_EQ(b->mesh.triangleCount(), 2u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

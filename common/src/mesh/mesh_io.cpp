@@ -202,7 +202,8 @@ Result<LoadedMesh> loadChecked(std::string_view bytes, MeshFormat format, const 
     std::lock_guard<std::mutex> lock(openMeshMutex());
     ErrorStreamCapture capture;
     try {
-      std::istringstream in{std::string(bytes), std::ios::in | std::ios::binary};
+      std::string text = pre->rewritten.empty() ? std::string(bytes) : std::move(pre->rewritten);
+      std::istringstream in{std::move(text), std::ios::in | std::ios::binary};
       readOk = OpenMesh::IO::read_mesh(tm, in, "." + ext, opt);
     } catch (const std::bad_alloc&) {
       return Status(ErrorCode::kResourceExhausted, name + ": out of memory while reading");
