@@ -104,6 +104,18 @@ TEST(Trace, NonUnitQuaternionIsNormalised) {
   EXPECT_EQ(t->poses[0].orientation, glm::quat(1, 0, 0, 0));
 }
 
+// Fuzz finding 22 (fuzz/corpus/trace/crash-quat-overflows-float-norm.trace):
+// glm::normalize squares in float, so components above ~1.8e19 gave the
+// zero quaternion; normalised in double they give the unit one.
+TEST(Trace, HugeQuaternionComponentsNormaliseToAUnitRotation) {
+  const auto t = parseTrace(withHeader("0 0 0 0 quat 0 0 0 1.1e38 60\n1 0 0 0 quat 3e20 0 4e20 0 60\n"));
+  ASSERT_TRUE(t.ok()) << t.status().toString();
+  EXPECT_EQ(t->poses[0].orientation, glm::quat(0, 0, 0, 1));
+  EXPECT_NEAR(glm::length(t->poses[1].orientation), 1.0f, 1e-6f);
+  EXPECT_NEAR(t->poses[1].orientation.w, 0.6f, 1e-6f);
+  EXPECT_NEAR(t->poses[1].orientation.y, 0.8f, 1e-6f);
+}
+
 TEST(Trace, AcceptsMissingFinalNewlineAndCrlf) {
   const auto t =
       parseTrace("# thinlod-trace 1\r\n0 0 0 0 quat 1 0 0 0 60\r\n1 0 0 1 quat 1 0 0 0 60");

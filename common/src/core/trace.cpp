@@ -161,7 +161,15 @@ Result<Pose> parsePoseLine(std::size_t line, const std::vector<std::string_view>
                                   double(raw.y) * raw.y + double(raw.z) * raw.z);
     if (!(norm > 1e-6)) return lineError(line, "quaternion has zero length");
     // Keep already-unit quaternions bit-exact (so writeTrace round-trips).
-    pose.orientation = std::fabs(norm - 1.0) <= 1e-6 ? raw : glm::normalize(raw);
+    // Others are normalised in double: glm::normalize squares in float, which
+    // overflowed for components above ~1.8e19 and gave the zero quaternion
+    // (fuzz finding 22, seed fuzz/corpus/trace/crash-quat-overflows-float-norm.trace).
+    pose.orientation = std::fabs(norm - 1.0) <= 1e-6
+                           ? raw
+                           : glm::quat(static_cast<float>(raw.w / norm),
+                                       static_cast<float>(raw.x / norm),
+                                       static_cast<float>(raw.y / norm),
+                                       static_cast<float>(raw.z / norm));
     const Status fovStatus = parseFields(line, fields, 9, {"fov_deg"}, true, &fov);
     if (!fovStatus.ok()) return fovStatus;
   } else {
