@@ -152,17 +152,20 @@ TEST(Budgets, BelowTheCheapestPlanTheLeastVisibleObjectsAreDropped) {
   EXPECT_EQ(plan->dropped.size(), 4u);
 }
 
-// Four objects in a row ahead of the viewer (5, 15, 25, 35 m), each one mesh
-// of 100-1000 triangles (relative accuracy 5-50) at 200 B per triangle; the
-// three farther ones hold a 400-triangle frontend copy with `validity`, the
-// nearest holds nothing.
-SchedulingScene fourInARowThreeHeld(const ConicRange& validity) {
+// Four objects in a row ahead of the viewer, object i at 5 + 10 i m (or,
+// `farthestFirst`, at 35 - 10 i m), each one mesh of 100-1000 triangles
+// (relative accuracy 5-50) at 200 B per triangle; all but the nearest hold a
+// 400-triangle frontend copy with `validity`.
+SchedulingScene fourInARowThreeHeld(const ConicRange& validity, bool farthestFirst = false) {
   SceneBuilder b;
   const int root = b.group(-1);
   for (int i = 0; i < 4; ++i)
-    b.leaf(root, {{0, 0, -5.0 - 10.0 * i}, 0.5}, {meshOption(5, 100, 50, 1000, 200.0)});
+    b.leaf(root, {{0, 0, -5.0 - 10.0 * (farthestFirst ? 3 - i : i)}, 0.5},
+           {meshOption(5, 100, 50, 1000, 200.0)});
   SchedulingScene scene = b.build();
-  for (std::uint32_t object = 1; object < 4; ++object) {
+  const std::uint32_t nearest = farthestFirst ? 3 : 0;
+  for (std::uint32_t object = 0; object < 4; ++object) {
+    if (object == nearest) continue;
     RepresentationCopy& copy = scene.options[scene.objects[object].firstOption].atFrontend;
     copy.present = true;
     copy.id = 100 + object;
@@ -241,20 +244,28 @@ TEST(Budgets, ExpiredCopiesStayOnScreenWhileTheTrianglesFit) {
   EXPECT_EQ(below, (std::vector<std::uint32_t>{1, 2, 3}));
   EXPECT_EQ(plan->predictedTriangles, 1200.0);
 
-  // 900 triangles hold two copies: the two nearest stay, the farthest is
-  // dropped and its copy removed.
+  // 900 triangles hold two copies: the two nearest held ones stay, the
+  // farthest is dropped and its copy removed, whichever order the scene
+  // lists them in.
   budget.maxTriangles = 900.0;
-  PlannerState capped;
-  plan = scheduler->plan(scene, viewer, budget, capped);
-  ASSERT_TRUE(plan.ok()) << plan.status().toString();
-  EXPECT_LE(plan->predictedTriangles, 900.0);
-  EXPECT_EQ(plan->stats.expiredCopiesKept, 2u);
-  std::vector<std::uint32_t> dropped = plan->dropped;
-  std::sort(dropped.begin(), dropped.end());
-  EXPECT_EQ(dropped, (std::vector<std::uint32_t>{0, 3}));
-  ASSERT_EQ(plan->removals.size(), 1u);
-  EXPECT_EQ(plan->removals[0].object, 3u);
-
+  for (const bool farthestFirst : {false, true}) {
+    SCOPED_TRACE(farthestFirst ? "farthest first" : "nearest first");
+    const SchedulingScene ordered =
+        fourInARowThreeHeld(ConicRange::ball({100.0, 0.0, 0.0}, 1.0), farthestFirst);
+    const std::uint32_t nearest = farthestFirst ? 3 : 0;
+    const std::uint32_t farthest = farthestFirst ? 0 : 3;
+    PlannerState capped;
+    plan = scheduler->plan(ordered, viewer, budget, capped);
+    ASSERT_TRUE(plan.ok()) << plan.status().toString();
+    EXPECT_LE(plan->predictedTriangles, 900.0);
+    EXPECT_EQ(plan->stats.expiredCopiesKept, 2u);
+    std::vector<std::uint32_t> dropped = plan->dropped;
+    std::sort(dropped.begin(), dropped.end());
+    EXPECT_EQ(dropped, (std::vector<std::uint32_t>{std::min(nearest, farthest),
+                                                   std::max(nearest, farthest)}));
+    ASSERT_EQ(plan->removals.size(), 1u);
+    EXPECT_EQ(plan->removals[0].object, farthest);
+  }
 }
 
 TEST(Budgets, ALinkBurstLetsRepresentationsLargerThanALifetimesBytesGo) {

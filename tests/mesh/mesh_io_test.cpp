@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <glm/geometric.hpp>
 #include <map>
 #include <string>
@@ -416,11 +417,18 @@ TEST(MeshIo, NumbersBeyondTheFloatRangeAreRejected) {
       loadMeshFromMemory("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1e300 0\n3 0 1 2\n", "off", "big.off");
   ASSERT_FALSE(off.ok());
   EXPECT_TRUE(contains(off.status().message(), "beyond the float range")) << off.status().message();
-  // The largest float itself is in range and loads.
-  Result<LoadedMesh> edge = loadMeshFromMemory(
-      "v 0 0 0\nv 3.4028234e38 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "edge.obj");
-  ASSERT_TRUE(edge.ok()) << edge.status().toString();
-  EXPECT_EQ(edge->mesh.triangleCount(), 1u);
+  // The largest float itself is in range and loads, also as %.9g prints it
+  // (3.40282347e+38, a hair above FLT_MAX, which float rounding brings back).
+  for (const char* largest : {"3.4028234e38", "3.40282347e+38"}) {
+    Result<LoadedMesh> edge = loadMeshFromMemory(
+        std::string("v 0 0 0\nv ") + largest + " 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "edge.obj");
+    ASSERT_TRUE(edge.ok()) << largest << ": " << edge.status().toString();
+    EXPECT_EQ(edge->mesh.positions[1].x, std::numeric_limits<float>::max()) << largest;
+  }
+  // Just beyond, float rounding gives infinity: refused.
+  EXPECT_FALSE(loadMeshFromMemory("v 0 0 0\nv 3.4028236e38 0 0\nv 0 1 0\nf 1 2 3\n", "obj",
+                                  "beyond.obj")
+                   .ok());
 }
 
 // Fuzz finding (session 10 campaign, fuzz/corpus/mesh/crash-obj-vertical-tab-before-vertex.obj;

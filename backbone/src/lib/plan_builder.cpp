@@ -366,25 +366,32 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
   // the client already has beats a blank one: a link cut below the size of
   // any new representation otherwise empties the screen as the viewer moves
   // out of the held copies' regions); the rest lose their copies.
+  // The order is recomputed from the node's bounds: most ways of leaving a
+  // leaf unrendered do not fill in its distance and diameter.
   if (expiredCopyRoom && unrendered.size() > 1) {
     const ViewCone cone(ctx.viewer);
-    auto priority = [&](const LeafSelection* s) {
-      return s->distance > 0.0 ? cone.keepPriority(ctx.scene.nodes[s->node].bounds, s->diameter,
-                                                   s->distance)
-                               : 0.0;
-    };
-    std::stable_sort(unrendered.begin(), unrendered.end(),
-                     [&](const LeafSelection* a, const LeafSelection* b) {
-                       return priority(a) > priority(b);
-                     });
+    std::vector<std::pair<double, const LeafSelection*>> ranked;
+    ranked.reserve(unrendered.size());
+    for (const LeafSelection* s : unrendered) {
+      const Sphere& bounds = ctx.scene.nodes[s->node].bounds;
+      const double distance = conversionDistance(ctx.region.center, ctx.region.reachRadius, bounds,
+                                                 ctx.config.minimalDistance);
+      ranked.emplace_back(cone.keepPriority(bounds, 2.0 * bounds.radius, distance), s);
+    }
+    std::stable_sort(ranked.begin(), ranked.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t i = 0; i < ranked.size(); ++i) unrendered[i] = ranked[i].second;
   }
   double room = expiredCopyRoom ? *expiredCopyRoom - triangles : -kInf;
   for (const LeafSelection* s : unrendered) {
     const SceneObject& obj = ctx.scene.objects[s->object];
-    std::int32_t kept = -1;
-    for (std::uint32_t k = 0; k < obj.optionCount && kept < 0; ++k) {
+    std::int32_t kept = -1;  // the most accurate held copy that fits
+    for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
       const RepresentationCopy& copy = ctx.scene.options[obj.firstOption + k].atFrontend;
-      if (copy.present && copy.triangles <= room) kept = static_cast<std::int32_t>(obj.firstOption + k);
+      if (!copy.present || !(copy.triangles <= room)) continue;
+      if (kept < 0 || copy.relativeAccuracy >
+                          ctx.scene.options[static_cast<std::uint32_t>(kept)].atFrontend.relativeAccuracy)
+        kept = static_cast<std::int32_t>(obj.firstOption + k);
     }
     if (kept < 0) {
       if (s->dropped) {
@@ -416,7 +423,6 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
     }
     room -= d.triangles;
     triangles += d.triangles;
-    minAccuracy = 0.0;
     ++keeps;
     rendered.push_back(s->object);
     ++plan.stats.expiredCopiesKept;

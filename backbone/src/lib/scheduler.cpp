@@ -93,9 +93,10 @@ Result<Plan> Scheduler::plan(const SchedulingScene& scene, const ViewerState& vi
   // Expired copies fill only triangle room the polygon budget leaves. A method
   // with a frame-cost model keeps none: its budget is modelled time, which
   // this frame cannot check (active-set's frame-time mode may come from its
-  // own config, not from Budget::maxFrameSeconds).
+  // own config, not from Budget::maxFrameSeconds). Nor do baselines that
+  // honour no budget (the static VRML LOD): they stay as published.
   std::optional<double> expiredCopyRoom;
-  if (!method_->modelsFrameTime())
+  if (method_->honoursBudgets() && !method_->modelsFrameTime())
     expiredCopyRoom = budget.maxTriangles.value_or(std::numeric_limits<double>::infinity());
   finishPlan(context, selection.leaves, target, expiredCopyRoom, plan);
   // The selections are consumed: keep their storage for the next step.

@@ -62,7 +62,11 @@ double linkWindowSeconds(const Budget& budget, const SchedulerConfig& config) {
   const double lifetime = config.plannedLifetime;
   if (!budget.linkBurstBytes || !budget.maxLinkBytesPerSecond || !(*budget.maxLinkBytesPerSecond > 0))
     return lifetime;
-  return std::max(lifetime, *budget.linkBurstBytes / *budget.maxLinkBytesPerSecond);
+  // At most an hour: a tiny rate would otherwise keep the link log forever
+  // (a shorter window only allows rate x W < burst, so the bound still holds).
+  constexpr double kLongestLinkWindowSeconds = 3600.0;
+  const double window = *budget.linkBurstBytes / *budget.maxLinkBytesPerSecond;
+  return std::max(lifetime, std::min(window, kLongestLinkWindowSeconds));
 }
 
 JointBudget hardBudget(const Budget& budget, const PlannerStateImpl& state,

@@ -9,10 +9,14 @@
 namespace thinlod::backbone {
 
 const char* modeName(const Budget& budget);
-// The link window W: plannedLifetime, or burst / rate when the budget's
-// linkBurstBytes is larger than a lifetime's bytes. Every window of length W
-// then carries at most rate x W, which the shaper's token bucket of that
-// burst admits (any longer span T is within burst + rate x T).
+// The link window W: plannedLifetime, or burst / rate (at most an hour) when
+// the budget's linkBurstBytes is larger than a lifetime's bytes. Every window
+// of length W then carries at most rate x W <= burst, which the shaper's
+// token bucket of that burst admits (any longer span T is within
+// ceil(T / W) rate W < burst + rate x T). After a rate change the log holds
+// only the old window's sends, so a cut that widens W may count too few for
+// a while; the shaper's bucket, which keeps no more tokens across the
+// change, holds the cap then.
 double linkWindowSeconds(const Budget& budget, const SchedulerConfig& config);
 // The budgets of this step as hard caps; link in bytes over the window W,
 // minus what was sent in the window already.

@@ -79,7 +79,9 @@ struct PlanContext {
 // triangle budget left by the rendered leaves; nullopt: never keep one). Such
 // a copy costs no link bytes, is kept (ObjectAction::kKeep) with absolute
 // accuracy 0 (its validity no longer covers the region, so nothing is
-// guaranteed) and is listed in Plan::belowTarget, not Plan::dropped.
+// guaranteed) and is listed in Plan::belowTarget, not Plan::dropped; it is
+// left out of Plan::achievedMinAccuracy (counted in expiredCopiesKept). Of
+// an object's held copies the most accurate that fits stays.
 void finishPlan(const PlanContext& context, std::vector<LeafSelection>& selections,
                 double targetAccuracy, std::optional<double> expiredCopyRoom, Plan& plan);
 

@@ -202,7 +202,7 @@ Result<LoadedMesh> loadChecked(std::string_view bytes, MeshFormat format, const 
     std::lock_guard<std::mutex> lock(openMeshMutex());
     ErrorStreamCapture capture;
     try {
-      std::string text = pre->rewritten.empty() ? std::string(bytes) : std::move(pre->rewritten);
+      std::string text = pre->rewritten ? std::move(*pre->rewritten) : std::string(bytes);
       std::istringstream in{std::move(text), std::ios::in | std::ios::binary};
       readOk = OpenMesh::IO::read_mesh(tm, in, "." + ext, opt);
     } catch (const std::bad_alloc&) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -22,8 +23,8 @@ struct PrecheckResult {
   // OBJ: the file as OpenMesh gets it, rewritten from the tokens the pre-check
   // validated (v, vc, vn, vt and f lines only, single spaces, LF line ends,
   // no comments), so OpenMesh cannot read anything the pre-check did not see.
-  // Empty for the other formats: OpenMesh reads the original bytes.
-  std::string rewritten;
+  // Unset for the other formats: OpenMesh reads the original bytes.
+  std::optional<std::string> rewritten;
 };
 
 // `name` prefixes every message.

@@ -130,6 +130,7 @@ struct Plan {
   PredictedRegion region;
   double targetAccuracy = 0.0;       // rad^-1
   double achievedMinAccuracy = 0.0;  // min guaranteed accuracy over rendered objects
+                                     // (expired copies, with none, left out)
   double predictedTriangles = 0.0;
   double linkBytesThisStep = 0.0;
   double linkBytesPerSecond = 0.0;              // linkBytesThisStep / plannedLifetime
