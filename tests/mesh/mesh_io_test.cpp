@@ -475,6 +475,25 @@ TEST(MeshIo, ObjDecorationsLoadTheSameMeshAsThePlainFile) {
   EXPECT_EQ(b->mesh.triangleCount(), 2u);
 }
 
+// Fuzz finding 23 (session 10, fuzz/corpus/mesh/oom-off-value-after-face-indices.off;
+// libFuzzer out-of-memory, a 3 GB reservation): OpenMesh's OFF reader left a
+// value after a face's indices in the stream as the next face's vertex
+// count. Face lines hold their count and indices only.
+TEST(MeshIo, OffFaceLinesWithValuesAfterTheIndicesAreRejected) {
+  for (const char* tail : {" 999999999", " 1 0 0", " 0.5 0.5 0.5 0.5"}) {
+    const std::string off =
+        std::string("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2") + tail + "\n3 0 2 1\n";
+    Result<LoadedMesh> r = loadMeshFromMemory(off, "off", "tail.off");
+    ASSERT_FALSE(r.ok()) << tail;
+    EXPECT_TRUE(contains(r.status().message(), "tail.off:6: face has")) << r.status().message();
+    EXPECT_TRUE(contains(r.status().message(), "after its 3 vertex indices")) << r.status().message();
+  }
+  Result<LoadedMesh> plain =
+      loadMeshFromMemory("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n", "off", "ok.off");
+  ASSERT_TRUE(plain.ok()) << plain.status().toString();
+  EXPECT_EQ(plain->mesh.triangleCount(), 2u);
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {

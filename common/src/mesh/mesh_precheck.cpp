@@ -408,6 +408,16 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
                              std::to_string(nv) + " vertices)");
       }
     }
+    // OpenMesh reads faces token by token and, without face colours asked
+    // for, leaves values after the indices in the stream: one became the next
+    // face's vertex count, and "3 0 1 2 999999999" reserved 3 GB (fuzz
+    // finding 23, seed fuzz/corpus/mesh/oom-off-value-after-face-indices.off;
+    // three colour values made the next face unreadable). Refused.
+    if (tokens.size() != k + 1) {
+      return lineError(name, ln,
+                       "face has " + std::to_string(tokens.size() - k - 1) + " value(s) after its " +
+                           std::to_string(k) + " vertex indices (face colours are not read)");
+    }
   }
   PrecheckResult result;
   result.declaredFaces = nf;
