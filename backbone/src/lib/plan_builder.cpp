@@ -71,6 +71,17 @@ CurrentCopy currentCopy(const PlanContext& ctx, std::uint32_t object, const Sphe
   return result;
 }
 
+// A kept frontend copy: every other copy the frontend holds of the object goes.
+void removeOtherCopies(const PlanContext& ctx, std::uint32_t object, std::uint32_t keptOption,
+                       Plan& plan) {
+  const SceneObject& obj = ctx.scene.objects[object];
+  for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
+    const std::uint32_t index = obj.firstOption + k;
+    const RepresentationCopy& copy = ctx.scene.options[index].atFrontend;
+    if (copy.present && index != keptOption) plan.removals.push_back({object, index, copy.id});
+  }
+}
+
 void removeAllCopies(const PlanContext& ctx, std::uint32_t object, Plan& plan, bool addDecision) {
   const SceneObject& obj = ctx.scene.objects[object];
   bool any = false;
@@ -236,11 +247,10 @@ void beginStep(PlannerStateImpl& state, const SchedulingScene& scene, const Sche
     if (list.size() != before) ++state.pendingGeneration;
     it = list.empty() ? state.pending.erase(it) : std::next(it);
   }
-  const double window = linkWindow;
   // Settled entries carry their send time, so the log is not in time order.
   state.linkLog.erase(
       std::remove_if(state.linkLog.begin(), state.linkLog.end(),
-                     [&](const LinkSend& s) { return s.time <= viewer.timeSeconds - window; }),
+                     [&](const LinkSend& s) { return s.time <= viewer.timeSeconds - linkWindow; }),
       state.linkLog.end());
   state.lastTime = viewer.timeSeconds;
 }
@@ -297,13 +307,7 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
       case CandidateSource::kFrontendCopy: {
         d.action = ObjectAction::kKeep;
         ++keeps;
-        const SceneObject& obj = ctx.scene.objects[s.object];
-        for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
-          const std::uint32_t index = obj.firstOption + k;
-          const RepresentationCopy& copy = ctx.scene.options[index].atFrontend;
-          if (copy.present && index != s.candidate.option)
-            plan.removals.push_back({s.object, index, copy.id});
-        }
+        removeOtherCopies(ctx, s.object, s.candidate.option, plan);
         break;
       }
       case CandidateSource::kPending:
@@ -415,12 +419,7 @@ void finishPlan(const PlanContext& ctx, std::vector<LeafSelection>& selections,
     d.belowTarget = true;
     plan.belowTarget.push_back(s->object);
     plan.decisions.push_back(d);
-    for (std::uint32_t k = 0; k < obj.optionCount; ++k) {
-      const std::uint32_t index = obj.firstOption + k;
-      const RepresentationCopy& copy = ctx.scene.options[index].atFrontend;
-      if (copy.present && index != static_cast<std::uint32_t>(kept))
-        plan.removals.push_back({s->object, index, copy.id});
-    }
+    removeOtherCopies(ctx, s->object, static_cast<std::uint32_t>(kept), plan);
     room -= d.triangles;
     triangles += d.triangles;
     ++keeps;
