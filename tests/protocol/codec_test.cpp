@@ -432,6 +432,23 @@ TEST(Codec, OutOfRangeEnumIsRejected) {
   EXPECT_NE(decoded.status().message().find("Hello.role"), std::string::npos);
 }
 
+TEST(Codec, PeerNamesThatCouldForgeALogLineAreRejected) {
+  for (const std::string& bad : {std::string("w\nevent=ready"), std::string("a\"b"),
+                                std::string("a\\b"), std::string("\x7f"), std::string("caf\xc3\xa9")}) {
+    Hello hello;
+    hello.role = Role::kSimplifier;
+    hello.name = bad;
+    const Result<Bytes> bytes = encode(Message(hello));
+    ASSERT_FALSE(bytes.ok()) << bad;
+    EXPECT_NE(bytes.status().message().find("Hello.name"), std::string::npos)
+        << bytes.status().message();
+  }
+  Hello hello;
+  hello.role = Role::kSimplifier;
+  hello.name = "simplifier@host-1#42 (farm)";
+  EXPECT_TRUE(encode(Message(hello)).ok());
+}
+
 TEST(Codec, NegotiatesTheHighestCommonVersion) {
   Hello hello;
   hello.minVersion = 1;

@@ -62,9 +62,19 @@ Status checkText(const FieldPath& path, const std::string& text, std::size_t max
   return Status();
 }
 
+// A peer's name goes into every daemon's log (event=worker_joined name="..."):
+// printable ASCII without quotes or backslashes, so it cannot end a quoted
+// log field or start a forged log line.
 Status checkName(const FieldPath& path, const std::string& name) {
   if (name.empty()) return invalidField(path, "is empty");
-  return checkText(path, name, kMaxNameBytes);
+  THINLOD_RETURN_IF_ERROR(checkText(path, name, kMaxNameBytes));
+  for (const char c : name) {
+    if (c < 0x20 || c > 0x7e || c == '"' || c == '\\') {
+      return invalidField(path, "holds byte " + std::to_string(static_cast<unsigned char>(c)) +
+                                    ", allowed are printable ASCII without \" and \\");
+    }
+  }
+  return Status();
 }
 
 Status checkRequestId(const FieldPath& path, std::uint64_t id) {
