@@ -359,8 +359,8 @@ class Daemon {
   void onWorkerEvent(protocol::WorkerPoolEvent& event) {
     switch (event.kind) {
       case protocol::WorkerPoolEvent::Kind::kWorkerJoined:
-        spdlog::info("event=worker_joined worker={} workers={}", event.worker.value,
-                     workers_.liveWorkers());
+        spdlog::info("event=worker_joined worker={} name=\"{}\" workers={}", event.worker.value,
+                     event.workerName, workers_.liveWorkers());
         break;
       case protocol::WorkerPoolEvent::Kind::kWorkerLeft:
         spdlog::info("event=worker_left worker={} workers={} pending={}", event.worker.value,
@@ -369,7 +369,8 @@ class Daemon {
       case protocol::WorkerPoolEvent::Kind::kSimplifyResult: {
         lastResultAt_ = resultAt_;
         const std::size_t pendingBefore = core_.curvesPending();
-        noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId);
+        noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId,
+                   event.worker);
         if (core_.curvesPending() < pendingBefore) {
           const auto now = Clock::now();
           if (curveReleasedAt_) {
@@ -388,19 +389,23 @@ class Daemon {
         break;
       }
       case protocol::WorkerPoolEvent::Kind::kImpostorResult:
-        noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId);
+        noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId,
+                   event.worker);
         break;
     }
   }
 
-  void noteResult(const Status& status, const char* kind, std::uint64_t requestId) {
+  // worker: the simplifier that answered (0 for a request the pool failed
+  // itself after its attempts), so a farm's share of the work can be read.
+  void noteResult(const Status& status, const char* kind, std::uint64_t requestId,
+                  protocol::PeerId worker) {
     resultAt_ = Clock::now();
     if (status.ok()) {
       ++resultsAccepted_;
-      spdlog::debug("event=result kind={} request={}", kind, requestId);
+      spdlog::debug("event=result kind={} request={} worker={}", kind, requestId, worker.value);
     } else {
-      spdlog::warn("event=result_rejected kind={} request={} error=\"{}\"", kind, requestId,
-                   status.toString());
+      spdlog::warn("event=result_rejected kind={} request={} worker={} error=\"{}\"", kind,
+                   requestId, worker.value, status.toString());
     }
   }
 

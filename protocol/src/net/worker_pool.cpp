@@ -208,6 +208,7 @@ std::vector<WorkerPoolEvent> WorkerPool::poll(std::chrono::milliseconds timeout)
         WorkerPoolEvent event;
         event.kind = WorkerPoolEvent::Kind::kWorkerJoined;
         event.worker = e.peer;
+        event.workerName = hello.name;
         s.events.push_back(std::move(event));
         break;
       }

@@ -235,6 +235,7 @@ struct WorkerPoolEvent {
   enum class Kind { kWorkerJoined, kWorkerLeft, kSimplifyResult, kImpostorResult };
   Kind kind = Kind::kSimplifyResult;
   PeerId worker;
+  std::string workerName;   // kWorkerJoined: the name in its Hello
   SimplifyResult simplify;  // kSimplifyResult
   ImpostorResult impostor;  // kImpostorResult
 };
