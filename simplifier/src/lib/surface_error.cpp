@@ -316,14 +316,22 @@ double uvArea(const IndexedMesh& mesh) {
 namespace {
 
 // Barycentrics (of corners b and c) of point p on the plane of tri; false
-// for a zero-area triangle.
+// for a zero-area triangle. Clamped into the simplex: p is a point of the
+// triangle (its closest point to something), so only rounding - large on a
+// sliver - can put them outside, and the interpolated value then stays in
+// the corners' box (what forEachWithinWhileNearer's pruning relies on).
 bool barycentrics(const detail::Triangle& tri, const dvec3& p, double& wb, double& wc) {
   const dvec3 n = glm::cross(tri.b - tri.a, tri.c - tri.a);
   const double n2 = glm::dot(n, n);
   if (!(n2 > 0.0)) return false;
-  wb = glm::dot(glm::cross(p - tri.a, tri.c - tri.a), n) / n2;
-  wc = glm::dot(glm::cross(tri.b - tri.a, p - tri.a), n) / n2;
-  return true;
+  wb = std::max(0.0, glm::dot(glm::cross(p - tri.a, tri.c - tri.a), n) / n2);
+  wc = std::max(0.0, glm::dot(glm::cross(tri.b - tri.a, p - tri.a), n) / n2);
+  if (wb + wc > 1.0) {
+    const double sum = wb + wc;
+    wb /= sum;
+    wc /= sum;
+  }
+  return std::isfinite(wb) && std::isfinite(wc);
 }
 
 double percentile95(std::vector<double>& values) {
@@ -383,6 +391,15 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
   for (const glm::vec2& uv : original.uvs) uvLayout.positions.emplace_back(uv.x, uv.y, 0.0f);
   uvLayout.indices = original.indices;
   const TriangleBvh uvBvh(uvLayout);
+  // The candidates' least uv distance (and least displacement) is searched
+  // with the other value's boxes: at coarse levels the tie radius 2 d holds
+  // a large share of the mesh, and most of it lies far from s in uv.
+  const std::vector<detail::Box> uvBoxes = bvh.nodeBoxesOf([&](std::uint32_t i, int k) {
+    const glm::dvec2 uv = uvOf(original, bvh.sourceTriangle(i), k);
+    return dvec3(uv.x, uv.y, 0.0);
+  });
+  const std::vector<detail::Box> positionBoxes = uvBvh.nodeBoxesOf(
+      [&](std::uint32_t i, int k) { return originalGeometry.corner(uvBvh.sourceTriangle(i), k); });
   std::uint32_t hint = 0, uvHint = 0;
   std::vector<double> uvErrors, displacements;
   uvErrors.reserve(points.random.size());
@@ -396,7 +413,10 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
     const double nearest = std::sqrt(bvh.squaredDistance(q, hint));
     const double radius = (1.0 + options.tieFactor) * nearest + tie;
     double bestUv = std::numeric_limits<double>::infinity();
-    bvh.forEachWithin(q, radius * radius, [&](std::uint32_t i, const detail::Triangle& tri) {
+    const dvec3 s3(s.x, s.y, 0.0);
+    auto bestUvSquared = [&] { return bestUv * bestUv; };
+    bvh.forEachWithinWhileNearer(q, radius * radius, uvBoxes, s3, bestUvSquared,
+                                 [&](std::uint32_t i, const detail::Triangle& tri) {
       const std::uint32_t t = bvh.sourceTriangle(i);
       double wb = 0.0, wc = 0.0;
       glm::dvec2 o = uvOf(original, t, 0);  // zero area: no interpolation to speak of
@@ -410,7 +430,10 @@ Result<UvError> measureUvError(const IndexedMesh& original, const IndexedMesh& s
     const double uvNearest = std::sqrt(uvBvh.squaredDistance(su, uvHint));
     const double uvRadius = uvNearest + options.texelTolerance;
     double bestDisplacement = std::numeric_limits<double>::infinity();
-    uvBvh.forEachWithin(su, uvRadius * uvRadius, [&](std::uint32_t i, const detail::Triangle& tri) {
+    auto bestDisplacementSquared = [&] { return bestDisplacement * bestDisplacement; };
+    uvBvh.forEachWithinWhileNearer(su, uvRadius * uvRadius, positionBoxes, q,
+                                   bestDisplacementSquared,
+                                   [&](std::uint32_t i, const detail::Triangle& tri) {
       const std::uint32_t t = uvBvh.sourceTriangle(i);
       double wb = 0.0, wc = 0.0;
       const dvec3 p = barycentrics(tri, detail::closestPointOnTriangle(su, tri), wb, wc)

@@ -1,5 +1,6 @@
 // Private to surface_error*.cpp and white-box tests: exact point-triangle
-// distance and a bounding-volume hierarchy over a mesh's triangles.
+// distance and a bounding-volume hierarchy over a mesh's triangles, with
+// boxes of a second per-corner value for least-value searches.
 // Precondition for TriangleBvh: a validated mesh with at least one triangle.
 #pragma once
 
@@ -187,6 +188,69 @@ class TriangleBvh {
 
   // The mesh's triangle number of BVH-order triangle i.
   std::uint32_t sourceTriangle(std::uint32_t i) const { return order_[i]; }
+
+  // Per node, the box of a second per-corner value over the node's triangles
+  // (for example the uvs of a BVH built over positions): value(i, k) is
+  // corner k of BVH-order triangle i. Children follow their parent in
+  // nodes_, so one backward pass fills every box. Each box is grown by
+  // 1e-9 of the largest value magnitude: a convex combination of corners
+  // computed in doubles may leave the exact box by a few ulps.
+  template <typename CornerValue>
+  std::vector<Box> nodeBoxesOf(CornerValue value) const {
+    std::vector<Box> boxes(nodes_.size());
+    for (std::size_t n = nodes_.size(); n-- > 0;) {
+      const BvhNode& node = nodes_[n];
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          for (int k = 0; k < 3; ++k) boxes[n].extend(value(i, k));
+        }
+      } else {
+        boxes[n].extend(boxes[node.first]);
+        boxes[n].extend(boxes[node.first + 1]);
+      }
+    }
+    if (!boxes.empty()) {
+      const dvec3 magnitude = glm::max(glm::abs(boxes[0].lo), glm::abs(boxes[0].hi));
+      const dvec3 slack(1e-9 * std::max({magnitude.x, magnitude.y, magnitude.z}));
+      for (Box& box : boxes) {
+        box.lo -= slack;
+        box.hi += slack;
+      }
+    }
+    return boxes;
+  }
+
+  // forEachWithin for a search that keeps the least of a value taken inside
+  // each triangle (a point of the triangle, or an attribute interpolated on
+  // it with barycentrics in the simplex), so the value lies in the
+  // triangle's box of `valueBoxes` (nodeBoxesOf). bestSquared() is the search's current least squared
+  // distance from `target` to a value; a node whose value box lies no nearer
+  // than that cannot lower it and is skipped, the nearer child first. The
+  // least value found is the one forEachWithin's visits would give: only
+  // triangles that cannot change it are left out.
+  template <typename Best, typename Visit>
+  void forEachWithinWhileNearer(const dvec3& p, double radius2, const std::vector<Box>& valueBoxes,
+                                const dvec3& target, Best bestSquared, Visit visit) const {
+    std::array<std::uint32_t, kTraversalStack> stack;
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const std::uint32_t index = stack[--top];
+      const BvhNode& node = nodes_[index];
+      if (squaredDistanceToBox(p, node.box) > radius2) continue;
+      if (squaredDistanceToBox(target, valueBoxes[index]) >= bestSquared()) continue;
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          if (squaredDistanceToTriangle(p, triangles_[i]) <= radius2) visit(i, triangles_[i]);
+        }
+        continue;
+      }
+      const double dl = squaredDistanceToBox(target, valueBoxes[node.first]);
+      const double dr = squaredDistanceToBox(target, valueBoxes[node.first + 1]);
+      stack[top++] = dl <= dr ? node.first + 1 : node.first;  // farther first: popped last
+      stack[top++] = dl <= dr ? node.first : node.first + 1;
+    }
+  }
 
   // Squared distance from p to the closest triangle. `hint` is a triangle
   // index (in BVH order) whose distance seeds the search bound; it is
