@@ -494,6 +494,37 @@ TEST(MeshIo, OffFaceLinesWithValuesAfterTheIndicesAreRejected) {
   EXPECT_EQ(plain->mesh.triangleCount(), 2u);
 }
 
+// Fuzz finding 24: "2OFF\r0 0" - a lone \r ended the header line for the
+// pre-check, not for OpenMesh, which left its counts unread and reserved
+// 14 GB. The header must be [ST][C][N]OFF, and OpenMesh reads the file as
+// rewritten from the checked lines, so line ends and spacing are read one way.
+TEST(MeshIo, OffHeadersOutsideTheGrammarAreRejectedAndLineEndsReadOneWay) {
+  for (const char* bad : {"2OFF\r0 0\n", "2OFF\n0 0 0\n", "XOFF\n0 0 0\n", "CSTOFF\n0 0 0\n"}) {
+    Result<LoadedMesh> r = loadMeshFromMemory(bad, "off", "bad.off");
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_TRUE(contains(r.status().message(), "bad.off:1: expected an OFF header"))
+        << r.status().message();
+  }
+  // The same triangle with CR, CRLF and LF line ends, \v and \f as spaces,
+  // indentation, and two counts only (OpenMesh always reads three).
+  for (const char* off :
+       {"OFF\r3 1 0\r0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r", "OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n",
+        "OFF\n 3\v1 0\n\t0 0 0\n1\f0 0\n0 1 0\n3 0 1 2", "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+        "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n"}) {
+    Result<LoadedMesh> r = loadMeshFromMemory(off, "off", "tri.off");
+    ASSERT_TRUE(r.ok()) << r.status().toString();
+    ASSERT_EQ(r->mesh.triangleCount(), 1u);
+    ASSERT_EQ(r->mesh.vertexCount(), 3u);
+    glm::vec3 lo(1e9f), hi(-1e9f);
+    for (const glm::vec3& p : r->mesh.positions) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    EXPECT_EQ(lo, glm::vec3(0.0f));
+    EXPECT_EQ(hi, glm::vec3(1.0f, 1.0f, 0.0f));
+  }
+}
+
 // Memory safety: every truncated prefix and random byte corruptions of valid
 // files give a result (ok or error), never a crash or a hang.
 TEST(MeshIo, TruncatedPrefixesNeverCrash) {
