@@ -286,6 +286,32 @@ TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {
   EXPECT_EQ(core->frontendTriangles(), second.frontendTriangles);
 }
 
+// --measured-generation-delay sets the horizon through setGenerationDelay:
+// a longer delay is a larger region to serve, so at the same budget and pose
+// the guaranteed target is lower; a bad value is refused and changes nothing.
+TEST(BackboneCorePose, ALongerGenerationDelayLowersTheGuaranteedTarget) {
+  double target[2] = {0.0, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    auto core = makeCore(polygonBudget(400));
+    ASSERT_NE(core, nullptr);
+    deliverCurves(*core);
+    if (k == 1) {
+      EXPECT_FALSE(core->setGenerationDelay(-1.0).ok());
+      EXPECT_FALSE(core->setGenerationDelay(std::nan("")).ok());
+      EXPECT_EQ(core->generationDelay(), CoreOptions{}.config.generationDelay);
+      ASSERT_TRUE(core->setGenerationDelay(20.0).ok());
+      EXPECT_EQ(core->generationDelay(), 20.0);
+    }
+    ASSERT_TRUE(core->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+    submitAll(*core);
+    const PoseOutcome outcome = core->finishPose();
+    ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+    target[k] = outcome.update.targetAccuracy;
+  }
+  EXPECT_GT(target[0], 0.0);
+  EXPECT_LT(target[1], target[0]);
+}
+
 TEST(BackboneCorePose, SyncWaitReplanSendsInTheSameUpdate) {
   auto core = makeCore(polygonBudget(400));
   ASSERT_NE(core, nullptr);

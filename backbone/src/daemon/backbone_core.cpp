@@ -449,6 +449,14 @@ void BackboneCore::touchObject(std::uint32_t object) {
   dirty_ = true;
 }
 
+Status BackboneCore::setGenerationDelay(double seconds) {
+  backbone::SchedulerConfig config = options_.config;
+  config.generationDelay = seconds;
+  THINLOD_RETURN_IF_ERROR(scheduler_->setConfig(config));
+  options_.config = config;
+  return Status();
+}
+
 double BackboneCore::timeoutSeconds() const {
   const backbone::SchedulerConfig& c = options_.config;
   return c.linkDelay + c.generationDelay + c.plannedLifetime;

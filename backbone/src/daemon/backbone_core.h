@@ -180,6 +180,14 @@ class BackboneCore {
   std::size_t sharedTextureCount() const { return sharedTextures_.size(); }
   std::size_t texturesAtFrontend() const { return texturesAtFrontend_.size(); }
 
+  // ---- the prediction horizon ----
+  // The generation delay the scheduler plans with from the next pose on (the
+  // daemon's measured one, delay_estimate.h, under --measured-generation-delay);
+  // also the requests' expected-by time. kInvalidArgument (unchanged) when it
+  // is not finite or < 0.
+  Status setGenerationDelay(double seconds);
+  double generationDelay() const { return options_.config.generationDelay; }
+
   // ---- requests to the simplifier ----
   std::vector<OutgoingRequest> takeRequests();
   std::vector<std::uint64_t> takeCancellations();  // request ids

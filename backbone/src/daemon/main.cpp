@@ -15,9 +15,11 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "backbone_core.h"
+#include "thinlod/backbone/delay_estimate.h"
 #include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/protocol/daemon_runtime.h"
@@ -57,6 +59,7 @@ struct Settings {
   std::string simplifierAddress = protocol::kDefaultSimplifierAddress;
   int attemptTimeoutMs = 30000;
   int maxAttempts = 3;
+  bool measuredGenerationDelay = false;
   protocol::TransportOptions transport;
 };
 
@@ -81,6 +84,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "planned lifetime of a representation (s)");
   runtime.addOption("link-delay", &config.linkDelay, "backbone -> frontend delay (s)");
   runtime.addOption("generation-delay", &config.generationDelay, "simplifier generation delay (s)");
+  runtime.addOption("measured-generation-delay", &s.measuredGenerationDelay,
+                    "plan with the 90th percentile of the last 32 plan requests' submission-to-"
+                    "result times (at least --generation-delay) instead of the fixed delay");
   runtime.addOption("fill-budget", &config.fillBudget,
                     "curves: spend what the uniform target leaves of the budget (=false: off)");
   runtime.addOption("minimal-distance", &config.minimalDistance,
@@ -304,13 +310,21 @@ class Daemon {
       curveReleasedAt_ = now;
       nextCurveAt_ = Clock::time_point::max();  // until its answer
     }
-    for (std::uint64_t id : core_.takeCancellations()) workers_.cancel(id);
+    for (std::uint64_t id : core_.takeCancellations()) {
+      workers_.cancel(id);
+      submittedAt_.erase(id);
+    }
     // The pool sends each request under the id the core (and the scheduler) gave it.
     for (auto& request : core_.takeRequests()) {
       thinlod::Result<std::uint64_t> id =
           std::visit([&](auto& message) { return workers_.submit(message); }, request.message);
       if (id.ok() && *id == request.requestId) {
         core_.requestSubmitted(request.requestId);
+        const auto* simplify = std::get_if<protocol::SimplifyRequest>(&request.message);
+        // Plan requests only: not the startup warm-up (sent before any pose,
+        // it waits for the worker to load the scene) nor curve measurements.
+        if (posesServed_ > 0 && (simplify == nullptr || simplify->curvePoints == 0))
+          submittedAt_[*id] = now;
       } else {
         core_.requestNotSubmitted(request.requestId);
         if (id.ok()) workers_.cancel(*id);
@@ -356,6 +370,29 @@ class Daemon {
     }
   }
 
+  // --measured-generation-delay: a plan request's submission to its result
+  // is one observation (curve measurements are startup work, not what a plan
+  // waits for; cancelled and failed requests deliver nothing). The horizon
+  // moves when the estimate's grid value does (delay_estimate.h).
+  void observeDelivery(std::uint64_t requestId, const Status& status) {
+    const auto it = submittedAt_.find(requestId);
+    if (it == submittedAt_.end()) return;
+    const double seconds = std::chrono::duration<double>(Clock::now() - it->second).count();
+    submittedAt_.erase(it);
+    if (!status.ok() || !settings_.measuredGenerationDelay) return;
+    generationDelays_.observe(seconds);
+    const double delay = generationDelays_.estimate(settings_.core.config.generationDelay);
+    if (delay == core_.generationDelay()) return;
+    const Status set = core_.setGenerationDelay(delay);
+    if (!set.ok()) {
+      spdlog::warn("event=generation_delay_refused seconds={:.3f} error=\"{}\"", delay,
+                   set.toString());
+      return;
+    }
+    spdlog::info("event=generation_delay seconds={:.3f} p90={:.3f} samples={} last={:.3f}", delay,
+                 generationDelays_.rawQuantile(), generationDelays_.samples(), seconds);
+  }
+
   void onWorkerEvent(protocol::WorkerPoolEvent& event) {
     switch (event.kind) {
       case protocol::WorkerPoolEvent::Kind::kWorkerJoined:
@@ -369,6 +406,7 @@ class Daemon {
       case protocol::WorkerPoolEvent::Kind::kSimplifyResult: {
         lastResultAt_ = resultAt_;
         const std::size_t pendingBefore = core_.curvesPending();
+        observeDelivery(event.simplify.requestId, event.simplify.status);
         noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId,
                    event.worker);
         if (core_.curvesPending() < pendingBefore) {
@@ -389,6 +427,7 @@ class Daemon {
         break;
       }
       case protocol::WorkerPoolEvent::Kind::kImpostorResult:
+        observeDelivery(event.impostor.requestId, event.impostor.status);
         noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId,
                    event.worker);
         break;
@@ -554,6 +593,9 @@ class Daemon {
   std::uint64_t resultsAccepted_ = 0;
   std::uint64_t posesServed_ = 0;
   std::uint64_t lastLinkRate_ = 0;  // logged when it changes (--link-schedule)
+  // Plan requests in flight and when they were submitted (observeDelivery).
+  std::unordered_map<std::uint64_t, Clock::time_point> submittedAt_;
+  thinlod::backbone::DelayEstimate generationDelays_;
 };
 
 }  // namespace

@@ -50,6 +50,12 @@ Scheduler::Scheduler(const SchedulerConfig& config, std::unique_ptr<const Select
 
 Scheduler::~Scheduler() = default;
 
+Status Scheduler::setConfig(const SchedulerConfig& config) {
+  THINLOD_RETURN_IF_ERROR(validateConfig(config));
+  config_ = config;
+  return Status();
+}
+
 const char* Scheduler::name() const { return method_->name(); }
 
 Status Scheduler::accepts(const Budget& budget) const {

@@ -201,6 +201,10 @@ class Scheduler {
 
   const char* name() const;
   const SchedulerConfig& config() const { return config_; }
+  // Replaces the config for the next steps (e.g. a measured generation
+  // delay, delay_estimate.h); kInvalidArgument (config unchanged) when
+  // validateConfig refuses it. Caches keyed by the config start over.
+  Status setConfig(const SchedulerConfig& config);
   // kUnsupported when the method cannot honour this budget (greedy-fs93
   // without a polygon budget); plan() checks it too.
   Status accepts(const Budget& budget) const;
