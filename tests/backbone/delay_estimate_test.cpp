@@ -13,6 +13,13 @@
 namespace thinlod::backbone {
 namespace {
 
+DelayEstimate::Options windowed(std::size_t window, std::size_t minSamples) {
+  DelayEstimate::Options o;
+  o.window = window;
+  o.minSamples = minSamples;
+  return o;
+}
+
 TEST(DelayEstimate, IsTheFloorUntilEnoughSamples) {
   DelayEstimate e;  // minSamples 4
   EXPECT_EQ(e.estimate(0.1), 0.1);
@@ -23,9 +30,7 @@ TEST(DelayEstimate, IsTheFloorUntilEnoughSamples) {
 }
 
 TEST(DelayEstimate, NearestRankQuantileRoundedUpOntoTheFloorsGrid) {
-  DelayEstimate::Options o;
-  o.window = 10;
-  o.minSamples = 1;
+  const DelayEstimate::Options o = windowed(10, 1);
   DelayEstimate e(o);
   for (int i = 1; i <= 10; ++i) e.observe(0.1 * i);  // 0.1 .. 1.0
   EXPECT_DOUBLE_EQ(e.rawQuantile(), 0.9);            // ceil(0.9 * 10) = 9th smallest
@@ -39,10 +44,7 @@ TEST(DelayEstimate, NearestRankQuantileRoundedUpOntoTheFloorsGrid) {
 }
 
 TEST(DelayEstimate, KeepsOnlyTheWindowAndIgnoresBadValues) {
-  DelayEstimate::Options o;
-  o.window = 4;
-  o.minSamples = 4;
-  DelayEstimate e(o);
+  DelayEstimate e(windowed(4, 4));
   for (int i = 0; i < 4; ++i) e.observe(9.0);
   for (int i = 0; i < 4; ++i) e.observe(0.05);
   EXPECT_EQ(e.samples(), 4u);
