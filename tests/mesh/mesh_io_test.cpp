@@ -494,11 +494,18 @@ TEST(MeshIo, OffFaceLinesWithValuesAfterTheIndicesAreRejected) {
   EXPECT_EQ(plain->mesh.triangleCount(), 2u);
 }
 
-// Fuzz finding 24: "2OFF\r0 0" - a lone \r ended the header line for the
+// Fuzz finding 24: "OFF\r0 0" - a lone \r ended the header line for the
 // pre-check, not for OpenMesh, which left its counts unread and reserved
-// 14 GB. The header must be [ST][C][N]OFF, and OpenMesh reads the file as
-// rewritten from the checked lines, so line ends and spacing are read one way.
+// 14 GB. OpenMesh now reads the file as rewritten from the checked lines, so
+// line ends and spacing are read one way; and the header must be
+// [ST][C][N]OFF (anything else before OFF was let through).
 TEST(MeshIo, OffHeadersOutsideTheGrammarAreRejectedAndLineEndsReadOneWay) {
+  {
+    // The finding itself: a clear answer (no triangles), no 14 GB reserve.
+    Result<LoadedMesh> r = loadMeshFromMemory(std::string_view("OFF\r0 0\n"), "off", "cr.off");
+    ASSERT_FALSE(r.ok());
+    EXPECT_TRUE(contains(r.status().message(), "cr.off")) << r.status().message();
+  }
   for (const char* bad : {"2OFF\r0 0\n", "2OFF\n0 0 0\n", "XOFF\n0 0 0\n", "CSTOFF\n0 0 0\n"}) {
     Result<LoadedMesh> r = loadMeshFromMemory(bad, "off", "bad.off");
     ASSERT_FALSE(r.ok()) << bad;
@@ -523,6 +530,30 @@ TEST(MeshIo, OffHeadersOutsideTheGrammarAreRejectedAndLineEndsReadOneWay) {
     EXPECT_EQ(lo, glm::vec3(0.0f));
     EXPECT_EQ(hi, glm::vec3(1.0f, 1.0f, 0.0f));
   }
+}
+
+// Fuzz finding 25: "comment ...\rend_header" - OpenMesh's PLY header reader
+// ends lines at line feeds only, skipped end_header with the comment and
+// looped at the end of the file. A lone CR in a PLY header is refused; CRLF
+// headers still load.
+TEST(MeshIo, PlyHeaderWithALoneCarriageReturnIsRejectedAndCrlfLoads) {
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  for (const std::string& bad :
+       {header + "comment x\rend_header\n" + body, header + "end_header\r" + body,
+        "ply\rformat ascii 1.0\n" + header.substr(4) + "end_header\n" + body}) {
+    Result<LoadedMesh> r = loadMeshFromMemory(bad, "ply", "cr.ply");
+    ASSERT_FALSE(r.ok());
+    EXPECT_TRUE(contains(r.status().message(), "cr.ply")) << r.status().message();
+  }
+  std::string crlf = header + "comment made on Windows\nend_header\n";
+  for (std::size_t i = crlf.find('\n'); i != std::string::npos; i = crlf.find('\n', i + 2))
+    crlf.insert(i, "\r");
+  Result<LoadedMesh> ok = loadMeshFromMemory(crlf + body, "ply", "crlf.ply");
+  ASSERT_TRUE(ok.ok()) << ok.status().toString();
+  EXPECT_EQ(ok->mesh.triangleCount(), 1u);
 }
 
 // Memory safety: every truncated prefix and random byte corruptions of valid
