@@ -52,6 +52,16 @@ std::vector<std::string_view> tokenize(std::string_view line) {
   return tokens;
 }
 
+// Appends a checked line to a rewritten file (PrecheckResult::rewritten):
+// its tokens up to a comment, single spaces, an LF.
+void appendCheckedLine(const std::vector<std::string_view>& tokens, std::string* rewritten) {
+  for (std::size_t i = 0; i < tokens.size() && tokens[i][0] != '#'; ++i) {
+    if (i > 0) *rewritten += ' ';
+    rewritten->append(tokens[i].data(), tokens[i].size());
+  }
+  *rewritten += '\n';
+}
+
 std::string quoted(std::string_view token) {
   const std::size_t kMax = 32;
   std::string s(token.substr(0, kMax));
@@ -189,11 +199,7 @@ Result<PrecheckResult> precheckObj(std::string_view bytes, const std::string& na
   std::string rewritten;
   rewritten.reserve(bytes.size() + 1);  // never longer than the file and a final LF
   const auto keep = [&rewritten](const std::vector<std::string_view>& tokens) {
-    for (std::size_t i = 0; i < tokens.size() && tokens[i][0] != '#'; ++i) {
-      if (i > 0) rewritten += ' ';
-      rewritten.append(tokens[i].data(), tokens[i].size());
-    }
-    rewritten += '\n';
+    appendCheckedLine(tokens, &rewritten);
   };
   while (scanner.next(&line)) {
     const std::vector<std::string_view> tokens = tokenize(line);
@@ -387,12 +393,9 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
   // cannot then be read two ways.
   std::string rewritten;
   rewritten.reserve(bytes.size() + 16);
+  // (No token holds a '#' here: nextContentLine stops at comments.)
   const auto keep = [&rewritten](const std::vector<std::string_view>& lineTokens) {
-    for (std::size_t i = 0; i < lineTokens.size(); ++i) {
-      if (i > 0) rewritten += ' ';
-      rewritten.append(lineTokens[i].data(), lineTokens[i].size());
-    }
-    rewritten += '\n';
+    appendCheckedLine(lineTokens, &rewritten);
   };
   rewritten.append(magic.data(), magic.size());
   rewritten += '\n';
