@@ -165,27 +165,6 @@ class TriangleBvh {
     for (std::size_t i = 0; i < n; ++i) triangles_[i] = source[order_[i]];
   }
 
-  // Calls visit(i, triangle) for every triangle (BVH order index i) within
-  // squared distance radius2 of p.
-  template <typename Visit>
-  void forEachWithin(const dvec3& p, double radius2, Visit visit) const {
-    std::array<std::uint32_t, kTraversalStack> stack;
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& node = nodes_[stack[--top]];
-      if (squaredDistanceToBox(p, node.box) > radius2) continue;
-      if (node.count > 0) {
-        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-          if (squaredDistanceToTriangle(p, triangles_[i]) <= radius2) visit(i, triangles_[i]);
-        }
-        continue;
-      }
-      stack[top++] = node.first;
-      stack[top++] = node.first + 1;
-    }
-  }
-
   // The mesh's triangle number of BVH-order triangle i.
   std::uint32_t sourceTriangle(std::uint32_t i) const { return order_[i]; }
 
@@ -220,14 +199,16 @@ class TriangleBvh {
     return boxes;
   }
 
-  // forEachWithin for a search that keeps the least of a value taken inside
-  // each triangle (a point of the triangle, or an attribute interpolated on
-  // it with barycentrics in the simplex), so the value lies in the
-  // triangle's box of `valueBoxes` (nodeBoxesOf). bestSquared() is the search's current least squared
-  // distance from `target` to a value; a node whose value box lies no nearer
-  // than that cannot lower it and is skipped, the nearer child first. The
-  // least value found is the one forEachWithin's visits would give: only
-  // triangles that cannot change it are left out.
+  // Calls visit(i, triangle) for triangles (BVH order index i) within
+  // squared distance radius2 of p, for a search that keeps the least of a
+  // value taken inside each triangle (a point of the triangle, or an
+  // attribute interpolated on it with barycentrics in the simplex), so the
+  // value lies in the triangle's box of `valueBoxes` (nodeBoxesOf).
+  // bestSquared() is the search's current least squared distance from
+  // `target` to a value; a node whose value box lies no nearer than that
+  // cannot lower it and is skipped, the nearer child first. The least value
+  // found is the one visiting every triangle within the radius would give:
+  // only triangles that cannot change it are left out.
   template <typename Best, typename Visit>
   void forEachWithinWhileNearer(const dvec3& p, double radius2, const std::vector<Box>& valueBoxes,
                                 const dvec3& target, Best bestSquared, Visit visit) const {
