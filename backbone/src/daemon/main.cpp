@@ -323,7 +323,8 @@ class Daemon {
         const auto* simplify = std::get_if<protocol::SimplifyRequest>(&request.message);
         // Plan requests only: not the startup warm-up (sent before any pose,
         // it waits for the worker to load the scene) nor curve measurements.
-        if (posesServed_ > 0 && (simplify == nullptr || simplify->curvePoints == 0))
+        if (settings_.measuredGenerationDelay && posesServed_ > 0 &&
+            (simplify == nullptr || simplify->curvePoints == 0))
           submittedAt_[*id] = now;
       } else {
         core_.requestNotSubmitted(request.requestId);
@@ -379,7 +380,7 @@ class Daemon {
     if (it == submittedAt_.end()) return;
     const double seconds = std::chrono::duration<double>(Clock::now() - it->second).count();
     submittedAt_.erase(it);
-    if (!status.ok() || !settings_.measuredGenerationDelay) return;
+    if (!status.ok()) return;
     generationDelays_.observe(seconds);
     const double delay = generationDelays_.estimate(settings_.core.config.generationDelay);
     if (delay == core_.generationDelay()) return;

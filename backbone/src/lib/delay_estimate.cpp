@@ -42,14 +42,16 @@ double DelayEstimate::rawQuantile() const {
 
 double DelayEstimate::estimate(double floor) const {
   const double lowest = std::isfinite(floor) && floor > 0.0 ? floor : 0.0;
-  if (observed_.size() < options_.minSamples) return std::min(lowest, options_.maxSeconds);
+  if (observed_.size() < options_.minSamples) return lowest;
   const double q = rawQuantile();
-  if (q <= lowest) return std::min(lowest, options_.maxSeconds);
-  // Up onto base x ratio^k: the first grid point at or above q.
+  if (q <= lowest) return lowest;
+  // Up onto base x ratio^k: the first grid point at or above q, at most
+  // maxSeconds, never below the floor (std::clamp would be undefined for a
+  // floor above maxSeconds).
   const double base = lowest > 0.0 ? lowest : options_.minStep;
   double value = base;
   while (value < q && value < options_.maxSeconds) value *= options_.ratio;
-  return std::clamp(value, lowest, options_.maxSeconds);
+  return std::max(lowest, std::min(value, options_.maxSeconds));
 }
 
 }  // namespace thinlod::backbone

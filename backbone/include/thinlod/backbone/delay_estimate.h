@@ -9,8 +9,9 @@
 //   is ignored (returns false). The last `window` observations are kept.
 // - estimate(floor): the `quantile` of the kept observations (nearest rank:
 //   the ceil(q n)-th smallest), rounded up onto the grid floor x ratio^k
-//   (k = 0, 1, ...) and clamped to [floor, maxSeconds]; `floor` (the
-//   configured delay, >= 0) while fewer than `minSamples` are kept. The grid
+//   (k = 0, 1, ...), at most maxSeconds and never below `floor` (the
+//   configured delay, >= 0), which is also the estimate while fewer than
+//   `minSamples` are kept. The grid
 //   makes the horizon, and with it the scheduler's caches keyed by its
 //   config, change only when the measurement moves by a grid step; a floor
 //   of 0 uses minStep as the grid's base.
