@@ -600,5 +600,207 @@ TEST(MeshIo, RandomCorruptionsNeverCrash) {
   }
 }
 
+// PLY files reach OpenMesh only as rewritten from what the pre-check read
+// (header from its parsed elements, ASCII items line by line, a binary body
+// as walked): comments, CRLF, tabs, extra blank lines and bytes after the
+// last element load the same mesh as the plain file.
+TEST(MeshIo, PlyDecorationsLoadTheSameMeshAsThePlainFile) {
+  const std::string header =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "element face 2\nproperty list uchar int vertex_indices\n";
+  const std::string plain = "ply\nformat ascii 1.0\n" + header +
+                            "end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n"
+                            "0 1 0 9 9 9\n3 0 1 2\n3 0 2 3\n";
+  const std::string decorated =
+      "ply\r\nformat\tascii 1.0\r\ncomment made by hand\r\nobj_info x\r\n"
+      "element vertex 4\r\nproperty float x\r\nproperty  float y\r\nproperty float z\r\n"
+      "property uchar red\r\nproperty uchar green\r\nproperty uchar blue\r\n"
+      "element face 2\r\ncomment faces next\r\nproperty list uchar int vertex_indices\r\n"
+      "end_header\r\n0 0 0 255 0 0\r\n\r\n1\t0 0 0 255 0\r\n  1 1 0 0 0 255\r\n"
+      "0 1 0 9 9 9\r\n3 0 1 2\r\n3\t0 2 3 \r\nafter the last element\r\n";
+  Result<LoadedMesh> a = loadMeshFromMemory(plain, "ply", "plain.ply");
+  Result<LoadedMesh> b = loadMeshFromMemory(decorated, "ply", "decorated.ply");
+  ASSERT_TRUE(a.ok()) << a.status().toString();
+  ASSERT_TRUE(b.ok()) << b.status().toString();
+  EXPECT_EQ(a->mesh.positions, b->mesh.positions);
+  EXPECT_EQ(a->mesh.colors, b->mesh.colors);
+  EXPECT_EQ(a->mesh.indices, b->mesh.indices);
+  EXPECT_EQ(b->mesh.triangleCount(), 2u);
+}
+
+// OpenMesh reads ASCII PLY values with operator>> into their types and skips
+// a list other than a face's vertex indices as one value, so an item with a
+// value more or less, a value that does not fit its type or such a list
+// shifted every value after it. Each is refused with its line.
+TEST(MeshIo, PlyItemsMustHoldExactlyTheirDeclaredValues) {
+  const std::string vertex =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string verts = "0 0 0\n1 0 0\n0 1 0\n";
+  struct Case {
+    std::string text;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header\n0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "bad.ply:10: vertex item has 1 value(s) after its properties"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header\n0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "bad.ply:10: vertex item ends before its property 'z'"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header\n" + verts + "3 0 1 2 5\n",
+       "bad.ply:13: face item has 1 value(s) after its properties"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header\n" + verts + "3 0 1.5 2\n",
+       "bad.ply:13: face vertex index '1.5' is not a signed 32-bit integer"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "end_header\n" + verts + "300 0 1 2\n",
+       "bad.ply:13: list count '300' is not an unsigned 8-bit integer"},
+      {"ply\nformat ascii 1.0\n" + vertex + "property uchar red\n" + face + "end_header\n" +
+           "0 0 0 256\n1 0 0 1\n0 1 0 1\n3 0 1 2\n",
+       "bad.ply:11: vertex value '256' is not an unsigned 8-bit integer"},
+      {"ply\nformat ascii 1.0\n" + vertex + "property float red\n" + face + "end_header\n" +
+           "0 0 0 1e9\n1 0 0 1\n0 1 0 1\n3 0 1 2\n",
+       "bad.ply:11: vertex colour component '1e9' is outside [0, 1]"},
+      {"ply\nformat ascii 1.0\n" + vertex + "property double red\n" + face + "end_header\n" +
+           "0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n",
+       "bad.ply:7: colour property 'red' of type double is not supported"},
+      {"ply\nformat ascii 1.0\n" + vertex + "property list uchar float extra\n" + face +
+           "end_header\n0 0 0 1 5\n1 0 0 0\n0 1 0 0\n3 0 1 2\n",
+       "bad.ply:7: list property 'extra' of element 'vertex' is not supported"},
+      {"ply\nformat ascii 1.0\n" + vertex + face + "property list uchar float uv\nend_header\n" +
+           verts + "3 0 1 2 2 0.5 0.5\n",
+       "bad.ply:9: list property 'uv' of element 'face' is not supported"},
+      {"ply\nformat ascii 1.0\n" + vertex +
+           "element face 1\nproperty list uint int vertex_indices\nend_header\n" + verts +
+           "3 0 1 2\n",
+       "bad.ply:8: list count type 'uint' is not supported"},
+      {"ply\nformat ascii 1.0\n" + vertex +
+           "element face 1\nproperty list uchar float vertex_indices\nend_header\n" + verts +
+           "3 0 1 2\n",
+       "bad.ply:8: face vertex indices must have an integer type"},
+      {"ply\nformat ascii 1.0\n" + face + vertex + "end_header\n3 0 1 2\n" + verts,
+       "bad.ply:3: the face element comes before the vertex element"},
+      {"ply\nformat ascii 1.0\nelement edge 99999999999\nproperty int a\n" + vertex + face +
+           "end_header\n",
+       "exceed the limit"},
+  };
+  for (const Case& c : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(c.text, "ply", "bad.ply");
+    ASSERT_FALSE(r.ok()) << c.message;
+    EXPECT_TRUE(contains(r.status().message(), c.message))
+        << "expected '" << c.message << "', got: " << r.status().message();
+  }
+  Result<LoadedMesh> good = loadMeshFromMemory(
+      "ply\nformat ascii 1.0\n" + vertex + "property float red\n" + face + "end_header\n" +
+          "0 0 0 0\n1 0 0 0.5\n0 1 0 1\n3 0 1 2\n",
+      "ply", "good.ply");
+  ASSERT_TRUE(good.ok()) << good.status().toString();
+  EXPECT_EQ(good->mesh.triangleCount(), 1u);
+}
+
+// A binary PLY body is walked as OpenMesh reads it: each face list's count
+// and indices, every float finite and within the float range (OpenMesh
+// converts doubles to float), float colours in [0, 1] (it scales them by 255
+// into an int: undefined far outside). A negative count of an int-counted
+// list, read as unsigned, made it push about four billion indices.
+TEST(MeshIo, BinaryPlyBodiesAreWalkedValueByValue) {
+  struct Vertex {
+    float x, y, z, red;
+  };
+  const auto file = [](const std::string& countType, const std::vector<Vertex>& vertices,
+                       const std::vector<std::vector<std::int32_t>>& faces,
+                       const std::string& extra = "") {
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                        std::to_string(vertices.size()) +
+                        "\nproperty float x\nproperty float y\nproperty float z\n"
+                        "property float red\nelement face " +
+                        std::to_string(faces.size()) + "\nproperty list " + countType +
+                        " int vertex_indices\nend_header\n";
+    for (const Vertex& v : vertices) bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+    for (const std::vector<std::int32_t>& f : faces) {
+      if (countType == "int") {
+        const std::int32_t n = f[0];
+        bytes.append(reinterpret_cast<const char*>(&n), 4);
+      } else {
+        bytes += static_cast<char>(f[0]);
+      }
+      bytes.append(reinterpret_cast<const char*>(f.data() + 1), 4 * (f.size() - 1));
+    }
+    return bytes + extra;
+  };
+  const std::vector<Vertex> tri = {{0, 0, 0, 0}, {1, 0, 0, 0.5f}, {0, 1, 0, 1}};
+  Result<LoadedMesh> good = loadMeshFromMemory(file("uchar", tri, {{3, 0, 1, 2}}, "trailing"),
+                                               "ply", "good.ply");
+  ASSERT_TRUE(good.ok()) << good.status().toString();
+  EXPECT_EQ(good->mesh.triangleCount(), 1u);
+  Result<LoadedMesh> goodInt =
+      loadMeshFromMemory(file("int", tri, {{3, 0, 1, 2}}), "ply", "good.ply");
+  ASSERT_TRUE(goodInt.ok()) << goodInt.status().toString();
+  EXPECT_EQ(goodInt->mesh.positions, good->mesh.positions);
+
+  struct Case {
+    std::string bytes;
+    std::string message;
+  };
+  std::vector<Vertex> hot = tri;
+  hot[1].red = 3e9f;
+  std::vector<Vertex> inf = tri;
+  inf[2].y = std::numeric_limits<float>::infinity();
+  const std::vector<Case> cases = {
+      {file("int", tri, {{-1, 0, 1, 2}}), "bad.ply: face 0 has -1 vertices (at least 3)"},
+      {file("uchar", tri, {{2, 0, 1}}), "bad.ply: face 0 has 2 vertices (at least 3)"},
+      {file("uchar", tri, {{3, 0, 1, 3}}), "bad.ply: face 0 references vertex 3 (only 3 vertices)"},
+      {file("uchar", tri, {{3, 0, -1, 2}}), "bad.ply: face 0 references vertex -1"},
+      {file("uchar", tri, {{4, 0, 1, 2}}), "bad.ply: truncated: the data ends in face 0"},
+      {file("uchar", hot, {{3, 0, 1, 2}}),
+       "bad.ply: vertex 1: colour component 'red' is outside [0, 1]"},
+      {file("uchar", inf, {{3, 0, 1, 2}}),
+       "bad.ply: vertex 2: property 'y' is not a finite float"},
+  };
+  for (const Case& c : cases) {
+    Result<LoadedMesh> r = loadMeshFromMemory(c.bytes, "ply", "bad.ply");
+    ASSERT_FALSE(r.ok()) << c.message;
+    EXPECT_TRUE(contains(r.status().message(), c.message))
+        << "expected '" << c.message << "', got: " << r.status().message();
+  }
+  // A double beyond the float range (OpenMesh's double-to-float conversion
+  // would be undefined).
+  std::string doubles =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty double x\n"
+      "property double y\nproperty double z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const auto appendBigEndian = [&doubles](const void* p, int n) {
+    const char* c = static_cast<const char*>(p);
+    for (int i = n - 1; i >= 0; --i) doubles += c[i];
+  };
+  for (double v : {0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1e300, 0.0}) appendBigEndian(&v, 8);
+  doubles += '\3';
+  for (std::int32_t i : {0, 1, 2}) appendBigEndian(&i, 4);
+  Result<LoadedMesh> r = loadMeshFromMemory(doubles, "ply", "bad.ply");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.status().message(), "bad.ply: vertex 2: property 'y' is not a finite float"))
+      << r.status().message();
+}
+
+// OpenMesh skips "\r\n" after a binary header's end_header only when it
+// sees it; the rewrite ends the header with LF, so a CRLF header loads the
+// same mesh as an LF one.
+TEST(MeshIo, BinaryPlyWithACrlfHeaderLoadsTheSameMesh) {
+  std::ifstream in(dataPath("good_tetra_binary.ply"), std::ios::binary);
+  const std::string lf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t bodyAt = lf.find("end_header\n") + 11;
+  std::string crlf;
+  for (std::size_t i = 0; i < bodyAt; ++i) {
+    if (lf[i] == '\n') crlf += '\r';
+    crlf += lf[i];
+  }
+  crlf += lf.substr(bodyAt);
+  Result<LoadedMesh> a = loadMeshFromMemory(lf, "ply", "lf.ply");
+  Result<LoadedMesh> b = loadMeshFromMemory(crlf, "ply", "crlf.ply");
+  ASSERT_TRUE(a.ok()) << a.status().toString();
+  ASSERT_TRUE(b.ok()) << b.status().toString();
+  EXPECT_EQ(a->mesh.positions, b->mesh.positions);
+  EXPECT_EQ(a->mesh.colors, b->mesh.colors);
+  EXPECT_EQ(a->mesh.indices, b->mesh.indices);
+}
+
 }  // namespace
 }  // namespace thinlod

@@ -1,5 +1,6 @@
 #include "mesh/mesh_precheck.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -464,10 +465,32 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
 
 // ---------------------------------------------------------------- PLY
 
+// A PLY value type as the header names it: its size and how its ASCII
+// tokens must look.
+struct PlyType {
+  int bytes = 0;  // 0: not a PLY type
+  enum class Kind { kSigned, kUnsigned, kFloat, kDouble } kind = Kind::kSigned;
+};
+
+PlyType plyType(std::string_view type) {
+  using K = PlyType::Kind;
+  if (type == "char" || type == "int8") return {1, K::kSigned};
+  if (type == "uchar" || type == "uint8") return {1, K::kUnsigned};
+  if (type == "short" || type == "int16") return {2, K::kSigned};
+  if (type == "ushort" || type == "uint16") return {2, K::kUnsigned};
+  if (type == "int" || type == "int32") return {4, K::kSigned};
+  if (type == "uint" || type == "uint32") return {4, K::kUnsigned};
+  if (type == "float" || type == "float32") return {4, K::kFloat};
+  if (type == "double" || type == "float64") return {8, K::kDouble};
+  return {};
+}
+
 struct PlyProperty {
   std::string name;
-  int scalarBytes = 0;     // size of the value (or of the list entries)
-  int listCountBytes = 0;  // 0: not a list
+  std::string_view valueTypeName;  // the header's own token (kept in the rewrite)
+  std::string_view countTypeName;  // lists only
+  PlyType value;                   // the value (or the list entries)
+  PlyType count;                   // bytes == 0: not a list
 };
 
 struct PlyElement {
@@ -476,15 +499,196 @@ struct PlyElement {
   std::vector<PlyProperty> properties;
 };
 
-int plyTypeBytes(std::string_view type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
-      type == "float32") {
-    return 4;
+bool isColourProperty(const std::string& name) {
+  return name == "red" || name == "green" || name == "blue" || name == "alpha" ||
+         name == "diffuse_red" || name == "diffuse_green" || name == "diffuse_blue";
+}
+
+// One ASCII token as a value of `type`. OpenMesh reads ASCII PLY values with
+// operator>> into the declared type, so a token that is not exactly such a
+// value ("1.5" for an int, "300" for a uchar) would be read in part and the
+// rest left for the next value: everything after it shifts.
+Status checkPlyAsciiValue(std::string_view token, const PlyType& type, const std::string& name,
+                          int line, const char* what) {
+  using K = PlyType::Kind;
+  if (type.kind == K::kSigned || type.kind == K::kUnsigned) {
+    std::int64_t v = 0;
+    const int bits = 8 * type.bytes;
+    const std::int64_t lo = type.kind == K::kSigned ? -(std::int64_t{1} << (bits - 1)) : 0;
+    const std::int64_t hi = type.kind == K::kSigned ? (std::int64_t{1} << (bits - 1)) - 1
+                                                     : (std::int64_t{1} << bits) - 1;
+    if (!parseSigned(token, &v) || v < lo || v > hi) {
+      return lineError(name, line,
+                       std::string(what) + " " + quoted(token) + " is not " +
+                           (type.kind == K::kSigned ? "a signed" : "an unsigned") + " " +
+                           std::to_string(bits) + "-bit integer");
+    }
+    return Status();
   }
-  if (type == "double" || type == "float64") return 8;
-  return 0;
+  // float and double alike: OpenMesh reads ASCII values into floats, and
+  // operator>> fails beyond the float range (checkFiniteNumbers' rule).
+  return checkFiniteNumbers({token}, 0, 1, name, line, what);
+}
+
+// ASCII PLY: every item holds exactly its properties' values, each value
+// fits its declared type, colours given as floats lie in [0, 1] (OpenMesh
+// scales them by 255 into an integer: far outside, undefined behaviour in
+// its reader), the face's vertex index list (the only list the header
+// allows) has >= 3 indices of existing vertices. The checked tokens are
+// appended to `rewritten`, one item per line.
+Status checkPlyAsciiItem(const PlyElement& e, const std::vector<std::string_view>& tokens,
+                         std::uint64_t vertexCount, const std::string& name, int line,
+                         std::string* rewritten) {
+  const bool isVertex = e.name == "vertex";
+  const bool isFace = e.name == "face";
+  std::size_t t = 0;
+  for (std::size_t p = 0; p < e.properties.size(); ++p) {
+    const PlyProperty& prop = e.properties[p];
+    if (t >= tokens.size()) {
+      return lineError(name, line,
+                       e.name + " item ends before its property " + quoted(prop.name));
+    }
+    if (prop.count.bytes == 0) {
+      THINLOD_RETURN_IF_ERROR(checkPlyAsciiValue(tokens[t], prop.value, name, line,
+                                                 isVertex ? "vertex value" : "value"));
+      if ((isVertex || isFace) && isColourProperty(prop.name) &&
+          prop.value.kind == PlyType::Kind::kFloat) {
+        double v = 0.0;
+        parseNumberToken(tokens[t], &v);
+        if (!(v >= 0.0 && v <= 1.0)) {
+          return lineError(name, line,
+                           e.name + " colour component " + quoted(tokens[t]) +
+                               " is outside [0, 1]");
+        }
+      }
+      ++t;
+      continue;
+    }
+    THINLOD_RETURN_IF_ERROR(checkPlyAsciiValue(tokens[t], prop.count, name, line, "list count"));
+    std::uint64_t k = 0;
+    parseUnsigned(tokens[t], &k);  // a negative count (a signed count type) stays 0: refused
+    ++t;
+    if (k < 3) return lineError(name, line, "bad face line (fewer than 3 vertices)");
+    if (k > tokens.size() - t) {
+      return lineError(name, line,
+                       "list " + quoted(prop.name) + " declares " + std::to_string(k) +
+                           " values, the line has " + std::to_string(tokens.size() - t));
+    }
+    for (std::uint64_t j = 0; j < k; ++j, ++t) {
+      THINLOD_RETURN_IF_ERROR(
+          checkPlyAsciiValue(tokens[t], prop.value, name, line, "face vertex index"));
+      std::uint64_t index = 0;
+      if (!parseUnsigned(tokens[t], &index)) {
+        return lineError(name, line, "face has a bad vertex index " + quoted(tokens[t]));
+      }
+      if (index >= vertexCount) {
+        return lineError(name, line,
+                         "face references vertex " + std::to_string(index) + " (only " +
+                             std::to_string(vertexCount) + " vertices)");
+      }
+    }
+  }
+  if (t != tokens.size()) {
+    return lineError(name, line,
+                     e.name + " item has " + std::to_string(tokens.size() - t) +
+                         " value(s) after its properties");
+  }
+  appendCheckedLine(tokens, rewritten);
+  return Status();
+}
+
+// Binary PLY: walks every item as OpenMesh will read it, so the body is
+// exactly as long as the header says and each value is one OpenMesh can
+// take: face lists of >= 3 existing vertices (a negative count read as
+// unsigned made it push ~4 billion indices), floats finite, doubles within
+// the float range (it converts them to float, undefined beyond),
+// colours given as floats in [0, 1] (it scales them by 255 into an int).
+// `*walkedBytes` is where the last item ends.
+Status walkPlyBinary(std::string_view body, bool bigEndian, const std::vector<PlyElement>& elements,
+                     std::uint64_t vertexCount, const std::string& name,
+                     std::size_t* walkedBytes) {
+  using K = PlyType::Kind;
+  std::size_t pos = 0;
+  const auto truncated = [&](const PlyElement& e, std::uint64_t item) {
+    return Status(ErrorCode::kInvalidArgument,
+                  name + ": truncated: the data ends in " + e.name + " " + std::to_string(item) +
+                      " (byte " + std::to_string(pos) + " of " + std::to_string(body.size()) +
+                      " after the header)");
+  };
+  // Reads one value of `type` at pos; false when the body ends first.
+  const auto read = [&](const PlyType& type, double* value) {
+    if (body.size() - pos < static_cast<std::size_t>(type.bytes)) return false;
+    unsigned char b[8];
+    for (int i = 0; i < type.bytes; ++i) {
+      b[i] = static_cast<unsigned char>(body[pos + (bigEndian ? type.bytes - 1 - i : i)]);
+    }
+    pos += static_cast<std::size_t>(type.bytes);
+    std::uint64_t u = 0;
+    for (int i = type.bytes - 1; i >= 0; --i) u = (u << 8) | b[i];
+    switch (type.kind) {
+      case K::kUnsigned: *value = static_cast<double>(u); break;
+      case K::kSigned: {
+        const int shift = 64 - 8 * type.bytes;
+        *value = static_cast<double>(static_cast<std::int64_t>(u << shift) >> shift);
+        break;
+      }
+      case K::kFloat: {
+        float f;
+        const std::uint32_t u32 = static_cast<std::uint32_t>(u);
+        std::memcpy(&f, &u32, 4);
+        *value = f;
+        break;
+      }
+      case K::kDouble: std::memcpy(value, &u, 8); break;
+    }
+    return true;
+  };
+  for (const PlyElement& e : elements) {
+    const bool isVertex = e.name == "vertex";
+    for (std::uint64_t item = 0; item < e.count; ++item) {
+      for (const PlyProperty& p : e.properties) {
+        double v = 0.0;
+        if (p.count.bytes == 0) {
+          if (!read(p.value, &v)) return truncated(e, item);
+          if (p.value.kind == K::kFloat || p.value.kind == K::kDouble) {
+            if (!std::isfinite(v) || !(std::fabs(v) < 0x1.ffffffp+127)) {
+              return Status(ErrorCode::kInvalidArgument,
+                            name + ": " + e.name + " " + std::to_string(item) + ": property " +
+                                quoted(p.name) + " is not a finite float");
+            }
+            if ((isVertex || e.name == "face") && isColourProperty(p.name) &&
+                !(v >= 0.0 && v <= 1.0)) {
+              return Status(ErrorCode::kInvalidArgument,
+                            name + ": " + e.name + " " + std::to_string(item) +
+                                ": colour component " + quoted(p.name) + " is outside [0, 1]");
+            }
+          }
+          continue;
+        }
+        // The face's vertex index list (the only list the header allows).
+        if (!read(p.count, &v)) return truncated(e, item);
+        if (!(v >= 3.0)) {
+          return Status(ErrorCode::kInvalidArgument,
+                        name + ": face " + std::to_string(item) + " has " +
+                            std::to_string(static_cast<long long>(v)) +
+                            " vertices (at least 3)");
+        }
+        const std::uint64_t k = static_cast<std::uint64_t>(v);
+        for (std::uint64_t j = 0; j < k; ++j) {
+          if (!read(p.value, &v)) return truncated(e, item);
+          if (!(v >= 0.0) || v >= static_cast<double>(vertexCount)) {
+            return Status(ErrorCode::kInvalidArgument,
+                          name + ": face " + std::to_string(item) + " references vertex " +
+                              std::to_string(static_cast<long long>(v)) + " (only " +
+                              std::to_string(vertexCount) + " vertices)");
+          }
+        }
+      }
+    }
+    if (e.name == "face") break;  // OpenMesh reads nothing after the faces
+  }
+  *walkedBytes = pos;
+  return Status();
 }
 
 Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& name,
@@ -506,7 +710,8 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
     // more or less on a line shifts everything after it (the words of a
     // short property line ran into 'end_header', which it then never saw
     // and looped at the end of the file). So every line has exactly its
-    // words.
+    // words. (OpenMesh now reads the header as rewritten below; the rule
+    // stays, since such a line is malformed.)
     if (key == "format") {
       if (tokens.size() != 3 || tokens[2] != "1.0") {
         return Status(ErrorCode::kVersionMismatch,
@@ -522,21 +727,66 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
         return lineError(name, ln, "element line needs a name and a count, nothing else");
       }
       e.name = std::string(tokens[1]);
+      // OpenMesh reads counts as 32-bit unsigned; a larger one failed its
+      // stream and left it reading the header forever. Every element is
+      // held to the face limit (vertex and face to their own, below).
+      if (e.count > options.maxFaces && e.name != "vertex" && e.name != "face") {
+        return limitError(name, ("'" + e.name + "' items").c_str(), e.count, options.maxFaces);
+      }
+      for (const PlyElement& earlier : elements) {
+        if (earlier.name == e.name) return lineError(name, ln, "element " + quoted(e.name) + " declared twice");
+      }
+      if (e.name == "face" && std::none_of(elements.begin(), elements.end(),
+                       [](const PlyElement& x) { return x.name == "vertex"; })) {
+        return lineError(name, ln, "the face element comes before the vertex element");
+      }
       elements.push_back(e);
     } else if (key == "property") {
       if (elements.empty()) return lineError(name, ln, "property before any element");
       PlyProperty p;
       if (tokens.size() == 5 && tokens[1] == "list") {
-        p.listCountBytes = plyTypeBytes(tokens[2]);
-        p.scalarBytes = plyTypeBytes(tokens[3]);
+        p.countTypeName = tokens[2];
+        p.valueTypeName = tokens[3];
+        p.count = plyType(tokens[2]);
+        p.value = plyType(tokens[3]);
         p.name = std::string(tokens[4]);
       } else if (tokens.size() == 3 && tokens[1] != "list") {
-        p.scalarBytes = plyTypeBytes(tokens[1]);
+        p.valueTypeName = tokens[1];
+        p.value = plyType(tokens[1]);
         p.name = std::string(tokens[2]);
       }
-      if (p.scalarBytes == 0 || (tokens[1] == "list" && p.listCountBytes == 0)) {
+      if (p.value.bytes == 0 || (tokens[1] == "list" && p.count.bytes == 0)) {
         return lineError(name, ln,
                          "bad property line (property TYPE NAME or property list TYPE TYPE NAME)");
+      }
+      if (p.count.bytes != 0) {
+        // OpenMesh reads one list only, a face's vertex indices; any other
+        // list it skips as one value, and everything after it shifts.
+        if (elements.back().name != "face" ||
+            (p.name != "vertex_indices" && p.name != "vertex_index")) {
+          return lineError(name, ln,
+                           "list property " + quoted(p.name) + " of element " +
+                               quoted(elements.back().name) +
+                               " is not supported (only a face's vertex_indices list is read)");
+        }
+        // The count types OpenMesh's header reader accepts; the indices must
+        // be integers (it reads a float index as 0 and without its bytes).
+        if (p.countTypeName != "uchar" && p.countTypeName != "uint8" &&
+            p.countTypeName != "uint16" && p.countTypeName != "int") {
+          return lineError(name, ln,
+                           "list count type " + quoted(p.countTypeName) +
+                               " is not supported (uchar, uint8, uint16 or int)");
+        }
+        if (p.value.kind != PlyType::Kind::kSigned && p.value.kind != PlyType::Kind::kUnsigned) {
+          return lineError(name, ln, "face vertex indices must have an integer type");
+        }
+      }
+      // OpenMesh reads a colour as a float (times 255) only when it is
+      // declared float; a double colour it reads as an integer, without its
+      // bytes when binary: everything after it shifts.
+      if (p.count.bytes == 0 && isColourProperty(p.name) && p.value.kind == PlyType::Kind::kDouble) {
+        return lineError(name, ln, "colour property " + quoted(p.name) +
+                                       " of type double is not supported (float or an integer type)");
       }
       elements.back().properties.push_back(p);
     } else if (key == "end_header") {
@@ -551,7 +801,9 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
   // Our scanner ends a line at a lone carriage return, OpenMesh's header
   // reader at line feeds only: it skipped "comment ...\rend_header" as one
   // comment, never saw end_header and looped at the end of the file (fuzz
-  // finding 25, seed fuzz/corpus/mesh/timeout-ply-cr-in-comment.ply). CRLF
+  // finding 25, seed fuzz/corpus/mesh/timeout-ply-cr-in-comment.ply). The
+  // rewrite below would hide that, but the bytes after such a header are
+  // then not where the writer meant them (binary bodies): refused. CRLF
   // stays allowed.
   {
     const std::string_view header = bytes.substr(0, scanner.offset());
@@ -573,40 +825,44 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
   if (nv > options.maxVertices) return limitError(name, "vertices", nv, options.maxVertices);
   if (nf > options.maxFaces) return limitError(name, "faces", nf, options.maxFaces);
 
+  // OpenMesh reads the header as rewritten from what was checked: the
+  // magic, the format, each element with its properties (types as the file
+  // spelled them), end_header; single spaces, LF, no comments. Findings 18
+  // and 25 were OpenMesh's header reading and ours differing; that class
+  // cannot reach it any more (as for OBJ and OFF).
+  std::string rewritten = "ply\nformat " + format + " 1.0\n";
+  for (const PlyElement& e : elements) {
+    rewritten += "element " + e.name + " " + std::to_string(e.count) + "\n";
+    for (const PlyProperty& p : e.properties) {
+      rewritten += "property ";
+      if (p.count.bytes != 0) {
+        rewritten += "list ";
+        rewritten.append(p.countTypeName.data(), p.countTypeName.size());
+        rewritten += ' ';
+      }
+      rewritten.append(p.valueTypeName.data(), p.valueTypeName.size());
+      rewritten += ' ' + p.name + '\n';
+    }
+  }
+  rewritten += "end_header\n";
+
   PrecheckResult result;
   result.declaredFaces = nf;
   result.binary = format != "ascii";
   const std::uint64_t body = bytes.size() - scanner.offset();
   if (result.binary) {
-    // Lower bound on the body: fixed-size properties exactly, lists with
-    // their count and (for faces) three entries.
-    std::uint64_t needed = 0;
-    for (const PlyElement& e : elements) {
-      std::uint64_t perItem = 0;
-      for (const PlyProperty& p : e.properties) {
-        if (p.listCountBytes == 0) {
-          perItem += static_cast<std::uint64_t>(p.scalarBytes);
-        } else {
-          perItem += static_cast<std::uint64_t>(p.listCountBytes) +
-                     (e.name == "face" ? 3u * static_cast<std::uint64_t>(p.scalarBytes) : 0u);
-        }
-      }
-      if (perItem != 0 &&
-          e.count > (std::numeric_limits<std::uint64_t>::max() - needed) / perItem) {
-        needed = std::numeric_limits<std::uint64_t>::max();
-        break;
-      }
-      needed += perItem * e.count;
-    }
-    if (needed > body) {
-      return Status(ErrorCode::kInvalidArgument,
-                    name + ": truncated: header declares " + std::to_string(nv) + " vertices and " +
-                        std::to_string(nf) + " faces, needing at least " + std::to_string(needed) +
-                        " bytes of data, file has " + std::to_string(body));
-    }
+    std::size_t bodyEnd = 0;
+    THINLOD_RETURN_IF_ERROR(walkPlyBinary(bytes.substr(scanner.offset()),
+                                          format == "binary_big_endian", elements, nv, name,
+                                          &bodyEnd));
+    // What OpenMesh reads: the elements up to the face element (it stops
+    // there), nothing after the walked items.
+    rewritten.append(bytes.substr(scanner.offset(), bodyEnd));
+    result.rewritten = std::move(rewritten);
     return result;
   }
-  // ASCII: one line per element item, in header order.
+  // ASCII: one line per element item, in header order, rewritten from its
+  // checked tokens; anything after the last item is dropped.
   std::vector<std::string_view> tokens;
   for (const PlyElement& e : elements) {
     if (e.count * 2 > body) {
@@ -623,29 +879,11 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
         }
         tokens = tokenize(line);
       } while (tokens.empty());
-      const int ln = scanner.lineNumber();
-      if (e.name == "vertex") {
-        THINLOD_RETURN_IF_ERROR(
-            checkFiniteNumbers(tokens, 0, e.properties.size(), name, ln, "vertex"));
-      } else if (e.name == "face" && !e.properties.empty() && e.properties[0].listCountBytes != 0) {
-        std::uint64_t k = 0;
-        if (!parseUnsigned(tokens[0], &k) || k < 3 || tokens.size() < k + 1) {
-          return lineError(name, ln, "bad face line");
-        }
-        for (std::uint64_t j = 1; j <= k; ++j) {
-          std::uint64_t index = 0;
-          if (!parseUnsigned(tokens[j], &index)) {
-            return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[j]));
-          }
-          if (index >= nv) {
-            return lineError(name, ln,
-                             "face references vertex " + std::to_string(index) + " (only " +
-                                 std::to_string(nv) + " vertices)");
-          }
-        }
-      }
+      THINLOD_RETURN_IF_ERROR(
+          checkPlyAsciiItem(e, tokens, nv, name, scanner.lineNumber(), &rewritten));
     }
   }
+  result.rewritten = std::move(rewritten);
   return result;
 }
 

@@ -20,11 +20,13 @@ enum class MeshFormat { kObj, kPly, kOff, kStl };
 struct PrecheckResult {
   bool binary = false;              // PLY / STL: OpenMesh needs to be told for STL
   std::uint64_t declaredFaces = 0;  // from the header (0 when the format has none)
-  // OBJ and OFF: the file as OpenMesh gets it, rewritten from the tokens the
-  // pre-check validated (OBJ: v, vc, vn, vt and f lines only; OFF: the magic,
-  // the three counts, the vertex and face lines; single spaces, LF line
-  // ends, no comments), so OpenMesh cannot read anything the pre-check did
-  // not see. Unset for PLY and STL: OpenMesh reads the original bytes.
+  // OBJ, OFF and PLY: the file as OpenMesh gets it, rewritten from the
+  // tokens the pre-check validated (OBJ: v, vc, vn, vt and f lines only;
+  // OFF: the magic, the three counts, the vertex and face lines; PLY: the
+  // header's format, elements and properties, ASCII items line by line, a
+  // binary body as walked up to the end of the faces; single spaces, LF
+  // line ends, no comments), so OpenMesh cannot read anything the pre-check
+  // did not see. Unset for STL: OpenMesh reads the original bytes.
   std::optional<std::string> rewritten;
 };
 
