@@ -802,5 +802,32 @@ TEST(MeshIo, BinaryPlyWithACrlfHeaderLoadsTheSameMesh) {
   EXPECT_EQ(a->mesh.indices, b->mesh.indices);
 }
 
+// An ASCII STL reaches OpenMesh only as rewritten from its checked vertex
+// lines (three to a facet, canonical layout): names, facet normals, CRLF,
+// indentation and a second solid load the same triangles as the plain file.
+TEST(MeshIo, AsciiStlDecorationsLoadTheSameMeshAsThePlainFile) {
+  const std::string plain =
+      "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n"
+      "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\n"
+      "vertex 0 1 0\nendloop\nendfacet\nendsolid a\n";
+  const std::string decorated =
+      "  solid some name with words\r\n  facet normal 9 9 9 junk\r\n    outer loop\r\n"
+      "      vertex\t0 0 0\r\n      vertex 1  0 0\r\n      vertex 1 1 0\r\n    endloop\r\n"
+      "  endfacet\r\nendsolid some name\r\nsolid b\r\nfacet normal 0 0 1\r\nouter loop\r\n"
+      "vertex 0 0 0\r\nvertex 1 1 0\r\nvertex 0 1 0\r\nendloop\r\nendfacet\r\nendsolid b\r\n";
+  Result<LoadedMesh> a = loadMeshFromMemory(plain, "stl", "plain.stl");
+  Result<LoadedMesh> b = loadMeshFromMemory(decorated, "stl", "decorated.stl");
+  ASSERT_TRUE(a.ok()) << a.status().toString();
+  ASSERT_TRUE(b.ok()) << b.status().toString();
+  EXPECT_EQ(a->mesh.positions, b->mesh.positions);
+  EXPECT_EQ(a->mesh.indices, b->mesh.indices);
+  EXPECT_EQ(b->mesh.triangleCount(), 2u);
+  Result<LoadedMesh> extra = loadMeshFromMemory(
+      "solid a\nvertex 0 0 0 5\nvertex 1 0 0\nvertex 1 1 0\nendsolid a\n", "stl", "extra.stl");
+  ASSERT_FALSE(extra.ok());
+  EXPECT_TRUE(contains(extra.status().message(), "extra.stl:2: a vertex line holds three numbers"))
+      << extra.status().message();
+}
+
 }  // namespace
 }  // namespace thinlod

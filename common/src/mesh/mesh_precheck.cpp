@@ -941,24 +941,42 @@ Result<PrecheckResult> precheckStl(std::string_view bytes, const std::string& na
   std::string_view line;
   std::uint64_t corners = 0;
   bool endSolid = false;
+  // OpenMesh reads the file as rewritten from the checked corners: every
+  // three 'vertex' lines one facet, in the canonical layout, so nothing
+  // else of the file (facet and loop lines, names, what follows endsolid)
+  // reaches its reader.
+  std::string rewritten = "solid thinlod\n";
   while (scanner.next(&line)) {
     const std::vector<std::string_view> tokens = tokenize(line);
     if (tokens.empty()) continue;
     if (tokens[0] == "vertex") {
       THINLOD_RETURN_IF_ERROR(
           checkFiniteNumbers(tokens, 1, 3, name, scanner.lineNumber(), "vertex"));
+      if (tokens.size() != 4) {
+        return lineError(name, scanner.lineNumber(), "a vertex line holds three numbers");
+      }
+      if (corners % 3 == 0) rewritten += "facet normal 0 0 0\nouter loop\n";
+      rewritten += "vertex ";
+      for (std::size_t i = 1; i <= 3; ++i) {
+        if (i > 1) rewritten += ' ';
+        rewritten.append(tokens[i].data(), tokens[i].size());
+      }
+      rewritten += '\n';
       ++corners;
+      if (corners % 3 == 0) rewritten += "endloop\nendfacet\n";
+      if (corners / 3 > options.maxFaces) {
+        return limitError(name, "faces", corners / 3, options.maxFaces);
+      }
     } else if (tokens[0] == "endsolid") {
-      endSolid = true;
+      endSolid = true;  // several solids in one file: all are read
     }
   }
   if (!endSolid || corners % 3 != 0) {
     return Status(ErrorCode::kInvalidArgument, name + ": truncated ASCII STL (no endsolid)");
   }
+  rewritten += "endsolid thinlod\n";
   result.declaredFaces = corners / 3;
-  if (result.declaredFaces > options.maxFaces) {
-    return limitError(name, "faces", result.declaredFaces, options.maxFaces);
-  }
+  result.rewritten = std::move(rewritten);
   return result;
 }
 

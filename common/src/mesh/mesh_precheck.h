@@ -24,9 +24,11 @@ struct PrecheckResult {
   // tokens the pre-check validated (OBJ: v, vc, vn, vt and f lines only;
   // OFF: the magic, the three counts, the vertex and face lines; PLY: the
   // header's format, elements and properties, ASCII items line by line, a
-  // binary body as walked up to the end of the faces; single spaces, LF
-  // line ends, no comments), so OpenMesh cannot read anything the pre-check
-  // did not see. Unset for STL: OpenMesh reads the original bytes.
+  // binary body as walked up to the end of the faces; ASCII STL: every three
+  // vertex lines one facet in the canonical layout; single spaces, LF line
+  // ends, no comments), so OpenMesh cannot read anything the pre-check did
+  // not see. Unset for binary STL (fixed 50-byte records, checked):
+  // OpenMesh reads the original bytes.
   std::optional<std::string> rewritten;
 };
 
