@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "test_meshes.h"
 #include "thinlod/common/core/relative_accuracy.h"
@@ -221,6 +222,82 @@ TEST(MeshCurve, ProgressiveMeshOfTheCowGivesConservativeCurves) {
   EXPECT_GT(curves->levels.back().accuracy, 10 * curves->levels.front().accuracy);
   expectMonotoneAndConservative(curves->triangles, curves->levels, false);
   expectMonotoneAndConservative(curves->bytes, curves->levels, true);
+}
+
+// Levels measured on several threads: every field of every level and both
+// curves are the same (==) as measured on one, on a plain and a textured
+// mesh; the progress callback hears every level once, counting up.
+TEST(MeshCurve, AnyThreadCountGivesTheSameCurves) {
+  Result<IndexedMesh> cow =
+      thinlod::testing::readObjPositions(thinlod::testing::sharedModelPath("cow.obj"));
+  ASSERT_TRUE(cow.ok()) << cow.status().toString();
+  Result<ProgressiveMesh> pm = ProgressiveMesh::build(*cow);
+  ASSERT_TRUE(pm.ok()) << pm.status().toString();
+  const IndexedMesh textured = ShiftedUvLadder::grid(16, 0.0f);
+  const auto sameCurves = [](const MeshCurves& a, const MeshCurves& b) {
+    ASSERT_EQ(a.levels.size(), b.levels.size());
+    for (std::size_t i = 0; i < a.levels.size(); ++i) {
+      const CurveLevel& x = a.levels[i];
+      const CurveLevel& y = b.levels[i];
+      EXPECT_EQ(x.requestedTriangles, y.requestedTriangles);
+      EXPECT_EQ(x.triangles, y.triangles);
+      EXPECT_EQ(x.relativeMaxError, y.relativeMaxError);
+      EXPECT_EQ(x.relativeHausdorffError, y.relativeHausdorffError);
+      EXPECT_EQ(x.relativeTextureError, y.relativeTextureError);
+      EXPECT_EQ(x.relativeMeanError, y.relativeMeanError);
+      EXPECT_EQ(x.accuracy, y.accuracy);
+      EXPECT_EQ(x.encodedBytes, y.encodedBytes);
+      EXPECT_EQ(x.encodedAccuracy, y.encodedAccuracy);
+    }
+    EXPECT_EQ(serializeMeshCurves(a, "k"), serializeMeshCurves(b, "k"));
+  };
+  MeshCurveOptions one = quickOptions();
+  one.levels = 10;
+  one.threads = 1;
+  Result<MeshCurves> serial = measureMeshCurves(*cow, *pm, one);
+  ASSERT_TRUE(serial.ok()) << serial.status().toString();
+  MeshCurveOptions uvOne = one;
+  uvOne.measureEncodedBytes = false;
+  Result<MeshCurves> uvSerial =
+      measureMeshCurves(textured, 2, textured.triangleCount(), ShiftedUvLadder{}, uvOne);
+  ASSERT_TRUE(uvSerial.ok()) << uvSerial.status().toString();
+  for (int threads : {0, 2, 3, 16}) {
+    SCOPED_TRACE(threads);
+    MeshCurveOptions many = one;
+    many.threads = threads;
+    std::vector<std::size_t> heard;
+    std::size_t heardTotal = 0;
+    many.levelMeasured = [&](const CurveLevel&, std::size_t done, std::size_t total) {
+      heard.push_back(done);
+      heardTotal = total;
+    };
+    Result<MeshCurves> parallel = measureMeshCurves(*cow, *pm, many);
+    ASSERT_TRUE(parallel.ok()) << parallel.status().toString();
+    sameCurves(*serial, *parallel);
+    ASSERT_EQ(heard.size(), serial->levels.size());
+    EXPECT_EQ(heardTotal, serial->levels.size());
+    for (std::size_t i = 0; i < heard.size(); ++i) EXPECT_EQ(heard[i], i + 1);
+
+    MeshCurveOptions uvMany = uvOne;
+    uvMany.threads = threads;
+    Result<MeshCurves> uvParallel =
+        measureMeshCurves(textured, 2, textured.triangleCount(), ShiftedUvLadder{}, uvMany);
+    ASSERT_TRUE(uvParallel.ok()) << uvParallel.status().toString();
+    sameCurves(*uvSerial, *uvParallel);
+  }
+  MeshCurveOptions bad = one;
+  bad.threads = -1;
+  EXPECT_EQ(measureMeshCurves(*cow, *pm, bad).status().code(), ErrorCode::kInvalidArgument);
+}
+
+// A failing level on another thread is reported like a serial failure.
+TEST(MeshCurve, AFailingLevelFailsTheParallelMeasurement) {
+  const IndexedMesh sphere = makeIcosphere(2, kRadius);
+  auto tooMany = [&](std::size_t) { return sphere; };
+  MeshCurveOptions options = quickOptions();
+  options.threads = 4;
+  Result<MeshCurves> curves = measureMeshCurves(sphere, 20, 320, tooMany, options);
+  EXPECT_EQ(curves.status().code(), ErrorCode::kInternal);
 }
 
 TEST(MeshCurve, InvalidInputsAreRejected) {

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
+#include <optional>
 #include <string>
 
+#include "thinlod/common/core/parallel_for.h"
 #include "thinlod/common/core/relative_accuracy.h"
 
 namespace thinlod::simplifier {
@@ -18,6 +21,7 @@ Status invalid(const std::string& message) {
 Status checkOptions(const MeshCurveOptions& options) {
   if (options.levels < 2) return invalid("levels must be >= 2");
   if (options.maxSegments < 1) return invalid("maxSegments must be >= 1");
+  if (options.threads < 0 || options.threads > 1024) return invalid("threads must be in 0..1024");
   if (!(options.minRelativeError > 0.0) || !std::isfinite(options.minRelativeError)) {
     return invalid("minRelativeError must be positive and finite");
   }
@@ -106,16 +110,34 @@ Result<MeshCurves> measureMeshCurves(const IndexedMesh& original, std::size_t mi
   const double reference = referenceLength(referenceSphere(original));
   if (!(reference > 0.0)) return invalid("original mesh has a zero-size reference sphere");
 
-  MeshCurves curves;
+  // Extract first, one after another; several requests can land on one
+  // collapse state: measure it once.
+  std::vector<std::size_t> targets;
+  std::vector<IndexedMesh> extracted;
   for (std::size_t target : geometricLadder(minTriangles, maxTriangles, options.levels)) {
-    const IndexedMesh level = extract(target);
-    // Several requests can land on one collapse state: measure it once.
-    if (!curves.levels.empty() && level.triangleCount() == curves.levels.back().triangles) {
-      continue;
+    IndexedMesh level = extract(target);
+    if (!extracted.empty() && level.triangleCount() == extracted.back().triangleCount()) continue;
+    targets.push_back(target);
+    extracted.push_back(std::move(level));
+  }
+  // Then measure the levels on options.threads threads, the largest (the
+  // slowest) first; each result goes to its own slot.
+  const std::size_t total = extracted.size();
+  std::vector<std::optional<Result<CurveLevel>>> measured(total);
+  std::mutex reportMutex;
+  std::size_t reported = 0;
+  parallelFor(total, options.threads, [&](std::size_t k) {
+    const std::size_t i = total - 1 - k;
+    measured[i] = measureLevel(original, reference, targets[i], extracted[i], options);
+    if (options.levelMeasured && measured[i]->ok()) {
+      std::lock_guard<std::mutex> lock(reportMutex);
+      options.levelMeasured(**measured[i], ++reported, total);
     }
-    Result<CurveLevel> measured = measureLevel(original, reference, target, level, options);
-    if (!measured.ok()) return measured.status();
-    curves.levels.push_back(*measured);
+  });
+  MeshCurves curves;
+  for (std::optional<Result<CurveLevel>>& level : measured) {
+    if (!level->ok()) return level->status();
+    curves.levels.push_back(std::move(**level));
   }
 
   std::vector<AccuracySample> triangleSamples;

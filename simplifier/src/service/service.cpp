@@ -51,6 +51,9 @@ MeshCurveOptions ServiceOptions::defaultCurveOptions() {
   // keep a first measurement of a 6k-triangle mesh well under a second.
   curve.measureEncodedBytes = false;
   curve.error.samplesPerMesh = 30000;
+  // All cores: a worker measures one curve at a time, and its levels are
+  // independent (several workers on one host: --curve-threads 1).
+  curve.threads = 0;
   return curve;
 }
 
@@ -229,23 +232,23 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   Result<MeshCurves> curves = Status(ErrorCode::kInternal, "not measured");
   // A measurement takes seconds for a large mesh: one progress line per level.
   const std::size_t minTriangles = std::max<std::size_t>(1, model.pm.minTriangles());
-  const std::size_t levels =
-      geometricLadder(minTriangles, model.pm.maxTriangles(), options.curve.levels).size();
-  std::size_t level = 0;
   const auto started = std::chrono::steady_clock::now();
-  const ExtractTriangles extract = [&](std::size_t n) {
+  const ExtractTriangles extract = [&](std::size_t n) { return model.pm.extract(n); };
+  // Levels are measured on options.curve.threads threads; one line as each is done.
+  MeshCurveOptions curveOptions = options.curve;
+  curveOptions.levelMeasured = [&](const CurveLevel& measured, std::size_t done,
+                                   std::size_t total) {
     progress("event=curve_progress mesh_triangles=" + std::to_string(model.pm.maxTriangles()) +
-             " level=" + std::to_string(++level) + "/" + std::to_string(levels) +
-             " triangles=" + std::to_string(n) + " ms=" +
+             " level=" + std::to_string(done) + "/" + std::to_string(total) +
+             " triangles=" + std::to_string(measured.triangles) + " ms=" +
              std::to_string(std::llround(std::chrono::duration<double, std::milli>(
                                              std::chrono::steady_clock::now() - started)
                                              .count())));
-    return model.pm.extract(n);
   };
   if (curveCache) {
     const int hitsBefore = curveCache->stats().hits;
     curves = curveCache->getOrMeasure(*model.original, curveProducerFor(model.attributeWeight), minTriangles,
-                                      model.pm.maxTriangles(), extract, options.curve);
+                                      model.pm.maxTriangles(), extract, curveOptions);
     if (curves.ok()) {
       if (curveCache->stats().hits > hitsBefore) {
         ++stats.curvesFromDisk;
@@ -255,7 +258,7 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
     }
   } else {
     curves = measureMeshCurves(*model.original, minTriangles, model.pm.maxTriangles(), extract,
-                               options.curve);
+                               curveOptions);
     if (curves.ok()) ++stats.curvesMeasured;
   }
   if (!curves.ok()) return curves.status();

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "commands.h"
+#include "thinlod/common/core/parallel_for.h"
 #include "thinlod/common/mesh/mesh_io.h"
 #include "thinlod/simplifier/mesh_curve.h"
 #include "thinlod/simplifier/progressive_mesh.h"
@@ -59,7 +60,8 @@ void runCurve(const CurveArgs& args) {
 
   const MeshCurveOptions& options = args.curve;
   progressLine(command, "measuring " + std::to_string(options.levels) + " levels (" +
-                            std::to_string(options.error.samplesPerMesh) + " samples per side)");
+                            std::to_string(options.error.samplesPerMesh) + " samples per side, " +
+                            std::to_string(resolveThreadCount(options.threads)) + " threads)");
   start = Clock::now();
   Result<MeshCurves> curves = measureMeshCurves(mesh, built.value(), options);
   if (!curves.ok()) fail(command, curves.status(), args.json, result);
@@ -117,6 +119,12 @@ void addCurveCommand(CLI::App& app) {
                   "Surface samples per side for the error")
       ->check(CLI::Range(std::size_t{100}, std::size_t{10'000'000}));
   sub->add_flag("!--no-bytes", args->curve.measureEncodedBytes, "Skip the encoded-bytes curve");
+  args->curve.threads = 0;  // the tool, like the daemon, measures on every core
+  sub->add_option("--threads", args->curve.threads,
+                  "Levels measured at once (0: one per hardware thread); the curves are the "
+                  "same for any count")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "Print levels, curves and timings as JSON on stdout");
   sub->callback([args] { runCurve(*args); });
 }

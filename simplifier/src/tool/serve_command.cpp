@@ -243,6 +243,9 @@ int runServe(const std::vector<std::string>& args) {
   runtime.addOption("answer-before-curve", &config.service.answerBeforeCurve,
                     "answer a mesh without a known curve from its one measured level (curve "
                     "requests still measure the whole curve); =false: measure the curve first");
+  runtime.addOption("curve-threads", &config.service.curve.threads,
+                    "levels of a curve measured at once (0: one per hardware thread; the "
+                    "curves are the same for any count; several workers on one host: 1)");
   runtime.addOption("backend", &config.backend, "offscreen rendering: auto|egl|osmesa");
   runtime.addOption("capacity", &config.capacity,
                     "requests the backbone may queue here at once (run one at a time)");
@@ -274,6 +277,11 @@ int runServe(const std::vector<std::string>& args) {
   if (config.capacity < 1 || config.capacity > static_cast<int>(protocol::kMaxWorkerCapacity)) {
     spdlog::error("event=bad_option option=capacity value={} expected=1..{}", config.capacity,
                   protocol::kMaxWorkerCapacity);
+    return 2;
+  }
+  if (config.service.curve.threads < 0 || config.service.curve.threads > 1024) {
+    spdlog::error("event=bad_option option=curve-threads value={} expected=0..1024",
+                  config.service.curve.threads);
     return 2;
   }
   if (config.textureSize < 8 || config.maxTextureSize < 8 || config.maxTextureSize > 4096 ||

@@ -26,6 +26,9 @@
 // - Both curves come from AccuracyCurve::fitConservative: for every a the
 //   curve's resources >= the cheapest measured level reaching >= a, so it
 //   never promises more accuracy for a resource than was measured.
+// - Levels are extracted one after another (the extraction function need
+//   not be thread-safe) and measured on options.threads threads (the same
+//   curves for any count).
 // - measureMeshCurves is pure (no I/O). MeshCurveCache is its thin file
 //   wrapper: one JSON file per key (hash of the mesh bytes, producer tag,
 //   options, ladder and kMeshCurveFormatVersion) in a directory; files that
@@ -59,19 +62,6 @@ namespace thinlod::simplifier {
 // mesh includes the texture term.
 inline constexpr int kMeshCurveFormatVersion = 3;
 
-struct MeshCurveOptions {
-  int levels = 12;                 // ladder rungs (duplicates after rounding merge)
-  int maxSegments = 6;             // per fitted curve (see error-validation.md)
-  double minRelativeError = 1e-4;  // floor on d: accuracy at most 10^4
-  SurfaceErrorOptions error{};
-  bool measureEncodedBytes = true;
-  // Textured meshes: d includes the texel displacement (above); its samples
-  // and seed are error's.
-  bool textureCredit = true;
-  double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
-  codec::MeshEncodeOptions encode{};        // positionBits is chosen per level
-};
-
 struct CurveLevel {
   std::size_t requestedTriangles = 0;
   std::size_t triangles = 0;             // what the extraction returned
@@ -85,6 +75,29 @@ struct CurveLevel {
   int positionBits = 0;
   double encodedAccuracy = 0.0;  // 1 / (max(d, floor) + quantization / L)
 };
+
+struct MeshCurveOptions {
+  int levels = 12;                 // ladder rungs (duplicates after rounding merge)
+  int maxSegments = 6;             // per fitted curve (see error-validation.md)
+  double minRelativeError = 1e-4;  // floor on d: accuracy at most 10^4
+  SurfaceErrorOptions error{};
+  bool measureEncodedBytes = true;
+  // Textured meshes: d includes the texel displacement (above); its samples
+  // and seed are error's.
+  bool textureCredit = true;
+  double quantizationBudgetFraction = 0.1;  // see positionBitsForAccuracy
+  codec::MeshEncodeOptions encode{};        // positionBits is chosen per level
+  // Levels measured at once (parallelFor; 0: one per hardware thread). Each
+  // level is an independent measurement with the same seed, so the curves
+  // are the same for any count (the cache key leaves it out).
+  int threads = 1;
+  // Called after each level's measurement (progress of long measurements),
+  // one call at a time, from the thread that measured it; `measured` counts
+  // the levels done so far of `total`. Not in the cache key.
+  std::function<void(const CurveLevel& level, std::size_t measured, std::size_t total)>
+      levelMeasured;
+};
+
 
 struct MeshCurves {
   std::vector<CurveLevel> levels;  // increasing triangle counts
