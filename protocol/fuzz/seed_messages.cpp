@@ -186,6 +186,7 @@ std::vector<NamedMessage> seedMessages() {
   stats.snrDb = 23.75;
   stats.renderMs = 2.6f;
   stats.rejectedPlans = {15, 16};
+  stats.earlyPolygons = 12;
   out.push_back({"frame_stats", stats});
 
   out.push_back({"heartbeat", Heartbeat{1'700'000'000'300'000'000, 9}});

@@ -125,10 +125,14 @@ TEST(FrontendScene, BatchesCommitInArrivalOrder) {
   EXPECT_TRUE(early.plans.empty());
   EXPECT_EQ(early.shownEarly, 1u);
   EXPECT_EQ(scene.lastAppliedPlan(), 0u);
+  // Held but ahead of its plan: what plan 0 left is polygons - early.
+  EXPECT_EQ(scene.polygons(), 2u);
+  EXPECT_EQ(scene.earlyPolygons(), 2u);
   ASSERT_TRUE(scene.markUploaded(plan[0].key).ok());
   EXPECT_EQ(scene.commitReady().plans, (std::vector<std::uint64_t>{1, 2}));
   EXPECT_EQ(scene.objects().size(), 2u);
   EXPECT_EQ(scene.polygons(), 4u);
+  EXPECT_EQ(scene.earlyPolygons(), 0u);
 }
 
 TEST(FrontendScene, ReplaceReleasesTheOldRepresentation) {
@@ -361,6 +365,7 @@ TEST(FrontendSceneEarly, DroppedBatchKeepsWhatWasShownEarly) {
   ASSERT_NE(scene.find(1), nullptr);
   EXPECT_EQ(scene.find(1)->key, plan[0].key);
   EXPECT_EQ(scene.polygons(), 2u);
+  EXPECT_EQ(scene.earlyPolygons(), 0u);  // held now, no plan ahead of it any more
   EXPECT_EQ(scene.lastAppliedPlan(), 0u);
 }
 
@@ -379,6 +384,9 @@ TEST(FrontendSceneEarly, RandomStreamsNeverHoldMoreThanTheBackboneCap) {
     std::map<ObjectId, std::size_t> mirror;  // the backbone's model after every op
     std::size_t mirrorTotal = 0;
     std::uint64_t plan = 0;
+    // The backbone's model after each plan: polygons() - earlyPolygons() must
+    // equal it for the last applied plan (the fault campaign's mirror check).
+    std::vector<std::size_t> mirrorAfterPlan = {0};
     for (int step = 0; step < 150; ++step) {
       if (rng() % 2 == 0) {
         std::vector<SceneOperation> ops;
@@ -414,6 +422,7 @@ TEST(FrontendSceneEarly, RandomStreamsNeverHoldMoreThanTheBackboneCap) {
         }
         if (!ops.empty()) {
           ASSERT_TRUE(scene.enqueue(batchOf(++plan, ops)).ok());
+          mirrorAfterPlan.push_back(mirrorTotal);
         }
       }
       const auto pending = scene.planUploads(1 + rng() % 2000);
@@ -424,6 +433,9 @@ TEST(FrontendSceneEarly, RandomStreamsNeverHoldMoreThanTheBackboneCap) {
       }
       shownEarly += scene.commitReady().shownEarly;
       ASSERT_LE(scene.polygons(), cap) << "seed " << seed << " step " << step;
+      ASSERT_LE(scene.earlyPolygons(), scene.polygons());
+      ASSERT_EQ(scene.polygons() - scene.earlyPolygons(), mirrorAfterPlan[scene.lastAppliedPlan()])
+          << "seed " << seed << " step " << step;
     }
     while (scene.pendingBatches() > 0) {
       uploadFrame(scene, 1 << 20);
@@ -431,6 +443,7 @@ TEST(FrontendSceneEarly, RandomStreamsNeverHoldMoreThanTheBackboneCap) {
       ASSERT_LE(scene.polygons(), cap);
     }
     EXPECT_EQ(scene.polygons(), mirrorTotal) << "seed " << seed;
+    EXPECT_EQ(scene.earlyPolygons(), 0u);
     EXPECT_EQ(scene.lastAppliedPlan(), plan);
     for (const auto& [id, triangles] : mirror) {
       ASSERT_NE(scene.find(id), nullptr);

@@ -355,8 +355,10 @@ class Daemon {
         if (auto* pose = std::get_if<protocol::ViewerPose>(&event.message)) {
           poses_.emplace_back(event.peer, *pose);
         } else if (auto* stats = std::get_if<protocol::FrameStats>(&event.message)) {
-          spdlog::debug("event=frame_stats frame={} plan={} polygons={} link_bytes={}",
-                        stats->frame, stats->plan, stats->polygons, stats->linkBytes);
+          spdlog::debug(
+              "event=frame_stats frame={} plan={} polygons={} link_bytes={} early_polygons={}",
+              stats->frame, stats->plan, stats->polygons, stats->linkBytes,
+              stats->earlyPolygons);
           if (active_ && *active_ == event.peer) {
             const std::size_t corrected = core_.onFrameStats(*stats);
             if (!stats->rejectedPlans.empty())

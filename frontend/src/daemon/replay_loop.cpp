@@ -244,6 +244,7 @@ class Replay {
     record.timeS = pose.time;
     record.polygons = produced.triangles;
     record.plan = produced.appliedPlan;
+    record.earlyPolygons = std::min(produced.earlyPolygons, produced.triangles);
     record.renderMs = produced.renderMs;
     record.drawCalls = produced.drawCalls;
     record.uploadedBytes = produced.uploadedBytes;

@@ -111,6 +111,7 @@ class BackboneLink {
 struct ProducedFrame {
   std::size_t triangles = 0;  // drawn
   std::uint64_t appliedPlan = 0;
+  std::size_t earlyPolygons = 0;  // of triangles, first representations shown before their plan
   std::size_t committedBatches = 0;
   std::size_t droppedBatches = 0;
   std::vector<std::uint64_t> droppedPlans;  // plans of the dropped batches

@@ -308,6 +308,8 @@ protocol::FrameStats toFrameStats(const FrameRecord& record, std::int64_t timest
   stats.snrDb = stats.hasSnr ? record.quality.snrDb : 0.0;
   stats.renderMs = std::isfinite(record.renderMs) ? static_cast<float>(record.renderMs) : 0.0f;
   stats.rejectedPlans = std::move(rejectedPlans);
+  stats.earlyPolygons = static_cast<std::uint32_t>(
+      std::min<std::size_t>(record.earlyPolygons, stats.polygons));
   return stats;
 }
 

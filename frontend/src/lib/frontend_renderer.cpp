@@ -464,6 +464,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   report.pendingBatches = impl.scene.pendingBatches();
   report.texturePages = impl.pages.size();
   report.appliedPlan = impl.scene.lastAppliedPlan();
+  report.earlyPolygons = impl.scene.earlyPolygons();
   return report;
 }
 

@@ -209,6 +209,7 @@ std::vector<RepresentationKey> FrontendScene::dropBatch(std::uint64_t batchSeque
     if (it->sequence != batchSequence) continue;
     for (std::size_t i = 0; i < it->objects.size(); ++i) {
       // A first representation shown early is held now: its GPU copy stays.
+      if (it->shownEarly[i]) earlyPolygons_ -= it->objects[i].triangleCount;
       if (it->types[i] == SceneOperation::Type::kAddOrReplace && !it->shownEarly[i])
         keys.push_back(it->objects[i].key);
     }
@@ -226,7 +227,10 @@ CommitResult FrontendScene::commitReady() {
     for (bool done : batch.uploaded) complete = complete && done;
     if (!complete) break;
     for (std::size_t i = 0; i < batch.objects.size(); ++i) {
-      if (batch.shownEarly[i]) continue;  // applied already (showFirstRepresentationsEarly)
+      if (batch.shownEarly[i]) {  // applied already (showFirstRepresentationsEarly)
+        earlyPolygons_ -= batch.objects[i].triangleCount;  // now part of the plan's state
+        continue;
+      }
       SceneObject& incoming = batch.objects[i];
       auto held = objects_.find(incoming.id);
       if (held != objects_.end()) {
@@ -279,6 +283,7 @@ void FrontendScene::showFirstRepresentationsEarly(CommitResult& result) {
         result.activated.push_back(incoming.key);
         ++result.shownEarly;
         polygons_ += incoming.triangleCount;
+        earlyPolygons_ += incoming.triangleCount;
         objects_[incoming.id] = incoming;  // the batch keeps its entry (skipped at commit)
         touched.insert(incoming.id);
         continue;

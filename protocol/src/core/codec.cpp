@@ -190,7 +190,7 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Impos
 std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const FrameStats& m) {
   auto rejected = idsOrNull(b, m.rejectedPlans);
   auto t = w::CreateFrameStats(b, m.frame, m.plan, m.timestampNs, m.polygons, m.linkBytes, m.hasSnr,
-                               m.snrDb, m.renderMs, rejected);
+                               m.snrDb, m.renderMs, rejected, m.earlyPolygons);
   return {w::Body::FrameStats, t.Union()};
 }
 
@@ -561,6 +561,7 @@ Result<Message> fromWire(const FieldPath& path, const w::FrameStats* m) {
   out.hasSnr = m->has_snr();
   out.snrDb = m->snr_db();
   out.renderMs = m->render_ms();
+  out.earlyPolygons = m->early_polygons();
   THINLOD_RETURN_IF_ERROR(
       checkVectorCount(path.child("rejected_plans"), m->rejected_plans(), kMaxRejectedPlans));
   if (const auto* rejected = m->rejected_plans())

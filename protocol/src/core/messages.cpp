@@ -99,7 +99,8 @@ bool operator==(const SceneUpdate& a, const SceneUpdate& b) {
 bool operator==(const FrameStats& a, const FrameStats& b) {
   return a.frame == b.frame && a.plan == b.plan && a.timestampNs == b.timestampNs &&
          a.polygons == b.polygons && a.linkBytes == b.linkBytes && a.hasSnr == b.hasSnr &&
-         a.snrDb == b.snrDb && a.renderMs == b.renderMs && a.rejectedPlans == b.rejectedPlans;
+         a.snrDb == b.snrDb && a.renderMs == b.renderMs && a.rejectedPlans == b.rejectedPlans &&
+         a.earlyPolygons == b.earlyPolygons;
 }
 bool operator==(const SimplifyRequest& a, const SimplifyRequest& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && a.sourcePath == b.sourcePath &&

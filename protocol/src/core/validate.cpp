@@ -378,6 +378,8 @@ Status check(const FieldPath& path, const FrameStats& m) {
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("render_ms"), m.renderMs));
   THINLOD_RETURN_IF_ERROR(
       checkCount(path.child("rejected_plans"), m.rejectedPlans.size(), kMaxRejectedPlans));
+  if (m.earlyPolygons > m.polygons)
+    return invalidField(path.child("early_polygons"), "must be at most polygons");
   return Status();
 }
 

@@ -74,6 +74,9 @@ struct FrameRecord {
   double poseToFrameMs = kMissing;
   double updateLatencyMs = kMissing;
   std::uint64_t plan = 0;  // last applied SceneUpdate plan
+  // Of polygons, first representations shown before their plan (not in the
+  // CSV; FrameStats.early_polygons).
+  std::size_t earlyPolygons = 0;
   std::size_t drawCalls = 0;
   std::size_t uploadedBytes = 0;  // representation bytes uploaded to the GPU this frame
   double waitMs = 0.0;            // pose sent -> render started (lockstep wait or poll)

@@ -89,6 +89,7 @@ struct FrameReport {
   std::string lastUploadError;              // why, when droppedBatches > 0
   std::size_t texturePages = 0;
   std::uint64_t appliedPlan = 0;  // FrontendScene::lastAppliedPlan()
+  std::size_t earlyPolygons = 0;  // FrontendScene::earlyPolygons()
 };
 
 class FrontendRenderer {

@@ -157,6 +157,10 @@ class FrontendScene {
   // A queued (not yet committed) representation, or null.
   const SceneObject* findPending(RepresentationKey key) const;
   std::size_t polygons() const { return polygons_; }  // triangles of the held objects
+  // Of polygons(), the triangles of first representations shown early
+  // (their batch not committed yet): polygons() - earlyPolygons() is what
+  // lastAppliedPlan() left (FrameStats.early_polygons).
+  std::size_t earlyPolygons() const { return earlyPolygons_; }
   std::size_t pendingBatches() const { return pending_.size(); }
   std::size_t pendingUploadBytes() const;
   std::uint64_t lastAppliedPlan() const { return lastPlan_; }
@@ -179,6 +183,7 @@ class FrontendScene {
   std::uint64_t nextSequence_ = 1;
   RepresentationKey nextKey_ = 1;
   std::size_t polygons_ = 0;
+  std::size_t earlyPolygons_ = 0;
   std::uint64_t lastPlan_ = 0;
 };
 

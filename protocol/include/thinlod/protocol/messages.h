@@ -205,6 +205,10 @@ struct FrameStats {
   // Plans of SceneUpdates the frontend refused (whole batch) since the
   // previous FrameStats: the backbone corrects its mirror of the frontend.
   std::vector<std::uint64_t> rejectedPlans;  // at most kMaxRejectedPlans
+  // Of `polygons`, those of first representations shown before their
+  // update's plan was applied (<= polygons): polygons - earlyPolygons are
+  // the ones `plan` left at the frontend.
+  std::uint32_t earlyPolygons = 0;
 };
 
 // --- Backbone <-> simplifier workers (request ids are idempotency keys) ---
