@@ -131,11 +131,7 @@ class Collapser {
       }
     }
     pairTarget_.assign(vertexCount, kNone);
-    removed_.assign(vertexCount, 0);
-    kind_.assign(vertexCount, VertexKind::kUnknown);
-    target_.assign(vertexCount, kNone);
-    exact_.assign(vertexCount, 0);
-    mark_.assign(vertexCount, 0);
+    vertex_.assign(vertexCount, VertexState());
     slot_.assign(vertexCount, 0);
     gatherMark_.assign(vertexCount, 0);
     buildAdjacency(vertexCount);
@@ -164,10 +160,10 @@ class Collapser {
         nextReport = liveTriangles_ > reportEvery ? liveTriangles_ - reportEvery : 0;
       }
       const std::uint32_t u = heap_.top();
-      if (exact_[u]) {
+      if (vertex_[u].exact) {
         // Changes nearby since the key was computed may have made the move
         // illegal or dearer: re-check, collapse only at no more than the key.
-        const std::uint32_t w = target_[u];
+        const std::uint32_t w = vertex_[u].target;
         const double key = heap_.topKey();
         compact(u);
         if (isValidMove(u, w)) {
@@ -184,7 +180,7 @@ class Collapser {
       // stays at the top (it was just validated).
       const double key = chooseTarget(u, /*exact=*/true);
       rekey(u, key);
-      if (key < kInfinity && heap_.top() == u) collapse(u, target_[u], key);
+      if (key < kInfinity && heap_.top() == u) collapse(u, vertex_[u].target, key);
     }
     if (options_.progress) options_.progress(1.0);
     CollapseRecord record = std::move(record_);
@@ -197,23 +193,24 @@ class Collapser {
 
  private:
   void buildAdjacency(std::size_t vertexCount) {
-    listStart_.assign(vertexCount + 1, 0);
+    // Lists in vertex order: start = the number of corners of lower vertices.
     for (const Triangle& t : triangle_) {
-      for (std::uint32_t v : t.v) ++listStart_[v + 1];
+      for (std::uint32_t v : t.v) ++vertex_[v].liveCount;
     }
-    for (std::size_t v = 0; v < vertexCount; ++v) listStart_[v + 1] += listStart_[v];
-    listSize_.assign(vertexCount, 0);
+    std::uint32_t start = 0;
+    for (std::size_t v = 0; v < vertexCount; ++v) {
+      vertex_[v].listStart = start;
+      start += vertex_[v].liveCount;
+    }
     // Headroom for the lists rebuilt on collapses (about 12 entries each).
     pool_.reserve(triangle_.size() * 9);
     pool_.resize(triangle_.size() * 3);
     for (std::uint32_t t = 0; t < triangle_.size(); ++t) {
       for (std::uint32_t k = 0; k < 3; ++k) {
         const std::uint32_t v = triangle_[t].v[k];
-        pool_[listStart_[v] + listSize_[v]++] = t << 2 | k;
+        pool_[vertex_[v].listStart + vertex_[v].listSize++] = t << 2 | k;
       }
     }
-    listStart_.resize(vertexCount);
-    liveCount_ = listSize_;
   }
 
   void buildQuadrics() {
@@ -246,12 +243,12 @@ class Collapser {
   void classifyAndAddBoundaryPlanes() {
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
       gather(v, neighborsU_);
-      kind_[v] = classify(neighborsU_);
+      vertex_[v].kind = classify(neighborsU_);
       // A kept or pinned vertex never moves; its quadric is built as usual
       // (it still prices the collapses onto it).
-      const bool interior = kind_[v] == VertexKind::kInterior;
+      const bool interior = vertex_[v].kind == VertexKind::kInterior;
       if (!constraints_.empty() && constraints_[v] != VertexConstraint::kFree) {
-        kind_[v] = VertexKind::kLocked;
+        vertex_[v].kind = VertexKind::kLocked;
       }
       if (interior || !options_.preserveBoundaries) continue;
       for (const Neighbor& nb : neighborsU_) {
@@ -281,22 +278,23 @@ class Collapser {
   // side's attributes onto the other.
   void classifySeams() {
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
-      if (kind_[v] == VertexKind::kLocked) continue;
+      if (vertex_[v].kind == VertexKind::kLocked) continue;
       if (groupSize_[v] == 1) {
-        if (kind_[v] != VertexKind::kBoundary) continue;
+        if (vertex_[v].kind != VertexKind::kBoundary) continue;
         gather(v, neighborsU_);
         std::uint32_t places[2] = {kNone, kNone};
         int found = 0;
         for (const Neighbor& nb : neighborsU_) {
           if (nb.triangles == 1 && found < 2) places[found++] = group_[nb.vertex];
         }
-        if (found == 2 && places[0] == places[1]) kind_[v] = VertexKind::kLocked;
+        if (found == 2 && places[0] == places[1]) vertex_[v].kind = VertexKind::kLocked;
         continue;
       }
       const std::uint32_t s = sibling_[v];
-      if (s == kNone || kind_[v] != VertexKind::kBoundary || kind_[s] == VertexKind::kLocked ||
+      if (s == kNone || vertex_[v].kind != VertexKind::kBoundary ||
+          vertex_[s].kind == VertexKind::kLocked ||
           (!constraints_.empty() && constraints_[s] != VertexConstraint::kFree)) {
-        kind_[v] = VertexKind::kLocked;
+        vertex_[v].kind = VertexKind::kLocked;
         continue;
       }
       gather(v, neighborsU_);
@@ -306,17 +304,17 @@ class Collapser {
         if (nb.triangles != 1) continue;
         if (borderNeighborAt(neighborsS_, group_[nb.vertex]) == kNone) matched = false;
       }
-      if (!matched) kind_[v] = VertexKind::kLocked;
+      if (!matched) vertex_[v].kind = VertexKind::kLocked;
     }
     // A pair is a seam only when both sides qualified.
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
-      if (sibling_[v] == kNone || kind_[v] != VertexKind::kBoundary) continue;
-      kind_[v] =
-          kind_[sibling_[v]] == VertexKind::kLocked ? VertexKind::kLocked : VertexKind::kSeam;
+      if (sibling_[v] == kNone || vertex_[v].kind != VertexKind::kBoundary) continue;
+      vertex_[v].kind = vertex_[sibling_[v]].kind == VertexKind::kLocked ? VertexKind::kLocked
+                                                                         : VertexKind::kSeam;
     }
     for (std::uint32_t v = 0; v < point_.size(); ++v) {
-      if (kind_[v] == VertexKind::kSeam && kind_[sibling_[v]] != VertexKind::kSeam) {
-        kind_[v] = VertexKind::kLocked;
+      if (vertex_[v].kind == VertexKind::kSeam && vertex_[sibling_[v]].kind != VertexKind::kSeam) {
+        vertex_[v].kind = VertexKind::kLocked;
       }
     }
   }
@@ -333,7 +331,7 @@ class Collapser {
 
   // The pair's leader (the lower index) is the one in the heap.
   bool isSeamFollower(std::uint32_t v) const {
-    return kind_[v] == VertexKind::kSeam && sibling_[v] < v;
+    return vertex_[v].kind == VertexKind::kSeam && sibling_[v] < v;
   }
   std::uint32_t heapVertex(std::uint32_t v) const { return isSeamFollower(v) ? sibling_[v] : v; }
 
@@ -352,7 +350,7 @@ class Collapser {
   // A move of u onto w, with u's sibling when u is a seam leader; u's list
   // is compacted.
   bool isValidMove(std::uint32_t u, std::uint32_t w) {
-    if (kind_[u] != VertexKind::kSeam) return isValidCollapse(u, w);
+    if (vertex_[u].kind != VertexKind::kSeam) return isValidCollapse(u, w);
     if (w == kNone || edgeTriangleCount(u, w) != 1) return false;
     const std::uint32_t sw = counterpart(u, w);
     if (sw == kNone || !isValidCollapse(sibling_[u], sw)) return false;
@@ -363,13 +361,13 @@ class Collapser {
   // After isValidMove(u, w) (the pair's target is set).
   double moveCost(std::uint32_t u, std::uint32_t w) const {
     double cost = fullCost(u, w);
-    if (kind_[u] == VertexKind::kSeam) cost += fullCost(sibling_[u], pairTarget_[u]);
+    if (vertex_[u].kind == VertexKind::kSeam) cost += fullCost(sibling_[u], pairTarget_[u]);
     return cost;
   }
 
   // A live triangle on edge ab (precondition: there is one).
   std::uint32_t triangleOn(std::uint32_t a, std::uint32_t b) const {
-    std::uint32_t i = listStart_[a];
+    std::uint32_t i = vertex_[a].listStart;
     while (triangle_[triangleOf(pool_[i])].removedAt != 0 ||
            !triangle_[triangleOf(pool_[i])].has(b)) {
       ++i;
@@ -380,7 +378,7 @@ class Collapser {
   // Live triangles on edge ab.
   std::uint32_t edgeTriangleCount(std::uint32_t a, std::uint32_t b) const {
     std::uint32_t count = 0;
-    for (std::uint32_t i = listStart_[a], end = i + listSize_[a]; i < end; ++i) {
+    for (std::uint32_t i = vertex_[a].listStart, end = i + vertex_[a].listSize; i < end; ++i) {
       const Triangle& t = triangle_[triangleOf(pool_[i])];
       count += t.removedAt == 0 && t.has(b) ? 1u : 0u;
     }
@@ -394,25 +392,25 @@ class Collapser {
 
   // Drops dead triangles from v's list (lazy deletion).
   void compact(std::uint32_t v) {
-    const std::uint32_t start = listStart_[v];
+    const std::uint32_t start = vertex_[v].listStart;
     std::uint32_t write = start;
-    for (std::uint32_t i = start, end = start + listSize_[v]; i < end; ++i) {
+    for (std::uint32_t i = start, end = start + vertex_[v].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       pool_[write] = entry;
       write += triangle_[triangleOf(entry)].removedAt == 0 ? 1u : 0u;
     }
-    listSize_[v] = write - start;
+    vertex_[v].listSize = write - start;
   }
 
   // compact(v), then lists v's neighbours with the number of live triangles
   // on each edge (quadratic in the valence: for classification and borders).
   void gather(std::uint32_t v, std::vector<Neighbor>& out) {
     out.clear();
-    const std::uint32_t start = listStart_[v];
+    const std::uint32_t start = vertex_[v].listStart;
     std::uint32_t write = start;
     // Small fans: linear search. Large ones (poles, cone apexes with
     // thousands of triangles) index their neighbours through stamped slots.
-    const bool large = listSize_[v] > 32;
+    const bool large = vertex_[v].listSize > 32;
     const std::uint32_t stamp = large ? ++gatherStamp_ : 0;
     auto add = [&](std::uint32_t x) {
       if (large) {
@@ -433,7 +431,7 @@ class Collapser {
       }
       out.push_back({x, 1});
     };
-    for (std::uint32_t i = start, end = start + listSize_[v]; i < end; ++i) {
+    for (std::uint32_t i = start, end = start + vertex_[v].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
       if (t.removedAt != 0) continue;
@@ -441,7 +439,7 @@ class Collapser {
       add(t.v[kNextCorner[cornerOf(entry)]]);
       add(t.v[kPrevCorner[cornerOf(entry)]]);
     }
-    listSize_[v] = write - start;
+    vertex_[v].listSize = write - start;
   }
 
   // Attribute quadric part of u -> w: u's and w's attribute planes at
@@ -521,7 +519,7 @@ class Collapser {
     const glm::dvec3 pu = point_[u].p;
     const glm::dvec3 pw = point_[w].p;
     double fan = 0.0, farthest = 0.0;
-    for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
+    for (std::uint32_t i = vertex_[u].listStart, end = i + vertex_[u].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
       const std::uint32_t a = t.v[kNextCorner[cornerOf(entry)]];
@@ -543,8 +541,8 @@ class Collapser {
     // (their weight scales with edge length squared): a tiny ear on a hole
     // of the bunny went first at almost no cost and stayed its 50% max.
     // Fans above kLargeFan skip it: the neighbour search is quadratic.
-    if ((kind_[u] == VertexKind::kBoundary || kind_[u] == VertexKind::kSeam) &&
-        listSize_[u] <= kLargeFan) {
+    if ((vertex_[u].kind == VertexKind::kBoundary || vertex_[u].kind == VertexKind::kSeam) &&
+        vertex_[u].listSize <= kLargeFan) {
       const std::uint32_t y = otherBorderNeighbor(u, w);
       if (y != kNone) farthest = std::max(farthest, squaredDistanceToSegment(pu, pw, point_[y].p));
     }
@@ -557,7 +555,7 @@ class Collapser {
   // border neighbour is a next corner that is nobody's previous corner or
   // the reverse. Skips dead triangles. O(valence^2), border fans are small.
   std::uint32_t otherBorderNeighbor(std::uint32_t u, std::uint32_t w) const {
-    const std::uint32_t start = listStart_[u], end = start + listSize_[u];
+    const std::uint32_t start = vertex_[u].listStart, end = start + vertex_[u].listSize;
     for (std::uint32_t i = start; i < end; ++i) {
       const Triangle& t = triangle_[triangleOf(pool_[i])];
       if (t.removedAt != 0) continue;
@@ -599,18 +597,18 @@ class Collapser {
     return borderEdges > 0 ? VertexKind::kBoundary : VertexKind::kInterior;
   }
 
-  // Picks target_[u] and returns its key (infinity when u must stay) and
+  // Picks vertex_[u].target and returns its key (infinity when u must stay) and
   // compacts u's list. Estimate (exact == false): the cheapest quadric cost
   // among the moves u's kind allows, plus that move's fan term. Exact: the
   // cheapest full cost among the legal moves.
   double chooseTarget(std::uint32_t u, bool exact) {
-    target_[u] = kNone;
-    exact_[u] = exact;
-    if (kind_[u] == VertexKind::kUnknown) {
+    vertex_[u].target = kNone;
+    vertex_[u].exact = exact;
+    if (vertex_[u].kind == VertexKind::kUnknown) {
       gather(u, neighborsU_);
-      kind_[u] = classify(neighborsU_);
+      vertex_[u].kind = classify(neighborsU_);
     }
-    const VertexKind kind = kind_[u];
+    const VertexKind kind = vertex_[u].kind;
     if (kind == VertexKind::kLocked || isSeamFollower(u)) return kInfinity;
     candidateVertices_.clear();
     if (kind == VertexKind::kSeam) return chooseSeamTarget(u, exact);
@@ -624,7 +622,7 @@ class Collapser {
       // Interior of an oriented manifold: every neighbour is the next
       // corner of exactly one triangle of the fan, no deduplication needed.
       compact(u);
-      for (std::uint32_t i = listStart_[u], end = i + listSize_[u]; i < end; ++i) {
+      for (std::uint32_t i = vertex_[u].listStart, end = i + vertex_[u].listSize; i < end; ++i) {
         const std::uint32_t entry = pool_[i];
         const std::uint32_t w = triangle_[triangleOf(entry)].v[kNextCorner[cornerOf(entry)]];
         if (mayTarget(w)) candidateVertices_.push_back(w);
@@ -636,10 +634,10 @@ class Collapser {
         const double cost = quadricCost(u, w);
         if (cost < best) {
           best = cost;
-          target_[u] = w;
+          vertex_[u].target = w;
         }
       }
-      return best < kInfinity ? best + fanCost(u, target_[u]) : kInfinity;
+      return best < kInfinity ? best + fanCost(u, vertex_[u].target) : kInfinity;
     }
     // In quadric order; the quadric cost is a lower bound of the full cost,
     // so candidates past the best legal full cost need no fan term.
@@ -658,7 +656,7 @@ class Collapser {
       const double cost = c.cost + fanCost(u, c.vertex, c.cost, best);
       if (cost < best && isValidCollapse(u, c.vertex)) {
         best = cost;
-        target_[u] = c.vertex;
+        vertex_[u].target = c.vertex;
       }
     }
     return best;
@@ -683,7 +681,7 @@ class Collapser {
       if (cost >= best) continue;
       if (exact && !(isValidCollapse(s, sw) && isValidCollapse(u, w))) continue;
       best = cost;
-      target_[u] = w;
+      vertex_[u].target = w;
       bestPair = sw;
     }
     pairTarget_[u] = bestPair;
@@ -695,7 +693,7 @@ class Collapser {
     if (w == kNone || !mayTarget(w)) return false;
     // Opposite corners of the triangles on edge uw (they die with it).
     opposite_.clear();
-    const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
+    const std::uint32_t uStart = vertex_[u].listStart, uEnd = uStart + vertex_[u].listSize;
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
@@ -713,19 +711,19 @@ class Collapser {
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
-      mark_[t.v[kNextCorner[cornerOf(entry)]]] = neighborOfU;
-      mark_[t.v[kPrevCorner[cornerOf(entry)]]] = neighborOfU;
+      vertex_[t.v[kNextCorner[cornerOf(entry)]]].mark = neighborOfU;
+      vertex_[t.v[kPrevCorner[cornerOf(entry)]]].mark = neighborOfU;
     }
     const std::uint32_t common = ++stamp_;
-    for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
+    for (std::uint32_t i = vertex_[w].listStart, end = i + vertex_[w].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
       if (t.removedAt != 0) continue;
       for (std::uint32_t x :
            {t.v[kNextCorner[cornerOf(entry)]], t.v[kPrevCorner[cornerOf(entry)]]}) {
-        if (x == u || mark_[x] != neighborOfU) continue;
+        if (x == u || vertex_[x].mark != neighborOfU) continue;
         if (std::find(opposite_.begin(), opposite_.end(), x) == opposite_.end()) return false;
-        mark_[x] = common;
+        vertex_[x].mark = common;
       }
     }
     const glm::dvec3 pu = point_[u].p;
@@ -739,7 +737,8 @@ class Collapser {
       if (a == w || b == w) continue;
       // A triangle w already has on a and b would be duplicated (the last
       // collapse of a tetrahedron). Needs a and b both common neighbours.
-      if (mark_[a] == common && mark_[b] == common && hasTriangleOn(w, a, b)) return false;
+      if (vertex_[a].mark == common && vertex_[b].mark == common && hasTriangleOn(w, a, b))
+        return false;
       if (!options_.preventFlips) continue;
       const glm::dvec3& pa = point_[a].p;
       const glm::dvec3& pb = point_[b].p;
@@ -771,7 +770,7 @@ class Collapser {
   }
 
   bool hasTriangleOn(std::uint32_t w, std::uint32_t a, std::uint32_t b) const {
-    for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
+    for (std::uint32_t i = vertex_[w].listStart, end = i + vertex_[w].listSize; i < end; ++i) {
       const Triangle& t = triangle_[triangleOf(pool_[i])];
       if (t.removedAt == 0 && t.has(a) && t.has(b)) return true;
     }
@@ -779,7 +778,7 @@ class Collapser {
   }
 
   void removeVertex(std::uint32_t v, std::uint32_t parent) {
-    removed_[v] = 1;
+    vertex_[v].removed = 1;
     record_.removedVertex.push_back(v);
     record_.removedParent.push_back(parent);
     heap_.remove(v);
@@ -790,7 +789,7 @@ class Collapser {
   // gathered them since the last change.
   void collapse(std::uint32_t u, std::uint32_t w, double cost) {
     const std::uint32_t step = static_cast<std::uint32_t>(record_.costOfStep.size()) + 1;
-    const bool pair = kind_[u] == VertexKind::kSeam;
+    const bool pair = vertex_[u].kind == VertexKind::kSeam;
     const std::uint32_t s = pair ? sibling_[u] : kNone;
     const std::uint32_t sw = pair ? pairTarget_[u] : kNone;
     collapseEdge(u, w, step);
@@ -801,14 +800,14 @@ class Collapser {
     record_.removalsAfterStep.push_back(static_cast<std::uint32_t>(record_.removedVertex.size()));
     record_.trianglesAfterStep.push_back(static_cast<std::uint32_t>(liveTriangles_));
     record_.costOfStep.push_back(static_cast<float>(cost));
-    if (!removed_[w]) rekeyAround(u, w);
-    if (pair && !removed_[sw]) rekeyAround(s, sw);
+    if (!vertex_[w].removed) rekeyAround(u, w);
+    if (pair && !vertex_[sw].removed) rekeyAround(s, sw);
   }
 
   void collapseEdge(std::uint32_t u, std::uint32_t w, std::uint32_t step) {
     // Kill the triangles on edge uw first so that w's new list skips them.
     opposite_.clear();
-    const std::uint32_t uStart = listStart_[u], uEnd = uStart + listSize_[u];
+    const std::uint32_t uStart = vertex_[u].listStart, uEnd = uStart + vertex_[u].listSize;
     for (std::uint32_t i = uStart; i < uEnd; ++i) {
       const std::uint32_t entry = pool_[i];
       Triangle& t = triangle_[triangleOf(entry)];
@@ -817,12 +816,12 @@ class Collapser {
       if (t.removedAt != 0 || (a != w && b != w)) continue;
       t.removedAt = step;
       --liveTriangles_;
-      for (std::uint32_t x : t.v) --liveCount_[x];
+      for (std::uint32_t x : t.v) --vertex_[x].liveCount;
       opposite_.push_back(a == w ? b : a);
     }
     // w's new list: its live triangles, then u's survivors renamed to w.
     // Written at the end of the pool (in place when w's list is already last).
-    const std::uint32_t wStart = listStart_[w], wEnd = wStart + listSize_[w];
+    const std::uint32_t wStart = vertex_[w].listStart, wEnd = wStart + vertex_[w].listSize;
     std::uint32_t newStart;
     if (wEnd == pool_.size()) {
       std::uint32_t write = wStart;
@@ -844,12 +843,12 @@ class Collapser {
       if (t.removedAt != 0) continue;
       t.v[cornerOf(entry)] = w;
       pool_.push_back(entry);
-      ++liveCount_[w];
+      ++vertex_[w].liveCount;
     }
-    liveCount_[u] = 0;
-    listStart_[w] = newStart;
-    listSize_[w] = static_cast<std::uint32_t>(pool_.size()) - newStart;
-    listSize_[u] = 0;
+    vertex_[u].liveCount = 0;
+    vertex_[w].listStart = newStart;
+    vertex_[w].listSize = static_cast<std::uint32_t>(pool_.size()) - newStart;
+    vertex_[u].listSize = 0;
 
     quadric_[w] += quadric_[u];
     point_[w].selfCost = quadric_[w].eval(point_[w].p);
@@ -862,9 +861,9 @@ class Collapser {
     }
     removeVertex(u, w);
     // Vertices left without triangles leave the mesh too (parent kNone).
-    if (listSize_[w] == 0) removeVertex(w, kNone);
+    if (vertex_[w].listSize == 0) removeVertex(w, kNone);
     for (std::uint32_t x : opposite_) {
-      if (!removed_[x] && liveCount_[x] == 0) removeVertex(x, kNone);
+      if (!vertex_[x].removed && vertex_[x].liveCount == 0) removeVertex(x, kNone);
     }
   }
 
@@ -878,30 +877,30 @@ class Collapser {
     compact(w);
     const bool wMayTarget = mayTarget(w);
     const std::uint32_t seen = ++stamp_;
-    for (std::uint32_t i = listStart_[w], end = i + listSize_[w]; i < end; ++i) {
+    for (std::uint32_t i = vertex_[w].listStart, end = i + vertex_[w].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
       const Triangle& t = triangle_[triangleOf(entry)];
       for (std::uint32_t corner :
            {t.v[kNextCorner[cornerOf(entry)]], t.v[kPrevCorner[cornerOf(entry)]]}) {
         const std::uint32_t x = heapVertex(corner);
-        if (mark_[x] == seen) continue;
-        mark_[x] = seen;
+        if (vertex_[x].mark == seen) continue;
+        vertex_[x].mark = seen;
         // A seam pair's cost spans both sides: always re-chosen.
-        if (target_[x] == u || target_[x] == w || target_[x] == kNone || !heap_.contains(x) ||
-            kind_[x] == VertexKind::kSeam) {
+        if (vertex_[x].target == u || vertex_[x].target == w || vertex_[x].target == kNone ||
+            !heap_.contains(x) || vertex_[x].kind == VertexKind::kSeam) {
           rekey(x, chooseTarget(x, /*exact=*/false));
           continue;
         }
-        if (kind_[x] == VertexKind::kLocked || !wMayTarget) continue;
+        if (vertex_[x].kind == VertexKind::kLocked || !wMayTarget) continue;
         // A huge fan (a pole, a cone apex) would pay O(valence) here on every
         // collapse around it; its key may stay high until it is re-chosen.
-        if (liveCount_[x] > kLargeFan) continue;
-        if (kind_[x] == VertexKind::kBoundary && edgeTriangleCount(x, w) != 1) continue;
+        if (vertex_[x].liveCount > kLargeFan) continue;
+        if (vertex_[x].kind == VertexKind::kBoundary && edgeTriangleCount(x, w) != 1) continue;
         double cost = quadricCost(x, w);
         if (cost < heap_.key(x)) cost += fanCost(x, w, cost, heap_.key(x));
         if (cost < heap_.key(x)) {
-          target_[x] = w;
-          exact_[x] = false;
+          vertex_[x].target = w;
+          vertex_[x].exact = false;
           heap_.update(x, cost);
         }
       }
@@ -938,23 +937,30 @@ class Collapser {
   std::vector<glm::vec3> inputNormal_;   // unit normal of each triangle in the input
   std::vector<glm::vec3> vertexNormal_;  // unit area-weighted normal of each input vertex
   std::size_t liveTriangles_ = 0;
-  // Vertex -> corner lists: pool_[listStart_[v] .. + listSize_[v]], may hold
+  // Vertex -> corner lists: pool_[vertex_[v].listStart .. + vertex_[v].listSize], may hold
   // dead triangles until the next gather of v.
-  std::vector<std::uint32_t> listStart_;
-  std::vector<std::uint32_t> listSize_;
-  std::vector<std::uint32_t> liveCount_;  // live triangles per vertex (the lists lag behind)
+  // The per-vertex state the collapse loop reads for every vertex it visits,
+  // in one 24-byte record: a visit costs one cache line instead of one per
+  // array.
+  struct VertexState {
+    std::uint32_t listStart = 0;
+    std::uint32_t listSize = 0;
+    std::uint32_t liveCount = 0;  // live triangles (the list lags behind)
+    std::uint32_t target = kNone;
+    std::uint32_t mark = 0;  // stamp_ of the last visit
+    VertexKind kind = VertexKind::kUnknown;
+    std::uint8_t exact = 0;  // heap key is the exact, validated cost of target
+    std::uint8_t removed = 0;
+  };
+  std::vector<VertexState> vertex_;
   std::vector<std::uint32_t> pool_;
-  std::vector<std::uint8_t> removed_;
-  std::vector<VertexKind> kind_;
   // Seams: place of each vertex, vertices at that place, the other vertex
   // of a two-vertex place (kNone otherwise), and where a seam leader's
-  // sibling goes when the leader moves onto target_.
+  // sibling goes when the leader moves onto its target.
   std::vector<std::uint32_t> group_;
   std::vector<std::uint32_t> groupSize_;
   std::vector<std::uint32_t> sibling_;
   std::vector<std::uint32_t> pairTarget_;
-  std::vector<std::uint32_t> target_;
-  std::vector<std::uint8_t> exact_;  // heap key is the exact, validated cost of target_
   IndexedMinHeap heap_;
   CollapseRecord record_;
   // Scratch, reused to avoid allocation per collapse.
@@ -970,7 +976,6 @@ class Collapser {
   };
   std::vector<std::uint32_t> candidateVertices_;
   std::vector<Candidate> candidates_;
-  std::vector<std::uint32_t> mark_;
   // Gather of large fans: stamp and index in the output per neighbour.
   std::vector<std::uint32_t> gatherMark_;
   std::vector<std::uint32_t> slot_;
