@@ -407,7 +407,9 @@ TEST(FrameLog, ALongRunKeepsMemoryPerFrameSmallAndTheSummaryExact) {
   EXPECT_EQ(line + "\n", frameCsvHeader());
   std::uint64_t rows = 0;
   while (std::getline(in, line)) {
-    if (rows % 9973 == 0) EXPECT_EQ(line + "\n", formatFrameCsvRow(syntheticFrame(rows)));
+    if (rows % 9973 == 0) {
+      EXPECT_EQ(line + "\n", formatFrameCsvRow(syntheticFrame(rows)));
+    }
     ++rows;
   }
   EXPECT_EQ(rows, kFrames);
