@@ -516,8 +516,9 @@ class Collapser {
   // value.
   double fanCost(std::uint32_t u, std::uint32_t w, double base = 0.0,
                  double limit = kInfinity) const {
-    const glm::dvec3 pu = point_[u].p;
     const glm::dvec3 pw = point_[w].p;
+    const glm::dvec3 pu = point_[u].p;
+    const glm::dvec3 toU = pu - pw;  // the same value in every term; GCC did not hoist it
     double fan = 0.0, farthest = 0.0;
     for (std::uint32_t i = vertex_[u].listStart, end = i + vertex_[u].listSize; i < end; ++i) {
       const std::uint32_t entry = pool_[i];
@@ -528,10 +529,11 @@ class Collapser {
       const glm::dvec3 after = glm::cross(point_[a].p - pw, point_[b].p - pw);
       const double afterLength2 = glm::dot(after, after);
       if (afterLength2 > 0.0) {
-        const double d = glm::dot(after, pu - pw);
-        fan += 0.5 * d * d / std::sqrt(afterLength2);  // area * squared distance
+        const double d = glm::dot(after, toU);
+        // The bound first: the triangle that decides skips its square root.
         farthest = std::max(farthest, d * d / afterLength2);
         if (base + kFarthestWeight * farthest >= limit) return kFarthestWeight * farthest;
+        fan += 0.5 * d * d / std::sqrt(afterLength2);  // area * squared distance
       }
     }
     // A border vertex also takes its stretch of border with it: the border
