@@ -286,6 +286,70 @@ TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {
   EXPECT_EQ(core->frontendTriangles(), second.frontendTriangles);
 }
 
+// Two sessions' cores of one scene (the daemon's several frontends): the
+// second takes the first one's measured curve (its own startup request is
+// withdrawn, nothing to ask) and the meshes the first one made, which it
+// then sends to its frontend under the same ids without a request of its
+// own (impostors, view-dependent, are not shared); a core of another scene
+// is refused.
+TEST(BackboneCoreSessions, ASecondCoreTakesTheCurvesAndMeshesTheFirstOneMade) {
+  CoreOptions options = polygonBudget(400);
+  options.simpleImpostorRadii = 0.0;  // meshes only: impostors are not shared
+  options.meshedImpostorRadii = 0.0;
+  auto first = makeCore(options);
+  auto second = makeCore(options);
+  ASSERT_NE(first, nullptr);
+  ASSERT_NE(second, nullptr);
+  deliverCurves(*first);
+  ASSERT_EQ(second->curvesPending(), 1u);
+  Result<std::size_t> curves = second->adoptMeasuredCurves(*first);
+  ASSERT_TRUE(curves.ok()) << curves.status().toString();
+  EXPECT_EQ(*curves, 1u);
+  EXPECT_EQ(second->curvesPending(), 0u);
+  EXPECT_TRUE(second->objectsWithoutMeasuredCurve().empty());
+  EXPECT_TRUE(second->takeRequests().empty());  // the startup request was withdrawn
+
+  // The first session's frontend is served: requests, results, sends.
+  FakeSimplifier fake(*first);
+  ASSERT_TRUE(first->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  answer(*first, fake, submitAll(*first));
+  ASSERT_TRUE(first->replan().ok());
+  const PoseOutcome served = first->finishPose();
+  const std::size_t sentFirst =
+      countOps(served.update, protocol::SceneOperation::Type::kAddOrReplace);
+  ASSERT_GT(sentFirst, 0u);
+  std::map<std::uint64_t, std::uint64_t> madeForFirst;  // object -> representation id
+  for (const auto& op : served.update.operations)
+    madeForFirst[op.objectId] = op.representation.representationId;
+
+  Result<std::size_t> copies = second->adoptGeneratedCopies(*first);
+  ASSERT_TRUE(copies.ok()) << copies.status().toString();
+  EXPECT_EQ(*copies, sentFirst);  // what the first frontend holds
+  ASSERT_TRUE(second->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  EXPECT_TRUE(submitAll(*second).empty());  // nothing to ask: the meshes are there
+  const PoseOutcome reused = second->finishPose();
+  ASSERT_TRUE(reused.planned) << reused.planError.toString();
+  std::size_t sameIds = 0;
+  for (const auto& op : reused.update.operations) {
+    if (op.type != protocol::SceneOperation::Type::kAddOrReplace) continue;
+    sameIds += madeForFirst.count(op.objectId) &&
+               madeForFirst.at(op.objectId) == op.representation.representationId;
+  }
+  EXPECT_EQ(sameIds, sentFirst);
+  EXPECT_LE(reused.frontendTriangles, 400.0);
+  // The first core's own frontend model is untouched.
+  EXPECT_EQ(first->frontendTriangles(), served.frontendTriangles);
+
+  // Another scene (a primitive-only room): refused, nothing taken.
+  Result<scene::Scene> other = scene::parseScene(
+      "#VRML V2.0 utf8\nShape { geometry Sphere { radius 1 } }\n", "other.wrl");
+  ASSERT_TRUE(other.ok()) << other.status().toString();
+  auto foreign = BackboneCore::create(std::move(other).value(), "/tmp/other.wrl", options);
+  ASSERT_TRUE(foreign.ok()) << foreign.status().toString();
+  EXPECT_EQ(second->adoptMeasuredCurves(**foreign).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(second->adoptGeneratedCopies(**foreign).status().code(), ErrorCode::kInvalidArgument);
+}
+
 // --measured-generation-delay sets the horizon through setGenerationDelay:
 // a longer delay is a larger region to serve, so at the same budget and pose
 // the guaranteed target is lower; a bad value is refused and changes nothing.

@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -651,6 +653,129 @@ TEST(BackboneDaemonProcess, FrameTimeBudgetUsesTheConstantsEachFrontendSends) {
   EXPECT_GT(slow, 0.0);
   EXPECT_LE(slow, (10e-3 - 1e-3) / 4e-6);
   EXPECT_GT(fast, 2.0 * slow) << fast << " vs " << slow;
+  EXPECT_EQ(daemon.stopWith(SIGTERM), 0);
+}
+
+// Several frontends at once (issue 19): each session has a core of its own
+// (its mirror: a second frontend at the same pose is sent every object, and
+// no frontend is ever sent again a representation it holds), the second
+// session starts from the first one's measured curve and sends it meshes
+// made for the first (the same representation ids), --max-frontends refuses
+// a third session, and a frontend leaving does not disturb the other.
+// (The fake worker delivers less accuracy than asked, so the sessions also
+// ask for better primitive meshes of their own.)
+TEST(BackboneDaemonProcess, SeveralFrontendsHaveSessionsOfTheirOwnAndShareCurvesAndMeshes) {
+  BackboneProcess daemon({"--budget-polygons", "400", "--sync-wait-ms", "3000", "--curve-timeout-s",
+                          "20", "--simple-impostor-radii", "0", "--meshed-impostor-radii", "0",
+                          "--max-frontends", "2", "--log-level", "info"});
+  ASSERT_TRUE(daemon.waitForAddresses()) << daemon.log();
+  FakeWorker worker(daemon.simplifierAddress());
+  ASSERT_TRUE(
+      pumpUntil([&] { worker.poll(10ms); }, [&] { return daemon.logContains("event=ready"); }))
+      << daemon.log();
+
+  struct Frontend {
+    std::unique_ptr<Channel> channel;
+    std::vector<SceneUpdate> updates;
+    std::map<std::uint64_t, std::uint64_t> held;  // object -> representation id
+    bool resent = false;                          // an add of a representation it held
+    const SceneUpdate* updateFor(std::uint64_t frame) const {
+      for (const SceneUpdate& u : updates)
+        if (u.frame == frame) return &u;
+      return nullptr;
+    }
+    void apply(const SceneUpdate& u) {
+      for (const SceneOperation& op : u.operations) {
+        if (op.type == SceneOperation::Type::kRemove) {
+          held.erase(op.objectId);
+          continue;
+        }
+        const auto it = held.find(op.objectId);
+        resent |= it != held.end() && it->second == op.representation.representationId;
+        held[op.objectId] = op.representation.representationId;
+      }
+      updates.push_back(u);
+    }
+  };
+  std::vector<std::unique_ptr<Frontend>> frontends;
+  auto step = [&] {
+    worker.poll(5ms);
+    for (auto& f : frontends) {
+      if (!f->channel) continue;
+      for (ChannelEvent& e : f->channel->poll(2ms))
+        if (auto* u = std::get_if<SceneUpdate>(&e.message)) f->apply(*u);
+    }
+  };
+  auto connect = [&](const std::string& name) -> Frontend& {
+    Channel::Options options;
+    options.address = daemon.frontendAddress();
+    options.hello.role = Role::kFrontend;
+    options.hello.name = name;
+    options.transport = testTransport();
+    auto channel = Channel::connect(options);
+    EXPECT_TRUE(channel.ok());
+    frontends.push_back(std::make_unique<Frontend>());
+    frontends.back()->channel = std::move(channel).value();
+    Frontend& f = *frontends.back();
+    EXPECT_TRUE(pumpUntil(step, [&] { return f.channel->connected(); })) << daemon.log();
+    return f;
+  };
+  auto pose = [&](Frontend& f, std::uint64_t frame, double seconds) -> const SceneUpdate* {
+    EXPECT_TRUE(f.channel->send(entrancePose(frame, seconds)).ok());
+    EXPECT_TRUE(pumpUntil(step, [&] { return f.updateFor(frame) != nullptr; })) << daemon.log();
+    return f.updateFor(frame);
+  };
+  auto addsOf = [](const SceneUpdate* u) {
+    std::map<std::uint64_t, std::uint64_t> adds;  // object -> representation id
+    double triangles = 0.0;
+    for (const SceneOperation& op : u->operations) {
+      if (op.type != SceneOperation::Type::kAddOrReplace) continue;
+      adds[op.objectId] = op.representation.representationId;
+      triangles += op.representation.triangleCount;
+    }
+    EXPECT_LE(triangles, 400.0);
+    return adds;
+  };
+
+  Frontend& a = connect("frontend-a");
+  const SceneUpdate* a1 = pose(a, 1, 0.0);
+  ASSERT_NE(a1, nullptr);
+  const std::map<std::uint64_t, std::uint64_t> sentToA = addsOf(a1);
+  ASSERT_EQ(sentToA.size(), 4u);
+  const int curvesBefore = worker.curveRequests;
+
+  Frontend& b = connect("frontend-b");
+  const SceneUpdate* b1 = pose(b, 1, 0.0);
+  ASSERT_NE(b1, nullptr);
+  // B's own mirror: every object A was sent, B is sent too; the cow's mesh
+  // is the one made for A (same id), and its curve was not measured again.
+  const std::map<std::uint64_t, std::uint64_t> sentToB = addsOf(b1);
+  EXPECT_EQ(sentToB.size(), 4u);
+  ASSERT_TRUE(sentToB.count(4) && sentToA.count(4));
+  EXPECT_EQ(sentToB.at(4), sentToA.at(4));
+  EXPECT_EQ(worker.curveRequests, curvesBefore);
+  EXPECT_TRUE(daemon.logContains("sessions=2 cores=2 curves_taken=1 copies_taken=4"))
+      << daemon.log();
+  ASSERT_NE(pose(a, 2, 0.1), nullptr);
+
+  // A third frontend beyond --max-frontends 2: answered, with nothing.
+  Frontend& c = connect("frontend-c");
+  const SceneUpdate* c1 = pose(c, 1, 0.0);
+  ASSERT_NE(c1, nullptr);
+  EXPECT_TRUE(c1->operations.empty());
+  EXPECT_TRUE(daemon.logContains("event=session_refused")) << daemon.log();
+
+  // B leaves; A is served as before, and C gets B's core, reset for it.
+  b.channel.reset();
+  ASSERT_TRUE(pumpUntil(step, [&] { return daemon.logContains("event=frontend_left"); }))
+      << daemon.log();
+  ASSERT_NE(pose(a, 3, 0.2), nullptr);
+  const SceneUpdate* c2 = pose(c, 2, 0.1);
+  ASSERT_NE(c2, nullptr);
+  EXPECT_EQ(addsOf(c2).size(), 4u);
+  EXPECT_TRUE(daemon.logContains("sessions=2 cores=2")) << daemon.log();
+  for (const auto& f : frontends) EXPECT_FALSE(f->resent);
+  EXPECT_TRUE(daemon.alive());
   EXPECT_EQ(daemon.stopWith(SIGTERM), 0);
 }
 

@@ -418,7 +418,10 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
   }
   // Fresh ids from the planner's counter are never known to the ledger.
   if (!ledger_.ask(request).ok()) return;
-  if (!warmup) ++curvesWanted_;
+  if (!warmup) {
+    ++curvesWanted_;
+    curveRequestOfOption_[option] = request.id;
+  }
   if (!warmup && options_.deferCurveRequests) {
     heldCurves_.push_back({record.fullTriangles, OutgoingRequest{request.id, std::move(message)}});
   } else {
@@ -517,6 +520,87 @@ void BackboneCore::withdraw(const LedgerRequest& request) {
                      [&](const auto& held) { return held.second.requestId == request.id; }),
       heldCurves_.end());
   planner_.releaseLinkReservation(request.id);
+}
+
+namespace {
+
+bool viewIndependentKind(protocol::RepresentationKind kind) {
+  return kind == protocol::RepresentationKind::kMesh ||
+         kind == protocol::RepresentationKind::kHybrid;
+}
+
+}  // namespace
+
+Status BackboneCore::checkSameLayout(const BackboneCore& other) const {
+  if (other.sceneGraph_.fingerprint != sceneGraph_.fingerprint ||
+      other.scenePath_ != scenePath_ || other.optionStates_.size() != optionStates_.size() ||
+      other.scene_.options.size() != scene_.options.size())
+    return invalid("the other core holds another scene or option layout");
+  for (std::size_t i = 0; i < optionStates_.size(); ++i) {
+    if (other.optionStates_[i].object != optionStates_[i].object ||
+        other.optionStates_[i].wireKind != optionStates_[i].wireKind)
+      return invalid("the other core's option " + std::to_string(i) + " differs");
+  }
+  return Status();
+}
+
+Result<std::size_t> BackboneCore::adoptMeasuredCurves(const BackboneCore& other) {
+  THINLOD_RETURN_IF_ERROR(checkSameLayout(other));
+  std::size_t adopted = 0;
+  for (std::uint32_t i = 0; i < optionStates_.size(); ++i) {
+    OptionState& mine = optionStates_[i];
+    const OptionState& theirs = other.optionStates_[i];
+    if (!viewIndependentKind(mine.wireKind)) continue;
+    if (mine.measuredCurve && theirs.measuredCurve && theirs.calibration < mine.calibration) {
+      // What the simplifier really delivered, learned by the other session
+      // (the same curve: analytic, or measured for the same mesh).
+      mine.calibration = theirs.calibration;
+      rebuildCurves(i);
+      continue;
+    }
+    if (mine.measuredCurve || !theirs.measuredCurve) continue;
+    mine.baseTriangles = theirs.baseTriangles;
+    mine.calibration = theirs.calibration;
+    mine.measuredCurve = true;
+    mine.estimatedCurve = false;
+    if (other.meshBytesLearned_[mine.object]) {
+      meshBytesPerTriangle_[mine.object] =
+          meshBytesLearned_[mine.object]
+              ? std::max(meshBytesPerTriangle_[mine.object],
+                         other.meshBytesPerTriangle_[mine.object])
+              : other.meshBytesPerTriangle_[mine.object];
+      meshBytesLearned_[mine.object] = true;
+    }
+    rebuildCurves(i);
+    ++adopted;
+    const auto asked = curveRequestOfOption_.find(i);
+    if (asked == curveRequestOfOption_.end()) continue;
+    if (const LedgerRequest* open = ledger_.open(asked->second)) {
+      const LedgerRequest request = *open;
+      ledger_.close(request.id, RequestState::kRetried);
+      withdraw(request);
+    }
+  }
+  return adopted;
+}
+
+Result<std::size_t> BackboneCore::adoptGeneratedCopies(const BackboneCore& other) {
+  THINLOD_RETURN_IF_ERROR(checkSameLayout(other));
+  std::size_t adopted = 0;
+  for (std::uint32_t i = 0; i < optionStates_.size(); ++i) {
+    if (!viewIndependentKind(optionStates_[i].wireKind) || scene_.options[i].atBackbone.present)
+      continue;
+    // The other core's stock copy, else the one its frontend holds (then a
+    // restarted frontend's Hello finds its copies here under their ids).
+    if (const protocol::Representation* stock = other.mirror_.generatedPayload(i)) {
+      storeBackboneCopy(i, other.scene_.options[i].atBackbone, *stock);
+      ++adopted;
+    } else if (const protocol::Representation* shown = other.mirror_.frontendPayload(i)) {
+      storeBackboneCopy(i, other.scene_.options[i].atFrontend, *shown);
+      ++adopted;
+    }
+  }
+  return adopted;
 }
 
 std::size_t BackboneCore::curvesPending() const {

@@ -41,7 +41,9 @@
 //   frontend is what it sent: one displayed copy per object.
 // - Time is the pose timestamp (clamped to never run backwards).
 // - Not thread-safe; one frontend session at a time (resetFrontend() when it
-//   changes).
+//   changes). The daemon serves several frontends with one core each; the
+//   cores share measured curves and view-independent copies through
+//   adoptMeasuredCurves / adoptGeneratedCopies.
 // - Frame cost (Budget::maxFrameSeconds): a frontend session's frame-time
 //   model uses the constants the frontend's Hello carries (its own renderer,
 //   calibrated by bench_calibrate), else CoreOptions::defaultFrameCost (the
@@ -251,6 +253,25 @@ class BackboneCore {
   // (FrontendMirror::acknowledge); returns the objects corrected.
   std::size_t onFrameStats(const protocol::FrameStats& stats);
 
+  // ---- several frontend sessions (the daemon runs one core per session) ----
+  // Takes over the measured curves `other` (a core of the same scene and
+  // options) has and this one lacks: each mesh or hybrid option's curve,
+  // its calibration and the object's learned mesh bytes per triangle (and
+  // a lower calibration of a curve both have: what the simplifier really
+  // delivers is the same for every session); this
+  // core's startup request for such a curve is withdrawn (closed as
+  // kRetried: what it asked for is in; cancelled on the wire when it was
+  // submitted). Returns how many curves were taken; kInvalidArgument when
+  // `other` holds another scene or option layout.
+  Result<std::size_t> adoptMeasuredCurves(const BackboneCore& other);
+  // Fills this core's empty stock slots from `other`'s copies: its stock
+  // copy, else the copy its frontend holds, of a mesh or hybrid option
+  // (view-independent: valid everywhere, credited the relative accuracy its
+  // result reported) where this core has none in stock. A representation made for one session is then sent
+  // to another without asking a simplifier again. Returns how many copies
+  // were taken; kInvalidArgument as adoptMeasuredCurves.
+  Result<std::size_t> adoptGeneratedCopies(const BackboneCore& other);
+
   // ---- introspection (tests, logs) ----
   const backbone::SchedulingScene& schedulingScene() const { return scene_; }
   const std::vector<ObjectRecord>& objects() const { return converted_.records; }
@@ -297,6 +318,7 @@ class BackboneCore {
 
   BackboneCore(scene::Scene scene, std::string scenePath, CoreOptions options);
   Status initialize();
+  Status checkSameLayout(const BackboneCore& other) const;
   void queueStartupRequest(std::uint32_t object, std::uint32_t option, bool warmup);
   void rebuildCurves(std::uint32_t option);
   void touchObject(std::uint32_t object);
@@ -343,6 +365,7 @@ class BackboneCore {
   std::vector<std::pair<double, OutgoingRequest>> heldCurves_;
   std::uint64_t releasedCurve_ = 0;
   std::size_t curvesWanted_ = 0;
+  std::map<std::uint32_t, std::uint64_t> curveRequestOfOption_;  // startup curve requests
   std::uint64_t posesPlanned_ = 0;
 
   // Current pose.

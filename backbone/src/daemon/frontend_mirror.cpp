@@ -51,6 +51,12 @@ const protocol::Representation* FrontendMirror::generatedPayload(std::uint32_t o
   return stockPayload_[option] ? &*stockPayload_[option] : nullptr;
 }
 
+const protocol::Representation* FrontendMirror::frontendPayload(std::uint32_t option) const {
+  if (option >= frontendPayload_.size() || !scene_.options[option].atFrontend.present)
+    return nullptr;
+  return frontendPayload_[option] ? &*frontendPayload_[option] : nullptr;
+}
+
 double FrontendMirror::trianglesOf(std::uint32_t object) const {
   const backbone::SceneObject& o = scene_.objects[object];
   double sum = 0.0;

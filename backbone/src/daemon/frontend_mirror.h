@@ -49,6 +49,9 @@ class FrontendMirror {
                       protocol::Representation payload);
   // Null when the option has no stock copy.
   const protocol::Representation* generatedPayload(std::uint32_t option) const;
+  // The payload of the option's copy at the frontend; null when there is
+  // none or it came without one (a Hello's foreign copy).
+  const protocol::Representation* frontendPayload(std::uint32_t option) const;
 
   // ---- the frontend ----
   double triangles() const { return triangles_; }

@@ -1,6 +1,9 @@
 // thinlod-backbone: the socket shell around BackboneCore (backbone_core.h).
 // Frontends connect to an Endpoint, simplifier workers to a WorkerPool; one
-// Poller waits on both and on the runtime's shutdown fd. See docs/backbone.md.
+// Poller waits on both and on the runtime's shutdown fd. Each frontend
+// session has a core of its own (its viewer, budgets, planner, mirror and
+// link shaper); the sessions share the workers, the measured curves and the
+// view-independent representations. See docs/backbone.md.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -10,7 +13,9 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -34,6 +39,16 @@ using thinlod::backbone_daemon::CoreOptions;
 using thinlod::backbone_daemon::PoseOutcome;
 namespace protocol = thinlod::protocol;
 using Clock = std::chrono::steady_clock;
+// A new core of the daemon's scene and options (one per frontend session).
+using CoreFactory = std::function<thinlod::Result<std::unique_ptr<BackboneCore>>()>;
+
+// Request ids start at a random point per core (as the WorkerPool's own
+// did), so a reply computed for an earlier backbone process, or for another
+// session's core, never matches a request.
+std::uint64_t randomRequestBase() {
+  static std::random_device device;
+  return ((std::uint64_t(device()) & 0x1fffffffu) << 32) | 1u;
+}
 
 // The shell's own settings; everything the core is configured with is bound
 // straight to `core` (one default each: CoreOptions / SchedulerConfig).
@@ -60,6 +75,7 @@ struct Settings {
   int attemptTimeoutMs = 30000;
   int maxAttempts = 3;
   bool measuredGenerationDelay = false;
+  int maxFrontends = 8;
   protocol::TransportOptions transport;
 };
 
@@ -117,6 +133,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "file of \"TIME_S RATE_BYTES_PER_S\" lines: the link's rate from each trace "
                     "time on (needs --budget-link for the time before; docs/backbone.md, Link)");
   runtime.addOption("decisions-csv", &s.decisionsCsv, "write one decision row per pose here");
+  runtime.addOption("max-frontends", &s.maxFrontends,
+                    "frontend sessions served at once, each with its own core (1..64); a further "
+                    "frontend's poses are answered empty until one leaves");
   runtime.addOption("ready-file", &s.readyFile,
                     "write the bound addresses as JSON here once both sockets are bound");
   runtime.addOption("frontend.address", &s.frontendAddress, "where frontends connect");
@@ -171,6 +190,8 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--texture-codec '" + s.textureCodec + "': expected png, jpeg, zstd or raw");
   }
+  if (s.maxFrontends < 1 || s.maxFrontends > 64)
+    return Status(thinlod::ErrorCode::kInvalidArgument, "--max-frontends must be 1..64");
   if (s.syncWaitMs < 0 || !(s.curveTimeoutS >= 0.0) || s.attemptTimeoutMs <= 0 || s.maxAttempts < 1)
     return Status(thinlod::ErrorCode::kInvalidArgument,
                   "--sync-wait-ms and --curve-timeout-s must be >= 0, the simplifier attempt "
@@ -202,16 +223,20 @@ Status writeReadyFile(const std::string& path, const std::string& frontend,
 
 class Daemon {
  public:
-  Daemon(protocol::DaemonRuntime& runtime, const Settings& settings, BackboneCore& core,
+  // `first` measures the startup curves and serves the first session;
+  // `makeCore` makes the cores of further concurrent sessions.
+  Daemon(protocol::DaemonRuntime& runtime, const Settings& settings,
+         std::unique_ptr<BackboneCore> first, CoreFactory makeCore,
          protocol::Endpoint& frontends, protocol::WorkerPool& workers, std::ofstream* csv,
          Clock::time_point processStart)
       : started_(processStart),
         runtime_(runtime),
         settings_(settings),
-        core_(core),
+        makeCore_(std::move(makeCore)),
         frontends_(frontends),
         workers_(workers),
         csv_(csv) {
+    cores_.push_back(std::move(first));
     poller_.add(frontends_);
     poller_.add(workers_.endpoint());
     poller_.addFd(runtime_.wakeFd());
@@ -225,15 +250,15 @@ class Daemon {
     // for the curves first, as it always did.
     if (settings_.syncWaitMs > 0) waitForCurves();
     if (runtime_.shutdownRequested()) return 0;
-    const auto estimated = core_.objectsWithEstimatedCurve();
+    const auto estimated = primary().objectsWithEstimatedCurve();
     spdlog::info(
         "event=ready frontend={} simplifier={} objects={} scheduler={} workers={} "
-        "curves_wanted={} estimated_curves={} ms={:.0f}",
-        frontends_.address(), workers_.endpoint().address(), core_.objects().size(),
-        core_.schedulerName(), workers_.liveWorkers(), core_.curvesWanted(), estimated.size(),
-        msSinceStart());
+        "curves_wanted={} estimated_curves={} max_frontends={} ms={:.0f}",
+        frontends_.address(), workers_.endpoint().address(), primary().objects().size(),
+        primary().schedulerName(), workers_.liveWorkers(), primary().curvesWanted(),
+        estimated.size(), settings_.maxFrontends, msSinceStart());
     spdlog::default_logger()->flush();
-    if (core_.curvesPending() == 0) curvesReported_ = true;
+    if (primary().curvesPending() == 0) curvesReported_ = true;
     while (!runtime_.shutdownRequested()) {
       pump(100ms);
       servePoses();
@@ -248,6 +273,42 @@ class Daemon {
     return std::chrono::duration<double, std::milli>(Clock::now() - started_).count();
   }
 
+  // The startup core: it measures the scene's curves and serves the first
+  // session; the cores made later take its curves over.
+  BackboneCore& primary() { return *cores_.front(); }
+
+  // The core of the session `peer` is in, or null when it has none yet.
+  BackboneCore* sessionCore(protocol::PeerId peer) {
+    const auto it = sessions_.find(peer.value);
+    return it == sessions_.end() ? nullptr : it->second;
+  }
+
+  // The core whose ledger knows request `id` (open, or closed and still
+  // remembered, so it can refuse a duplicate or late reply); the primary one
+  // when none does (it refuses the unknown id).
+  BackboneCore& ownerOf(std::uint64_t id) {
+    for (const std::unique_ptr<BackboneCore>& core : cores_)
+      if (core->requestLedger().state(id).has_value()) return *core;
+    return primary();
+  }
+
+  // After `source` accepted a result: the other cores take the curves it
+  // measured and the view-independent copies it made (a representation
+  // made for one session is reused by another; backbone_core.h).
+  void share(const BackboneCore& source) {
+    if (cores_.size() < 2) return;
+    for (const std::unique_ptr<BackboneCore>& core : cores_) {
+      if (core.get() == &source) continue;
+      const thinlod::Result<std::size_t> curves = core->adoptMeasuredCurves(source);
+      const thinlod::Result<std::size_t> copies = core->adoptGeneratedCopies(source);
+      if (!curves.ok() || !copies.ok())
+        spdlog::error("event=share_failed error=\"{}\"",
+                      (!curves.ok() ? curves.status() : copies.status()).toString());
+      else if (*copies > 0)
+        spdlog::debug("event=copies_shared curves={} copies={}", *curves, *copies);
+    }
+  }
+
   // Lockstep only: before ready, wait up to --curve-timeout-s for the
   // startup curves, so a deterministic run plans from measured curves as the
   // paper experiment always did.
@@ -256,11 +317,12 @@ class Daemon {
         Clock::now() + std::chrono::duration_cast<Clock::duration>(
                            std::chrono::duration<double>(settings_.curveTimeoutS));
     auto nextReport = Clock::now();
-    while (!runtime_.shutdownRequested() && core_.curvesPending() > 0 && Clock::now() < deadline) {
+    while (!runtime_.shutdownRequested() && primary().curvesPending() > 0 &&
+           Clock::now() < deadline) {
       if (Clock::now() >= nextReport) {
         spdlog::info("event=curves_waiting received={} wanted={} workers={} ms={:.0f}",
-                     core_.curvesWanted() - core_.curvesPending(), core_.curvesWanted(),
-                     workers_.liveWorkers(), msSinceStart());
+                     primary().curvesWanted() - primary().curvesPending(),
+                     primary().curvesWanted(), workers_.liveWorkers(), msSinceStart());
         nextReport = Clock::now() + 2s;
       }
       pump(100ms);
@@ -273,14 +335,15 @@ class Daemon {
   // wait ended) event=curves_missing names the meshes still estimated.
   void reportCurves(bool final) {
     if (curvesReported_) return;
-    if (core_.curvesPending() == 0) {
-      spdlog::info("event=curves_ready objects={} ms={:.0f}", core_.curvesWanted(), msSinceStart());
+    if (primary().curvesPending() == 0) {
+      spdlog::info("event=curves_ready objects={} ms={:.0f}", primary().curvesWanted(),
+                   msSinceStart());
       curvesReported_ = true;
       return;
     }
     if (!final) return;
     std::string ids;
-    for (std::uint64_t id : core_.objectsWithEstimatedCurve())
+    for (std::uint64_t id : primary().objectsWithEstimatedCurve())
       ids += (ids.empty() ? "" : ",") + std::to_string(id);
     spdlog::warn(
         "event=curves_missing objects={} ms={:.0f} note=\"estimated curves until they arrive\"",
@@ -305,21 +368,25 @@ class Daemon {
     // Service time = answer - max(release, the result before it): a worker
     // answers in order, so the queue wait before it is not counted.
     const auto now = Clock::now();
-    if (core_.curvesHeld() > 0 && workers_.liveWorkers() > 0 && now >= nextCurveAt_ &&
-        core_.releaseHeldCurve()) {
+    if (primary().curvesHeld() > 0 && workers_.liveWorkers() > 0 && now >= nextCurveAt_ &&
+        primary().releaseHeldCurve()) {
       curveReleasedAt_ = now;
       nextCurveAt_ = Clock::time_point::max();  // until its answer
     }
-    for (std::uint64_t id : core_.takeCancellations()) {
+    for (const std::unique_ptr<BackboneCore>& core : cores_) submitRequestsOf(*core, now);
+  }
+
+  void submitRequestsOf(BackboneCore& core, Clock::time_point now) {
+    for (std::uint64_t id : core.takeCancellations()) {
       workers_.cancel(id);
       submittedAt_.erase(id);
     }
     // The pool sends each request under the id the core (and the scheduler) gave it.
-    for (auto& request : core_.takeRequests()) {
+    for (auto& request : core.takeRequests()) {
       thinlod::Result<std::uint64_t> id =
           std::visit([&](auto& message) { return workers_.submit(message); }, request.message);
       if (id.ok() && *id == request.requestId) {
-        core_.requestSubmitted(request.requestId);
+        core.requestSubmitted(request.requestId);
         const auto* simplify = std::get_if<protocol::SimplifyRequest>(&request.message);
         // Plan requests only: not the startup warm-up (sent before any pose,
         // it waits for the worker to load the scene) nor curve measurements.
@@ -327,7 +394,7 @@ class Daemon {
             (simplify == nullptr || simplify->curvePoints == 0))
           submittedAt_[*id] = now;
       } else {
-        core_.requestNotSubmitted(request.requestId);
+        core.requestNotSubmitted(request.requestId);
         if (id.ok()) workers_.cancel(*id);
         spdlog::warn("event=request_not_submitted request={} error=\"{}\"", request.requestId,
                      id.ok() ? "the pool renamed the request" : id.status().toString());
@@ -346,9 +413,11 @@ class Daemon {
         break;
       }
       case protocol::EndpointEvent::Kind::kLeft:
-        spdlog::info("event=frontend_left peer={} reason=\"{}\"", event.peer.value,
-                     event.reason.toString());
-        if (active_ && *active_ == event.peer) active_.reset();
+        spdlog::info("event=frontend_left peer={} reason=\"{}\" sessions={}", event.peer.value,
+                     event.reason.toString(),
+                     sessions_.size() - (sessions_.count(event.peer.value) ? 1 : 0));
+        // Its core stays (its stock, its open requests) for the next session.
+        sessions_.erase(event.peer.value);
         hellos_.erase(event.peer.value);
         break;
       case protocol::EndpointEvent::Kind::kMessage:
@@ -356,11 +425,12 @@ class Daemon {
           poses_.emplace_back(event.peer, *pose);
         } else if (auto* stats = std::get_if<protocol::FrameStats>(&event.message)) {
           spdlog::debug(
-              "event=frame_stats frame={} plan={} polygons={} link_bytes={} early_polygons={}",
+              "event=frame_stats frame={} plan={} polygons={} link_bytes={} early_polygons={} "
+              "peer={}",
               stats->frame, stats->plan, stats->polygons, stats->linkBytes,
-              stats->earlyPolygons);
-          if (active_ && *active_ == event.peer) {
-            const std::size_t corrected = core_.onFrameStats(*stats);
+              stats->earlyPolygons, event.peer.value);
+          if (BackboneCore* core = sessionCore(event.peer)) {
+            const std::size_t corrected = core->onFrameStats(*stats);
             if (!stats->rejectedPlans.empty())
               spdlog::warn("event=updates_refused frame={} plans={} objects_corrected={}",
                            stats->frame, stats->rejectedPlans.size(), corrected);
@@ -385,12 +455,14 @@ class Daemon {
     if (!status.ok()) return;
     generationDelays_.observe(seconds);
     const double delay = generationDelays_.estimate(settings_.core.config.generationDelay);
-    if (delay == core_.generationDelay()) return;
-    const Status set = core_.setGenerationDelay(delay);
-    if (!set.ok()) {
-      spdlog::warn("event=generation_delay_refused seconds={:.3f} error=\"{}\"", delay,
-                   set.toString());
-      return;
+    if (delay == primary().generationDelay()) return;
+    for (const std::unique_ptr<BackboneCore>& core : cores_) {
+      const Status set = core->setGenerationDelay(delay);
+      if (!set.ok()) {
+        spdlog::warn("event=generation_delay_refused seconds={:.3f} error=\"{}\"", delay,
+                     set.toString());
+        return;
+      }
     }
     spdlog::info("event=generation_delay seconds={:.3f} p90={:.3f} samples={} last={:.3f}", delay,
                  generationDelays_.rawQuantile(), generationDelays_.samples(), seconds);
@@ -408,11 +480,13 @@ class Daemon {
         break;
       case protocol::WorkerPoolEvent::Kind::kSimplifyResult: {
         lastResultAt_ = resultAt_;
-        const std::size_t pendingBefore = core_.curvesPending();
+        BackboneCore& owner = ownerOf(event.simplify.requestId);
+        const std::size_t pendingBefore = owner.curvesPending();
         observeDelivery(event.simplify.requestId, event.simplify.status);
-        noteResult(core_.onSimplifyResult(event.simplify), "simplify", event.simplify.requestId,
-                   event.worker);
-        if (core_.curvesPending() < pendingBefore) {
+        if (noteResult(owner.onSimplifyResult(event.simplify), "simplify",
+                       event.simplify.requestId, event.worker))
+          share(owner);
+        if (&owner == &primary() && primary().curvesPending() < pendingBefore) {
           const auto now = Clock::now();
           if (curveReleasedAt_) {
             const auto began = std::max(*curveReleasedAt_, lastResultAt_);
@@ -423,32 +497,34 @@ class Daemon {
           spdlog::info(
               "event=curve_measured object={} samples={} received={} wanted={} held={} ms={:.0f}",
               event.simplify.objectId, event.simplify.curve.size(),
-              core_.curvesWanted() - core_.curvesPending(), core_.curvesWanted(),
-              core_.curvesHeld(), msSinceStart());
+              primary().curvesWanted() - primary().curvesPending(), primary().curvesWanted(),
+              primary().curvesHeld(), msSinceStart());
           reportCurves(false);
         }
         break;
       }
       case protocol::WorkerPoolEvent::Kind::kImpostorResult:
         observeDelivery(event.impostor.requestId, event.impostor.status);
-        noteResult(core_.onImpostorResult(event.impostor), "impostor", event.impostor.requestId,
-                   event.worker);
+        noteResult(ownerOf(event.impostor.requestId).onImpostorResult(event.impostor), "impostor",
+                   event.impostor.requestId, event.worker);
         break;
     }
   }
 
   // worker: the simplifier that answered (0 for a request the pool failed
   // itself after its attempts), so a farm's share of the work can be read.
-  void noteResult(const Status& status, const char* kind, std::uint64_t requestId,
+  // True when the result was accepted.
+  bool noteResult(const Status& status, const char* kind, std::uint64_t requestId,
                   protocol::PeerId worker) {
     resultAt_ = Clock::now();
     if (status.ok()) {
       ++resultsAccepted_;
       spdlog::debug("event=result kind={} request={} worker={}", kind, requestId, worker.value);
-    } else {
-      spdlog::warn("event=result_rejected kind={} request={} worker={} error=\"{}\"", kind,
-                   requestId, worker.value, status.toString());
+      return true;
     }
+    spdlog::warn("event=result_rejected kind={} request={} worker={} error=\"{}\"", kind,
+                 requestId, worker.value, status.toString());
+    return false;
   }
 
   void servePoses() {
@@ -459,7 +535,8 @@ class Daemon {
       for (const auto& queued : poses_) superseded |= queued.first == peer;
       if (superseded) {
         // A newer pose of the same frontend waits: answer this one empty.
-        send(peer, core_.emptyUpdate(pose));
+        BackboneCore* core = sessionCore(peer);
+        send(peer, (core != nullptr ? *core : primary()).emptyUpdate(pose));
         spdlog::info("event=pose_superseded frame={}", pose.sequence);
         continue;
       }
@@ -467,21 +544,72 @@ class Daemon {
     }
   }
 
+  // A core for a new session of `peer`: one no session uses (the startup
+  // core first, then those of sessions that ended), else a new one, up to
+  // --max-frontends. It takes over what the other cores have: measured
+  // curves and view-independent copies (so a restarted frontend's Hello
+  // finds its copies under their ids). Null when none can be had.
+  BackboneCore* coreForNewSession(protocol::PeerId peer) {
+    BackboneCore* chosen = nullptr;
+    for (const std::unique_ptr<BackboneCore>& core : cores_) {
+      bool busy = false;
+      for (const auto& session : sessions_) busy |= session.second == core.get();
+      if (!busy) {
+        chosen = core.get();
+        break;
+      }
+    }
+    if (chosen == nullptr) {
+      if (sessions_.size() >= static_cast<std::size_t>(settings_.maxFrontends)) {
+        spdlog::warn("event=session_refused peer={} sessions={} max_frontends={}", peer.value,
+                     sessions_.size(), settings_.maxFrontends);
+        return nullptr;
+      }
+      thinlod::Result<std::unique_ptr<BackboneCore>> made = makeCore_();
+      if (!made.ok()) {
+        spdlog::error("event=session_failed peer={} error=\"{}\"", peer.value,
+                      made.status().toString());
+        return nullptr;
+      }
+      cores_.push_back(std::move(made).value());
+      chosen = cores_.back().get();
+    }
+    std::size_t curves = 0;
+    std::size_t copies = 0;
+    for (const std::unique_ptr<BackboneCore>& core : cores_) {
+      if (core.get() == chosen) continue;
+      const thinlod::Result<std::size_t> c = chosen->adoptMeasuredCurves(*core);
+      const thinlod::Result<std::size_t> r = chosen->adoptGeneratedCopies(*core);
+      curves += c.ok() ? *c : 0;
+      copies += r.ok() ? *r : 0;
+    }
+    spdlog::info("event=frontend_session peer={} sessions={} cores={} curves_taken={} "
+                 "copies_taken={}",
+                 peer.value, sessions_.size() + 1, cores_.size(), curves, copies);
+    return chosen;
+  }
+
   void servePose(protocol::PeerId peer, const protocol::ViewerPose& pose) {
-    if (!active_ || *active_ != peer) {
-      if (hadFrontend_)
-        spdlog::info("event=frontend_session peer={} note=\"state reset\"", peer.value);
-      const auto hello = hellos_.find(peer.value);
-      const Status session =
-          core_.startFrontendSession(hello != hellos_.end() ? hello->second : protocol::Hello{});
-      if (!session.ok()) {
-        // Admission checked the same: only a changed configuration gets here.
-        spdlog::error("event=frontend_session_failed peer={} error=\"{}\"", peer.value,
-                      session.toString());
-        send(peer, core_.emptyUpdate(pose));
+    BackboneCore* session = sessionCore(peer);
+    if (session == nullptr) {
+      session = coreForNewSession(peer);
+      if (session == nullptr) {
+        send(peer, primary().emptyUpdate(pose));
         return;
       }
-      const thinlod::backbone_daemon::SessionFrameCost& cost = core_.sessionFrameCost();
+      BackboneCore& core = *session;
+      const auto hello = hellos_.find(peer.value);
+      const Status started =
+          core.startFrontendSession(hello != hellos_.end() ? hello->second : protocol::Hello{});
+      if (!started.ok()) {
+        // Admission checked the same: only a changed configuration gets here.
+        spdlog::error("event=frontend_session_failed peer={} error=\"{}\"", peer.value,
+                      started.toString());
+        send(peer, core.emptyUpdate(pose));
+        return;
+      }
+      sessions_[peer.value] = session;
+      const thinlod::backbone_daemon::SessionFrameCost& cost = core.sessionFrameCost();
       if (cost.source != thinlod::backbone_daemon::FrameCostSource::kUnused)
         spdlog::info(
             "event=frame_cost peer={} source={} init_ms={:.4g} final_ms={:.4g} setup_us={:.4g} "
@@ -495,20 +623,19 @@ class Daemon {
         spdlog::info(
             "event=frontend_resync peer={} held={} taken_back={} foreign={} "
             "frontend_triangles={:.0f}",
-            peer.value, held, core_.heldTakenBack(), core_.heldForeign(),
-            core_.frontendTriangles());
-      active_ = peer;
-      hadFrontend_ = true;
+            peer.value, held, core.heldTakenBack(), core.heldForeign(),
+            core.frontendTriangles());
     }
+    BackboneCore& core = *session;
     const auto started = Clock::now();
-    Status planned = core_.beginPose(pose);
-    logRequests(pose.sequence);
+    Status planned = core.beginPose(pose);
+    logRequests(core, pose.sequence);
     submitRequests();
-    if (planned.ok() && settings_.syncWaitMs > 0 && core_.awaitedResults() > 0) {
+    if (planned.ok() && settings_.syncWaitMs > 0 && core.awaitedResults() > 0) {
       const auto deadline = started + std::chrono::milliseconds(settings_.syncWaitMs);
       const std::uint64_t before = resultsAccepted_;
       // Without a worker no result can come (requests wait in the pool).
-      while (!runtime_.shutdownRequested() && core_.awaitedResults() > 0 &&
+      while (!runtime_.shutdownRequested() && core.awaitedResults() > 0 &&
              workers_.liveWorkers() > 0 && Clock::now() < deadline) {
         const auto left =
             std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
@@ -516,26 +643,27 @@ class Daemon {
       }
       if (resultsAccepted_ > before) {
         // A failed re-plan keeps the first plan's error for finishPose.
-        if (core_.replan().ok()) logRequests(pose.sequence);
+        if (core.replan().ok()) logRequests(core, pose.sequence);
         submitRequests();
       }
     }
-    PoseOutcome outcome = core_.finishPose();
+    PoseOutcome outcome = core.finishPose();
     send(peer, outcome.update);
     ++posesServed_;
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - started).count();
     if (!outcome.planned) {
-      spdlog::error("event=plan_failed frame={} error=\"{}\"", pose.sequence,
-                    outcome.planError.toString());
+      spdlog::error("event=plan_failed frame={} error=\"{}\" peer={} plan={}", pose.sequence,
+                    outcome.planError.toString(), peer.value, outcome.update.plan);
     } else {
       const auto& row = outcome.row;
       spdlog::info(
           "event=plan frame={} target={:.4g} triangles={:.0f} requests={} sends={} keeps={} "
           "expired_kept={} adds={} removes={} frontend_triangles={:.0f} link_bytes={} plans={} "
-          "ms={:.2f}",
+          "ms={:.2f} peer={} plan={}",
           pose.sequence, row.targetAccuracy, row.predictedTriangles, row.requests, row.sends,
           row.keeps, outcome.expiredCopiesKept, outcome.adds, outcome.removes,
-          outcome.frontendTriangles, outcome.linkBytes, outcome.plans, ms);
+          outcome.frontendTriangles, outcome.linkBytes, outcome.plans, ms, peer.value,
+          outcome.update.plan);
     }
     if (outcome.linkRate != 0 && outcome.linkRate != lastLinkRate_) {
       spdlog::info("event=link_rate frame={} bytes_per_s={}", pose.sequence, outcome.linkRate);
@@ -552,15 +680,15 @@ class Daemon {
     }
   }
 
-  void logRequests(std::uint64_t frame) {
-    const thinlod::backbone::Plan* plan = core_.latestPlan();
+  void logRequests(const BackboneCore& core, std::uint64_t frame) {
+    const thinlod::backbone::Plan* plan = core.latestPlan();
     if (plan == nullptr || !spdlog::should_log(spdlog::level::debug)) return;
     static constexpr const char* kReasons[] = {"missing", "expiring", "insufficient", "cheaper"};
     for (const thinlod::backbone::RepresentationRequest& r : plan->requests) {
       spdlog::debug(
           "event=request frame={} object={} kind={} reason={} relative_accuracy={:.4g} "
           "triangles={:.0f} bytes={:.0f}",
-          frame, core_.objects()[r.object].id, thinlod::backbone::optionKindName(r.kind),
+          frame, core.objects()[r.object].id, thinlod::backbone::optionKindName(r.kind),
           kReasons[static_cast<int>(r.reason) & 3], r.relativeAccuracy, r.expectedTriangles,
           r.expectedBytes);
     }
@@ -577,15 +705,15 @@ class Daemon {
   Clock::time_point started_;  // process start: ms= in the logs counts from it
   protocol::DaemonRuntime& runtime_;
   const Settings& settings_;
-  BackboneCore& core_;
+  CoreFactory makeCore_;
+  std::vector<std::unique_ptr<BackboneCore>> cores_;  // [0]: the startup core (primary())
+  std::map<std::uint64_t, BackboneCore*> sessions_;   // frontend peer -> the core serving it
   protocol::Endpoint& frontends_;
   protocol::WorkerPool& workers_;
   std::ofstream* csv_;
   protocol::Poller poller_;
   std::deque<std::pair<protocol::PeerId, protocol::ViewerPose>> poses_;
-  std::optional<protocol::PeerId> active_;
   std::map<std::uint64_t, protocol::Hello> hellos_;  // joined frontends by peer id
-  bool hadFrontend_ = false;
   bool curvesReported_ = false;
   // Duty cycle of held curve requests (submitRequests): the first may go
   // 2 s after startup, the next three answer durations after an answer.
@@ -621,10 +749,6 @@ int main(int argc, char** argv) {
     }
   }
 
-  // Request ids start at a random point (as the WorkerPool's own did), so a
-  // reply computed for an earlier backbone process never matches a request.
-  std::random_device device;
-  settings.core.firstRequestId = ((std::uint64_t(device()) & 0x1fffffffu) << 32) | 1u;
   thinlod::Result<CoreOptions> options = coreOptions(settings);
   if (!options.ok()) {
     spdlog::error("event=bad_options error=\"{}\"", options.status().toString());
@@ -650,18 +774,36 @@ int main(int argc, char** argv) {
   for (const std::string& warning : scene->warnings) {
     spdlog::warn("event=scene_warning message=\"{}\"", warning);
   }
-  auto core = BackboneCore::create(std::move(scene).value(), scenePath, *options);
+  // Every frontend session's core is made from the same scene (its nodes
+  // and meshes shared, read-only), options and textures; request ids start
+  // at a random point per core (randomRequestBase).
+  const thinlod::scene::Scene sceneTemplate = std::move(scene).value();
+  const CoreOptions sessionOptions = *options;
+  auto textures = std::make_shared<thinlod::backbone_daemon::SceneTextures>();
+  const auto newCore = [&sceneTemplate, &scenePath, &sessionOptions]() {
+    CoreOptions o = sessionOptions;
+    o.firstRequestId = randomRequestBase();
+    return BackboneCore::create(sceneTemplate, scenePath, o);
+  };
+  // The cores made after the first (its textures loaded by then).
+  const CoreFactory makeCore = [newCore,
+                                textures]() -> thinlod::Result<std::unique_ptr<BackboneCore>> {
+    thinlod::Result<std::unique_ptr<BackboneCore>> made = newCore();
+    if (!made.ok()) return made.status();
+    THINLOD_RETURN_IF_ERROR((*made)->setSharedTextures(*textures));
+    return made;
+  };
+  thinlod::Result<std::unique_ptr<BackboneCore>> core = newCore();
   if (!core.ok()) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, core.status().toString());
     return 1;
   }
   BackboneCore& backbone = **core;
   {
-    thinlod::backbone_daemon::SceneTextures textures =
-        thinlod::backbone_daemon::loadSceneTextures(backbone.sceneObjects());
-    for (const std::string& warning : textures.warnings)
+    *textures = thinlod::backbone_daemon::loadSceneTextures(backbone.sceneObjects());
+    for (const std::string& warning : textures->warnings)
       spdlog::warn("event=texture_warning message=\"{}\"", warning);
-    const thinlod::Status set = backbone.setSharedTextures(std::move(textures));
+    const thinlod::Status set = backbone.setSharedTextures(*textures);
     if (!set.ok()) {
       spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, set.toString());
       return 1;
@@ -725,7 +867,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  Daemon daemon(runtime, settings, backbone, **frontends, **workers, csv ? &*csv : nullptr,
-                processStart);
+  Daemon daemon(runtime, settings, std::move(core).value(), makeCore, **frontends, **workers,
+                csv ? &*csv : nullptr, processStart);
   return daemon.run();
 }
