@@ -874,6 +874,18 @@ class Collapser {
   // (its target's quadric cost is unchanged; a changed fan term is caught
   // when x reaches the top) unless its new option x -> w is cheaper.
   void rekeyAround(std::uint32_t u, std::uint32_t w) {
+    // The loop below prices every neighbour x of w: x's record and quadric
+    // are cache misses (collapses jump around the mesh). Asking for them all
+    // up front lets the misses overlap with each other and with w's own
+    // re-choice (3-5% of the build in paired runs on the bunny and the ogre,
+    // near the noise of this machine). No effect on results.
+    for (std::uint32_t i = vertex_[w].listStart, end = i + vertex_[w].listSize; i < end; ++i) {
+      for (std::uint32_t x : triangle_[triangleOf(pool_[i])].v) {
+        __builtin_prefetch(&vertex_[x]);
+        __builtin_prefetch(&quadric_[x]);
+        __builtin_prefetch(reinterpret_cast<const char*>(&quadric_[x]) + 64);
+      }
+    }
     const std::uint32_t lead = heapVertex(w);
     rekey(lead, chooseTarget(lead, /*exact=*/false));
     compact(w);
