@@ -128,6 +128,21 @@ bool parseSigned(std::string_view token, std::int64_t* value) {
   return ec == std::errc() && ptr == end;
 }
 
+// A face's vertex index token: an unsigned integer below `vertexCount`.
+Status checkFaceIndex(std::string_view token, std::uint64_t vertexCount, const std::string& name,
+                      int line) {
+  std::uint64_t index = 0;
+  if (!parseUnsigned(token, &index)) {
+    return lineError(name, line, "face has a bad vertex index " + quoted(token));
+  }
+  if (index >= vertexCount) {
+    return lineError(name, line,
+                     "face references vertex " + std::to_string(index) + " (only " +
+                         std::to_string(vertexCount) + " vertices)");
+  }
+  return Status();
+}
+
 Status limitError(const std::string& name, const char* what, std::uint64_t count,
                   std::uint64_t limit) {
   return Status(ErrorCode::kResourceExhausted, name + ": " + std::to_string(count) + " " + what +
@@ -435,15 +450,7 @@ Result<PrecheckResult> precheckOff(std::string_view bytes, const std::string& na
                            std::to_string(tokens.size() - 1));
     }
     for (std::uint64_t i = 1; i <= k; ++i) {
-      std::uint64_t index = 0;
-      if (!parseUnsigned(tokens[i], &index)) {
-        return lineError(name, ln, "face has a bad vertex index " + quoted(tokens[i]));
-      }
-      if (index >= nv) {
-        return lineError(name, ln,
-                         "face references vertex " + std::to_string(index) + " (only " +
-                             std::to_string(nv) + " vertices)");
-      }
+      THINLOD_RETURN_IF_ERROR(checkFaceIndex(tokens[i], nv, name, ln));
     }
     // OpenMesh reads faces token by token and, without face colours asked
     // for, leaves values after the indices in the stream: one became the next
@@ -577,15 +584,7 @@ Status checkPlyAsciiItem(const PlyElement& e, const std::vector<std::string_view
     for (std::uint64_t j = 0; j < k; ++j, ++t) {
       THINLOD_RETURN_IF_ERROR(
           checkPlyAsciiValue(tokens[t], prop.value, name, line, "face vertex index"));
-      std::uint64_t index = 0;
-      if (!parseUnsigned(tokens[t], &index)) {
-        return lineError(name, line, "face has a bad vertex index " + quoted(tokens[t]));
-      }
-      if (index >= vertexCount) {
-        return lineError(name, line,
-                         "face references vertex " + std::to_string(index) + " (only " +
-                             std::to_string(vertexCount) + " vertices)");
-      }
+      THINLOD_RETURN_IF_ERROR(checkFaceIndex(tokens[t], vertexCount, name, line));
     }
   }
   if (t != tokens.size()) {
