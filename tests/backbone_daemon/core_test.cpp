@@ -290,11 +290,13 @@ TEST(BackboneCorePose, RequestsFirstThenSendsOnceResultsArrive) {
 // second takes the first one's measured curve (its own startup request is
 // withdrawn, nothing to ask) and the meshes the first one made, which it
 // then sends to its frontend under the same ids without a request of its
-// own (impostors, view-dependent, are not shared); a core of another scene
-// is refused.
+// own; a core of another scene is refused.
 TEST(BackboneCoreSessions, ASecondCoreTakesTheCurvesAndMeshesTheFirstOneMade) {
+  // Meshes only: impostors are shared too, but one not on display must fit
+  // the reach ball grown by rangeHysteresis (the kind's Schmitt trigger), so
+  // at the first core's own pose its impostors do not serve the second.
   CoreOptions options = polygonBudget(400);
-  options.simpleImpostorRadii = 0.0;  // meshes only: impostors are not shared
+  options.simpleImpostorRadii = 0.0;
   options.meshedImpostorRadii = 0.0;
   auto first = makeCore(options);
   auto second = makeCore(options);

@@ -524,7 +524,7 @@ void BackboneCore::withdraw(const LedgerRequest& request) {
 
 namespace {
 
-bool viewIndependentKind(protocol::RepresentationKind kind) {
+bool curveMeasuredKind(protocol::RepresentationKind kind) {
   return kind == protocol::RepresentationKind::kMesh ||
          kind == protocol::RepresentationKind::kHybrid;
 }
@@ -550,7 +550,7 @@ Result<std::size_t> BackboneCore::adoptMeasuredCurves(const BackboneCore& other)
   for (std::uint32_t i = 0; i < optionStates_.size(); ++i) {
     OptionState& mine = optionStates_[i];
     const OptionState& theirs = other.optionStates_[i];
-    if (!viewIndependentKind(mine.wireKind)) continue;
+    if (!curveMeasuredKind(mine.wireKind)) continue;
     if (mine.measuredCurve && theirs.measuredCurve && theirs.calibration < mine.calibration) {
       // What the simplifier really delivered, learned by the other session
       // (the same curve: analytic, or measured for the same mesh).
@@ -588,10 +588,13 @@ Result<std::size_t> BackboneCore::adoptGeneratedCopies(const BackboneCore& other
   THINLOD_RETURN_IF_ERROR(checkSameLayout(other));
   std::size_t adopted = 0;
   for (std::uint32_t i = 0; i < optionStates_.size(); ++i) {
-    if (!viewIndependentKind(optionStates_[i].wireKind) || scene_.options[i].atBackbone.present)
-      continue;
+    if (scene_.options[i].atBackbone.present) continue;
     // The other core's stock copy, else the one its frontend holds (then a
     // restarted frontend's Hello finds its copies here under their ids).
+    // Any kind: a copy's validity range and credited accuracy are world
+    // properties (an impostor's cone is where its accuracy holds), and this
+    // core's scheduler checks them against its own viewer as for its own
+    // copies.
     if (const protocol::Representation* stock = other.mirror_.generatedPayload(i)) {
       storeBackboneCopy(i, other.scene_.options[i].atBackbone, *stock);
       ++adopted;

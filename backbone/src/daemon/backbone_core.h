@@ -265,9 +265,10 @@ class BackboneCore {
   // `other` holds another scene or option layout.
   Result<std::size_t> adoptMeasuredCurves(const BackboneCore& other);
   // Fills this core's empty stock slots from `other`'s copies: its stock
-  // copy, else the copy its frontend holds, of a mesh or hybrid option
-  // (view-independent: valid everywhere, credited the relative accuracy its
-  // result reported) where this core has none in stock. A representation made for one session is then sent
+  // copy, else the copy its frontend holds, of an option where this core
+  // has none in stock; any kind (a mesh is valid everywhere, an impostor
+  // within its validity cone, each credited the accuracy its result
+  // earned; this core's scheduler checks them against its own viewer). A representation made for one session is then sent
   // to another without asking a simplifier again. Returns how many copies
   // were taken; kInvalidArgument as adoptMeasuredCurves.
   Result<std::size_t> adoptGeneratedCopies(const BackboneCore& other);
