@@ -503,11 +503,14 @@ class Daemon {
         }
         break;
       }
-      case protocol::WorkerPoolEvent::Kind::kImpostorResult:
+      case protocol::WorkerPoolEvent::Kind::kImpostorResult: {
         observeDelivery(event.impostor.requestId, event.impostor.status);
-        noteResult(ownerOf(event.impostor.requestId).onImpostorResult(event.impostor), "impostor",
-                   event.impostor.requestId, event.worker);
+        BackboneCore& owner = ownerOf(event.impostor.requestId);
+        if (noteResult(owner.onImpostorResult(event.impostor), "impostor",
+                       event.impostor.requestId, event.worker))
+          share(owner);
         break;
+      }
     }
   }
 
@@ -591,6 +594,12 @@ class Daemon {
 
   void servePose(protocol::PeerId peer, const protocol::ViewerPose& pose) {
     BackboneCore* session = sessionCore(peer);
+    if (session == nullptr && hellos_.count(peer.value) == 0) {
+      // Queued before its frontend left: no session is started for it.
+      spdlog::info("event=pose_dropped frame={} peer={} note=\"the frontend left\"",
+                   pose.sequence, peer.value);
+      return;
+    }
     if (session == nullptr) {
       session = coreForNewSession(peer);
       if (session == nullptr) {
