@@ -694,6 +694,15 @@ TEST(MeshIo, PlyItemsMustHoldExactlyTheirDeclaredValues) {
       "ply", "good.ply");
   ASSERT_TRUE(good.ok()) << good.status().toString();
   EXPECT_EQ(good->mesh.triangleCount(), 1u);
+  // An element after the faces OpenMesh never reads: a list in it is fine,
+  // and its items are not checked (here: not even there).
+  Result<LoadedMesh> trailing = loadMeshFromMemory(
+      "ply\nformat ascii 1.0\n" + vertex + face +
+          "element material 2\nproperty list uchar float values\nend_header\n" + verts +
+          "3 0 1 2\n",
+      "ply", "trailing.ply");
+  ASSERT_TRUE(trailing.ok()) << trailing.status().toString();
+  EXPECT_EQ(trailing->mesh.triangleCount(), 1u);
 }
 
 // A binary PLY body is walked as OpenMesh reads it: each face list's count
@@ -760,6 +769,22 @@ TEST(MeshIo, BinaryPlyBodiesAreWalkedValueByValue) {
     ASSERT_FALSE(r.ok()) << c.message;
     EXPECT_TRUE(contains(r.status().message(), c.message))
         << "expected '" << c.message << "', got: " << r.status().message();
+  }
+  // A binary coordinate of an integer type: OpenMesh reads 0 and consumes no
+  // bytes (everything after it would shift).
+  {
+    std::string ints =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty short x\n"
+        "property short y\nproperty short z\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n";
+    ints.append(18, '\0');
+    ints += '\3';
+    ints.append(12, '\0');
+    Result<LoadedMesh> r = loadMeshFromMemory(ints, "ply", "bad.ply");
+    ASSERT_FALSE(r.ok());
+    EXPECT_TRUE(contains(r.status().message(),
+                         "bad.ply: binary vertex property 'x' of type 'short' is not supported"))
+        << r.status().message();
   }
   // A double beyond the float range (OpenMesh's double-to-float conversion
   // would be undefined).

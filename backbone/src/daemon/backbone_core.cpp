@@ -394,6 +394,7 @@ Status BackboneCore::initialize() {
 }
 
 void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t option, bool warmup) {
+  if (!options_.startupRequests) return;
   const ObjectRecord& record = converted_.records[object];
   LedgerRequest request;
   request.id = planner_.allocateRequestId();

@@ -119,6 +119,11 @@ struct CoreOptions {
   // The first request id (> 0, < 2^62). The shell draws a random one per
   // process, so a reply computed for an earlier backbone never matches.
   std::uint64_t firstRequestId = 1;
+  // Queue the startup requests (curve measurements, the warm-up) at
+  // create(). false: a further session's core, which takes the curves the
+  // daemon's first core measures (adoptMeasuredCurves) instead of asking
+  // again, so one measurement of each runs at a time.
+  bool startupRequests = true;
   // > 1: every mesh object gets one more option, a Hybrid (triangles + disc
   // points, docs/hybrid.md) whose graph the simplifier builds with this
   // kappa, the frontend renderer's measured point rate / triangle rate; its

@@ -483,7 +483,7 @@ class Daemon {
         BackboneCore& owner = ownerOf(event.simplify.requestId);
         const std::size_t pendingBefore = owner.curvesPending();
         observeDelivery(event.simplify.requestId, event.simplify.status);
-        if (noteResult(owner.onSimplifyResult(event.simplify), "simplify",
+        if (noteResult(owner, owner.onSimplifyResult(event.simplify), "simplify",
                        event.simplify.requestId, event.worker))
           share(owner);
         if (&owner == &primary() && primary().curvesPending() < pendingBefore) {
@@ -506,7 +506,7 @@ class Daemon {
       case protocol::WorkerPoolEvent::Kind::kImpostorResult: {
         observeDelivery(event.impostor.requestId, event.impostor.status);
         BackboneCore& owner = ownerOf(event.impostor.requestId);
-        if (noteResult(owner.onImpostorResult(event.impostor), "impostor",
+        if (noteResult(owner, owner.onImpostorResult(event.impostor), "impostor",
                        event.impostor.requestId, event.worker))
           share(owner);
         break;
@@ -516,12 +516,12 @@ class Daemon {
 
   // worker: the simplifier that answered (0 for a request the pool failed
   // itself after its attempts), so a farm's share of the work can be read.
-  // True when the result was accepted.
-  bool noteResult(const Status& status, const char* kind, std::uint64_t requestId,
-                  protocol::PeerId worker) {
+  // True when `owner` accepted the result.
+  bool noteResult(const BackboneCore& owner, const Status& status, const char* kind,
+                  std::uint64_t requestId, protocol::PeerId worker) {
     resultAt_ = Clock::now();
     if (status.ok()) {
-      ++resultsAccepted_;
+      ++resultsAccepted_[&owner];
       spdlog::debug("event=result kind={} request={} worker={}", kind, requestId, worker.value);
       return true;
     }
@@ -642,7 +642,8 @@ class Daemon {
     submitRequests();
     if (planned.ok() && settings_.syncWaitMs > 0 && core.awaitedResults() > 0) {
       const auto deadline = started + std::chrono::milliseconds(settings_.syncWaitMs);
-      const std::uint64_t before = resultsAccepted_;
+      // This session's own results (another session's do not re-plan it).
+      const std::uint64_t before = resultsAccepted_[&core];
       // Without a worker no result can come (requests wait in the pool).
       while (!runtime_.shutdownRequested() && core.awaitedResults() > 0 &&
              workers_.liveWorkers() > 0 && Clock::now() < deadline) {
@@ -650,7 +651,7 @@ class Daemon {
             std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
         pump(std::clamp(left, 1ms, 50ms));
       }
-      if (resultsAccepted_ > before) {
+      if (resultsAccepted_[&core] > before) {
         // A failed re-plan keeps the first plan's error for finishPose.
         if (core.replan().ok()) logRequests(core, pose.sequence);
         submitRequests();
@@ -730,7 +731,7 @@ class Daemon {
   Clock::time_point nextCurveAt_ = Clock::now() + 2s;
   Clock::time_point resultAt_;      // the latest simplifier result
   Clock::time_point lastResultAt_;  // the one before the result being handled
-  std::uint64_t resultsAccepted_ = 0;
+  std::map<const BackboneCore*, std::uint64_t> resultsAccepted_;  // per core
   std::uint64_t posesServed_ = 0;
   std::uint64_t lastLinkRate_ = 0;  // logged when it changes (--link-schedule)
   // Plan requests in flight and when they were submitted (observeDelivery).
@@ -789,20 +790,22 @@ int main(int argc, char** argv) {
   const thinlod::scene::Scene sceneTemplate = std::move(scene).value();
   const CoreOptions sessionOptions = *options;
   auto textures = std::make_shared<thinlod::backbone_daemon::SceneTextures>();
-  const auto newCore = [&sceneTemplate, &scenePath, &sessionOptions]() {
+  const auto newCore = [&sceneTemplate, &scenePath, &sessionOptions](bool startupRequests) {
     CoreOptions o = sessionOptions;
     o.firstRequestId = randomRequestBase();
+    o.startupRequests = startupRequests;
     return BackboneCore::create(sceneTemplate, scenePath, o);
   };
-  // The cores made after the first (its textures loaded by then).
+  // The cores made after the first (its textures loaded by then): they ask
+  // for no curves of their own but take the first one's (share()).
   const CoreFactory makeCore = [newCore,
                                 textures]() -> thinlod::Result<std::unique_ptr<BackboneCore>> {
-    thinlod::Result<std::unique_ptr<BackboneCore>> made = newCore();
+    thinlod::Result<std::unique_ptr<BackboneCore>> made = newCore(false);
     if (!made.ok()) return made.status();
     THINLOD_RETURN_IF_ERROR((*made)->setSharedTextures(*textures));
     return made;
   };
-  thinlod::Result<std::unique_ptr<BackboneCore>> core = newCore();
+  thinlod::Result<std::unique_ptr<BackboneCore>> core = newCore(true);
   if (!core.ok()) {
     spdlog::error("event=scene_failed path={} error=\"{}\"", scenePath, core.status().toString());
     return 1;

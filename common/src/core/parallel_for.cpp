@@ -38,8 +38,13 @@ void parallelFor(std::size_t count, int threads, const std::function<void(std::s
     }
   };
   std::vector<std::thread> pool;
-  pool.reserve(workers - 1);
-  for (std::size_t t = 1; t < workers; ++t) pool.emplace_back(work);
+  try {
+    pool.reserve(workers - 1);
+    for (std::size_t t = 1; t < workers; ++t) pool.emplace_back(work);
+  } catch (const std::exception&) {
+    // No more threads to be had (std::system_error, std::bad_alloc): the
+    // ones started and this one do the work; every item still runs once.
+  }
   work();
   for (std::thread& t : pool) t.join();
   if (firstError) std::rethrow_exception(firstError);

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <vector>
 
 namespace thinlod::mesh_detail {
@@ -644,6 +645,7 @@ Status walkPlyBinary(std::string_view body, bool bigEndian, const std::vector<Pl
   };
   for (const PlyElement& e : elements) {
     const bool isVertex = e.name == "vertex";
+    if (e.properties.empty()) continue;  // nothing to read however many items
     for (std::uint64_t item = 0; item < e.count; ++item) {
       for (const PlyProperty& p : e.properties) {
         double v = 0.0;
@@ -699,6 +701,8 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
   }
   std::string format;
   std::vector<PlyElement> elements;
+  std::set<std::string> elementNames;
+  bool afterFace = false;  // an element after the faces: OpenMesh never reads it
   bool ended = false;
   while (!ended && scanner.next(&line)) {
     const std::vector<std::string_view> tokens = tokenize(line);
@@ -732,13 +736,13 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
       if (e.count > options.maxFaces && e.name != "vertex" && e.name != "face") {
         return limitError(name, ("'" + e.name + "' items").c_str(), e.count, options.maxFaces);
       }
-      for (const PlyElement& earlier : elements) {
-        if (earlier.name == e.name) return lineError(name, ln, "element " + quoted(e.name) + " declared twice");
+      if (!elementNames.insert(e.name).second) {
+        return lineError(name, ln, "element " + quoted(e.name) + " declared twice");
       }
-      if (e.name == "face" && std::none_of(elements.begin(), elements.end(),
-                       [](const PlyElement& x) { return x.name == "vertex"; })) {
+      if (e.name == "face" && elementNames.count("vertex") == 0) {
         return lineError(name, ln, "the face element comes before the vertex element");
       }
+      afterFace = !elements.empty() && (afterFace || elements.back().name == "face");
       elements.push_back(e);
     } else if (key == "property") {
       if (elements.empty()) return lineError(name, ln, "property before any element");
@@ -758,9 +762,10 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
         return lineError(name, ln,
                          "bad property line (property TYPE NAME or property list TYPE TYPE NAME)");
       }
-      if (p.count.bytes != 0) {
+      if (p.count.bytes != 0 && !afterFace) {
         // OpenMesh reads one list only, a face's vertex indices; any other
-        // list it skips as one value, and everything after it shifts.
+        // list it skips as one value, and everything after it shifts (an
+        // element after the faces it never reads).
         if (elements.back().name != "face" ||
             (p.name != "vertex_indices" && p.name != "vertex_index")) {
           return lineError(name, ln,
@@ -787,6 +792,7 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
         return lineError(name, ln, "colour property " + quoted(p.name) +
                                        " of type double is not supported (float or an integer type)");
       }
+
       elements.back().properties.push_back(p);
     } else if (key == "end_header") {
       if (tokens.size() != 1) return lineError(name, ln, "end_header line holds only 'end_header'");
@@ -797,6 +803,24 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
   }
   if (!ended) return Status(ErrorCode::kInvalidArgument, name + ": truncated: no end_header");
   if (format.empty()) return Status(ErrorCode::kInvalidArgument, name + ": no format line");
+  // A binary vertex coordinate, normal or texture coordinate OpenMesh reads
+  // only as float or double: of an integer type it reads 0 and consumes no
+  // bytes, so everything after it shifts. (ASCII reads any number into a
+  // float.)
+  for (const PlyElement& e : elements) {
+    if (format == "ascii" || e.name != "vertex") continue;
+    for (const PlyProperty& p : e.properties) {
+      const bool read = p.name == "x" || p.name == "y" || p.name == "z" || p.name == "nx" ||
+                        p.name == "ny" || p.name == "nz" || p.name == "u" || p.name == "v" ||
+                        p.name == "s" || p.name == "t";
+      if (read && p.count.bytes == 0 && p.value.kind != PlyType::Kind::kFloat &&
+          p.value.kind != PlyType::Kind::kDouble) {
+        return Status(ErrorCode::kInvalidArgument,
+                      name + ": binary vertex property " + quoted(p.name) + " of type " +
+                          quoted(p.valueTypeName) + " is not supported (float or double)");
+      }
+    }
+  }
   // Our scanner ends a line at a lone carriage return, OpenMesh's header
   // reader at line feeds only: it skipped "comment ...\rend_header" as one
   // comment, never saw end_header and looped at the end of the file (fuzz
@@ -864,6 +888,7 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
   // checked tokens; anything after the last item is dropped.
   std::vector<std::string_view> tokens;
   for (const PlyElement& e : elements) {
+    if (e.name != "vertex" && e.name != "face" && e.properties.empty()) continue;
     if (e.count * 2 > body) {
       return Status(ErrorCode::kInvalidArgument,
                     name + ": truncated: header declares " + std::to_string(e.count) + " " +
@@ -881,6 +906,7 @@ Result<PrecheckResult> precheckPly(std::string_view bytes, const std::string& na
       THINLOD_RETURN_IF_ERROR(
           checkPlyAsciiItem(e, tokens, nv, name, scanner.lineNumber(), &rewritten));
     }
+    if (e.name == "face") break;  // OpenMesh reads nothing after the faces
   }
   result.rewritten = std::move(rewritten);
   return result;

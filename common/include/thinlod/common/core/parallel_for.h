@@ -9,6 +9,7 @@
 //   per-item slots, so the outcome does not depend on the thread count.
 // - An exception thrown by fn stops the handing out of further items; the
 //   first one is rethrown on the calling thread after every thread joined.
+//   When no more threads can be started, fewer do the work.
 // Written by hand rather than with TBB: one loop over a dozen coarse items
 // (seconds each) needs no scheduler, and the daemons need no new package.
 #pragma once
