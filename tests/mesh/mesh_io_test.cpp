@@ -854,5 +854,25 @@ TEST(MeshIo, AsciiStlDecorationsLoadTheSameMeshAsThePlainFile) {
       << extra.status().message();
 }
 
+// Fuzz finding 26 (session 12, fuzz/corpus/mesh/crash-obj-plus-minus-sign.obj;
+// OpenMesh's assert in PropertyT<Vec2f>::operator[]): "v +-.5 0 1" read as
+// -0.5 by the pre-check (the '+' dropped, then from_chars), refused by
+// OpenMesh's operator>>, which left the vertex out; a face's uv then went
+// past the vertices. A number carries one sign at most.
+TEST(MeshIo, NumbersWithTwoSignsAreRejected) {
+  for (const char* number : {"+-.5", "++1", "+-0"}) {
+    const std::string obj = std::string("v 0 0 0\nv 1 0 0\nv ") + number +
+                            " 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\n";
+    Result<LoadedMesh> r = loadMeshFromMemory(obj, "obj", "signs.obj");
+    ASSERT_FALSE(r.ok()) << number;
+    EXPECT_TRUE(contains(r.status().message(), "signs.obj:3:")) << r.status().message();
+  }
+  for (const char* number : {"+.5", "-.5", "+0.5", "-0"}) {
+    const std::string obj = std::string("v 0 0 0\nv 1 0 0\nv ") + number + " 1 0\nf 1 2 3\n";
+    Result<LoadedMesh> r = loadMeshFromMemory(obj, "obj", "signs.obj");
+    ASSERT_TRUE(r.ok()) << number << ": " << r.status().toString();
+  }
+}
+
 }  // namespace
 }  // namespace thinlod

@@ -1008,7 +1008,14 @@ Result<PrecheckResult> precheckStl(std::string_view bytes, const std::string& na
 }  // namespace
 
 bool parseNumberToken(std::string_view token, double* value) {
-  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  // One sign at most: from_chars takes no '+', so it is dropped here, but
+  // "+-.5" must not then read as -0.5 while OpenMesh's operator>> refuses it
+  // and drops the vertex (fuzz finding 26: a face then wrote a uv past its
+  // vertices; seed fuzz/corpus/mesh/crash-obj-plus-minus-sign.obj).
+  if (!token.empty() && token[0] == '+') {
+    token.remove_prefix(1);
+    if (!token.empty() && (token[0] == '-' || token[0] == '+')) return false;
+  }
   if (token.empty()) return false;
   const char* end = token.data() + token.size();
   auto [ptr, ec] = std::from_chars(token.data(), end, *value);
