@@ -596,13 +596,12 @@ Result<std::size_t> BackboneCore::adoptGeneratedCopies(const BackboneCore& other
     // properties (an impostor's cone is where its accuracy holds), and this
     // core's scheduler checks them against its own viewer as for its own
     // copies.
-    if (const protocol::Representation* stock = other.mirror_.generatedPayload(i)) {
-      storeBackboneCopy(i, other.scene_.options[i].atBackbone, *stock);
-      ++adopted;
-    } else if (const protocol::Representation* shown = other.mirror_.frontendPayload(i)) {
-      storeBackboneCopy(i, other.scene_.options[i].atFrontend, *shown);
-      ++adopted;
-    }
+    const protocol::Representation* stock = other.mirror_.generatedPayload(i);
+    const protocol::Representation* payload = stock ? stock : other.mirror_.frontendPayload(i);
+    if (payload == nullptr) continue;
+    const backbone::RepresentationOption& theirs = other.scene_.options[i];
+    storeBackboneCopy(i, stock ? theirs.atBackbone : theirs.atFrontend, *payload);
+    ++adopted;
   }
   return adopted;
 }

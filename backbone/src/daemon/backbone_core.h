@@ -42,8 +42,8 @@
 // - Time is the pose timestamp (clamped to never run backwards).
 // - Not thread-safe; one frontend session at a time (resetFrontend() when it
 //   changes). The daemon serves several frontends with one core each; the
-//   cores share measured curves and view-independent copies through
-//   adoptMeasuredCurves / adoptGeneratedCopies.
+//   cores share measured curves and copies through adoptMeasuredCurves /
+//   adoptGeneratedCopies.
 // - Frame cost (Budget::maxFrameSeconds): a frontend session's frame-time
 //   model uses the constants the frontend's Hello carries (its own renderer,
 //   calibrated by bench_calibrate), else CoreOptions::defaultFrameCost (the
@@ -273,9 +273,10 @@ class BackboneCore {
   // copy, else the copy its frontend holds, of an option where this core
   // has none in stock; any kind (a mesh is valid everywhere, an impostor
   // within its validity cone, each credited the accuracy its result
-  // earned; this core's scheduler checks them against its own viewer). A representation made for one session is then sent
-  // to another without asking a simplifier again. Returns how many copies
-  // were taken; kInvalidArgument as adoptMeasuredCurves.
+  // earned; this core's scheduler checks them against its own viewer). A
+  // representation made for one session is then sent to another without
+  // asking a simplifier again. Returns how many copies were taken;
+  // kInvalidArgument as adoptMeasuredCurves.
   Result<std::size_t> adoptGeneratedCopies(const BackboneCore& other);
 
   // ---- introspection (tests, logs) ----

@@ -3,7 +3,7 @@
 // Poller waits on both and on the runtime's shutdown fd. Each frontend
 // session has a core of its own (its viewer, budgets, planner, mirror and
 // link shaper); the sessions share the workers, the measured curves and the
-// view-independent representations. See docs/backbone.md.
+// representations. See docs/backbone.md.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -292,20 +292,31 @@ class Daemon {
     return primary();
   }
 
+  // `into` takes what `from` has and it lacks: measured curves and copies
+  // (backbone_core.h); the counts are added to `curves` and `copies`.
+  void takeOver(BackboneCore& into, const BackboneCore& from, std::size_t* curves,
+                std::size_t* copies) {
+    const thinlod::Result<std::size_t> c = into.adoptMeasuredCurves(from);
+    const thinlod::Result<std::size_t> r = into.adoptGeneratedCopies(from);
+    if (!c.ok() || !r.ok()) {
+      spdlog::error("event=share_failed error=\"{}\"",
+                    (!c.ok() ? c.status() : r.status()).toString());
+      return;
+    }
+    *curves += *c;
+    *copies += *r;
+  }
+
   // After `source` accepted a result: the other cores take the curves it
-  // measured and the view-independent copies it made (a representation
-  // made for one session is reused by another; backbone_core.h).
+  // measured and the copies it made (a representation made for one session
+  // is reused by another).
   void share(const BackboneCore& source) {
-    if (cores_.size() < 2) return;
     for (const std::unique_ptr<BackboneCore>& core : cores_) {
       if (core.get() == &source) continue;
-      const thinlod::Result<std::size_t> curves = core->adoptMeasuredCurves(source);
-      const thinlod::Result<std::size_t> copies = core->adoptGeneratedCopies(source);
-      if (!curves.ok() || !copies.ok())
-        spdlog::error("event=share_failed error=\"{}\"",
-                      (!curves.ok() ? curves.status() : copies.status()).toString());
-      else if (*copies > 0)
-        spdlog::debug("event=copies_shared curves={} copies={}", *curves, *copies);
+      std::size_t curves = 0;
+      std::size_t copies = 0;
+      takeOver(*core, source, &curves, &copies);
+      if (copies > 0) spdlog::debug("event=copies_shared curves={} copies={}", curves, copies);
     }
   }
 
@@ -550,8 +561,8 @@ class Daemon {
   // A core for a new session of `peer`: one no session uses (the startup
   // core first, then those of sessions that ended), else a new one, up to
   // --max-frontends. It takes over what the other cores have: measured
-  // curves and view-independent copies (so a restarted frontend's Hello
-  // finds its copies under their ids). Null when none can be had.
+  // curves and copies (so a restarted frontend's Hello finds its copies
+  // under their ids). Null when none can be had.
   BackboneCore* coreForNewSession(protocol::PeerId peer) {
     BackboneCore* chosen = nullptr;
     for (const std::unique_ptr<BackboneCore>& core : cores_) {
@@ -579,13 +590,8 @@ class Daemon {
     }
     std::size_t curves = 0;
     std::size_t copies = 0;
-    for (const std::unique_ptr<BackboneCore>& core : cores_) {
-      if (core.get() == chosen) continue;
-      const thinlod::Result<std::size_t> c = chosen->adoptMeasuredCurves(*core);
-      const thinlod::Result<std::size_t> r = chosen->adoptGeneratedCopies(*core);
-      curves += c.ok() ? *c : 0;
-      copies += r.ok() ? *r : 0;
-    }
+    for (const std::unique_ptr<BackboneCore>& core : cores_)
+      if (core.get() != chosen) takeOver(*chosen, *core, &curves, &copies);
     spdlog::info("event=frontend_session peer={} sessions={} cores={} curves_taken={} "
                  "copies_taken={}",
                  peer.value, sessions_.size() + 1, cores_.size(), curves, copies);

@@ -75,6 +75,33 @@ Status lineError(const std::string& name, int line, const std::string& problem) 
   return Status(ErrorCode::kInvalidArgument, name + ":" + std::to_string(line) + ": " + problem);
 }
 
+// OpenMesh's readers parse floats with operator>>, which fails on a value
+// beyond the float range and leaves the element out, so face references
+// checked against our count went past its vertices (an out-of-bounds normal
+// write; fuzz campaign of session 10, seed
+// fuzz/corpus/mesh/crash-obj-vertex-beyond-float.obj). The mesh stores
+// floats anyway. The limit is where float rounding stops giving FLT_MAX
+// (FLT_MAX + half an ulp): "3.40282347e+38", FLT_MAX as %.9g prints it,
+// still loads.
+constexpr double kFloatRoundsToInfinity = 0x1.ffffffp+127;
+
+// One token: a finite number within the float range.
+Status checkFiniteNumber(std::string_view token, const std::string& name, int line,
+                         const char* what) {
+  double v = 0.0;
+  if (!parseNumberToken(token, &v)) {
+    return lineError(name, line, std::string(what) + " has a bad number " + quoted(token));
+  }
+  if (!std::isfinite(v)) {
+    return lineError(name, line, std::string(what) + " has a non-finite coordinate " + quoted(token));
+  }
+  if (!(std::fabs(v) < kFloatRoundsToInfinity)) {
+    return lineError(name, line,
+                     std::string(what) + " has a number beyond the float range " + quoted(token));
+  }
+  return Status();
+}
+
 // All tokens from `first` up to a comment must be finite numbers, at least
 // `minCount` of them. A comment token does not count: "v 0 # 0 0" has one
 // number, and OpenMesh skips such a vertex, so face indices checked against
@@ -91,28 +118,7 @@ Status checkFiniteNumbers(const std::vector<std::string_view>& tokens, std::size
                          std::to_string(end > first ? end - first : 0));
   }
   for (std::size_t i = first; i < end; ++i) {
-    double v = 0.0;
-    if (!parseNumberToken(tokens[i], &v)) {
-      return lineError(name, line, std::string(what) + " has a bad number " + quoted(tokens[i]));
-    }
-    if (!std::isfinite(v)) {
-      return lineError(name, line,
-                       std::string(what) + " has a non-finite coordinate " + quoted(tokens[i]));
-    }
-    // OpenMesh's readers parse floats with operator>>, which fails on a
-    // value beyond the float range and leaves the element out, so face
-    // references checked against our count went past its vertices (an
-    // out-of-bounds normal write; fuzz campaign of session 10, seed
-    // fuzz/corpus/mesh/crash-obj-vertex-beyond-float.obj). The mesh stores
-    // floats anyway.
-    // The limit is where float rounding stops giving FLT_MAX (FLT_MAX + half
-    // an ulp): "3.40282347e+38", FLT_MAX as %.9g prints it, still loads.
-    constexpr double kFloatRoundsToInfinity = 0x1.ffffffp+127;
-    if (!(std::fabs(v) < kFloatRoundsToInfinity)) {
-      return lineError(name, line,
-                       std::string(what) + " has a number beyond the float range " +
-                           quoted(tokens[i]));
-    }
+    THINLOD_RETURN_IF_ERROR(checkFiniteNumber(tokens[i], name, line, what));
   }
   return Status();
 }
@@ -534,8 +540,8 @@ Status checkPlyAsciiValue(std::string_view token, const PlyType& type, const std
     return Status();
   }
   // float and double alike: OpenMesh reads ASCII values into floats, and
-  // operator>> fails beyond the float range (checkFiniteNumbers' rule).
-  return checkFiniteNumbers({token}, 0, 1, name, line, what);
+  // operator>> fails beyond the float range (checkFiniteNumber's rule).
+  return checkFiniteNumber(token, name, line, what);
 }
 
 // ASCII PLY: every item holds exactly its properties' values, each value
@@ -652,7 +658,7 @@ Status walkPlyBinary(std::string_view body, bool bigEndian, const std::vector<Pl
         if (p.count.bytes == 0) {
           if (!read(p.value, &v)) return truncated(e, item);
           if (p.value.kind == K::kFloat || p.value.kind == K::kDouble) {
-            if (!std::isfinite(v) || !(std::fabs(v) < 0x1.ffffffp+127)) {
+            if (!std::isfinite(v) || !(std::fabs(v) < kFloatRoundsToInfinity)) {
               return Status(ErrorCode::kInvalidArgument,
                             name + ": " + e.name + " " + std::to_string(item) + ": property " +
                                 quoted(p.name) + " is not a finite float");
