@@ -277,10 +277,17 @@ Status BackboneCore::initialize() {
   // and the rendered level adds at most half a texel.
   const double texelsPerDiagonal = double(options_.textureSize) / 3.5;
 
+  animationOf_.assign(count, nullptr);
   for (std::uint32_t k = 0; k < count; ++k) {
     const ObjectRecord& record = converted_.records[k];
     backbone::SceneObject& object = scene_.objects[k];
     object.firstOption = static_cast<std::uint32_t>(scene_.options.size());
+    if (!record.cluster && record.object != nullptr && record.object->shape != nullptr)
+      animationOf_[k] = record.object->shape->geometry.animation.get();
+    // A skinned object moves: only its meshes, which the frontend deforms
+    // with each frame's bone poses, show it. An impostor would freeze one
+    // pose, a Hybrid's points are not skinned.
+    const bool animated = animationOf_[k] != nullptr;
 
     // Simplified mesh (unless the scene's imposter nodes leave only impostors:
     // a cluster of several objects, an LOD level of one kind; docs/backbone.md
@@ -318,7 +325,7 @@ Status BackboneCore::initialize() {
 
     // Hybrid (behind CoreOptions::hybridKappa): like the simplified mesh, in
     // primitive units, exact full mesh until its own curve arrives.
-    if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered) {
+    if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered && !animated) {
       OptionState state;
       state.object = k;
       state.wireKind = protocol::RepresentationKind::kHybrid;
@@ -338,7 +345,7 @@ Status BackboneCore::initialize() {
     // (then everywhere: its copies' own validity cones still bound them).
     auto addImpostor = [&](OptionKind kind, protocol::RepresentationKind wireKind, double radii,
                            double triangles, const KindOffer& offer) -> Status {
-      if (!offer.offered) return Status();
+      if (!offer.offered || animated) return Status();
       if (!(radii > 0.0) && !offer.explicitNode) return Status();
       Result<ConicRange> validity = ConicRange();
       if (offer.range) {
@@ -1219,7 +1226,29 @@ PoseOutcome BackboneCore::finishPose() {
     ++out.resyncRemoves;
   }
   out.frontendTriangles = mirror_.triangles();
+  out.bonePoses = bonePosesAt(poseTimeNs_);
   return out;
+}
+
+std::vector<ObjectBonePose> BackboneCore::bonePosesAt(std::int64_t poseNs) const {
+  std::vector<ObjectBonePose> poses;
+  const double seconds = double(poseNs) * 1e-9;
+  for (std::uint32_t k = 0; k < animationOf_.size(); ++k) {
+    const scene::SkinnedAnimation* animation = animationOf_[k];
+    if (animation == nullptr || !(mirror_.trianglesOf(k) > 0.0)) continue;
+    poses.push_back({converted_.records[k].id,
+                     anim::paletteMatricesAt(animation->skeleton, animation->clip,
+                                             animation->palette, seconds, anim::ClipWrap::kLoop)});
+  }
+  std::sort(poses.begin(), poses.end(), [](const ObjectBonePose& a, const ObjectBonePose& b) {
+    return a.objectId < b.objectId;
+  });
+  return poses;
+}
+
+std::size_t BackboneCore::animatedObjects() const {
+  return static_cast<std::size_t>(std::count_if(animationOf_.begin(), animationOf_.end(),
+                                                [](const auto* a) { return a != nullptr; }));
 }
 
 Status BackboneCore::setSharedTextures(SceneTextures textures) {

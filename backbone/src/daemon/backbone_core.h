@@ -145,6 +145,13 @@ struct SessionFrameCost {
   FrameCostConstants constants;  // meaningful unless kUnused
 };
 
+// One skinned object's bone poses at one instant: the palette matrices of
+// its SkinnedAnimation (scene.h), entry i for palette.bones[i].
+struct ObjectBonePose {
+  std::uint64_t objectId = 0;
+  std::vector<glm::mat4> matrices;
+};
+
 struct OutgoingRequest {
   std::uint64_t requestId = 0;  // == the message's requestId
   std::variant<protocol::SimplifyRequest, protocol::ImpostorRequest> message;
@@ -166,6 +173,8 @@ struct PoseOutcome {
   std::uint64_t linkRate = 0;         // the shaper's rate at this pose (bytes/s; 0: no link budget)
   double frontendTriangles = 0.0;     // after the update is applied
   std::uint32_t expiredCopiesKept = 0;  // PlanStats::expiredCopiesKept of the final plan
+  // bonePosesAt(the pose's time) after the update: the held animated objects.
+  std::vector<ObjectBonePose> bonePoses;
 };
 
 class BackboneCore {
@@ -278,6 +287,16 @@ class BackboneCore {
   // asking a simplifier again. Returns how many copies were taken;
   // kInvalidArgument as adoptMeasuredCurves.
   Result<std::size_t> adoptGeneratedCopies(const BackboneCore& other);
+
+  // ---- animation (docs/animation.md) ----
+  // The clock: every skinned object's clip plays looped on pose time, clip
+  // time = the pose's timestamp in seconds, so lockstep replays are
+  // deterministic and every frontend of one trace sees the same motion.
+  // Bone poses at `poseNs` of the animated objects the frontend holds a
+  // representation of (the mirror after the last update), ascending ids.
+  std::vector<ObjectBonePose> bonePosesAt(std::int64_t poseNs) const;
+  // Scene objects with a skinned animation.
+  std::size_t animatedObjects() const;
 
   // ---- introspection (tests, logs) ----
   const backbone::SchedulingScene& schedulingScene() const { return scene_; }
@@ -400,6 +419,8 @@ class BackboneCore {
   std::uint64_t shapedBytes_ = 0;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
   std::map<std::uint64_t, std::uint32_t> objectById_;  // wire object id -> object index
+  // Per record: its Shape's skinned animation (null: static, a cluster).
+  std::vector<const scene::SkinnedAnimation*> animationOf_;
   std::size_t heldForeign_ = 0;
   std::size_t heldTakenBack_ = 0;
 };

@@ -338,6 +338,42 @@ Result<std::vector<float>> pathLengthWeights(const IndexedMesh& mesh,
   return weights;
 }
 
+SkinPalette compactSkin(const std::vector<VertexSkin>& skin) {
+  SkinPalette palette;
+  // A rigid vertex names boneA only: its boneB (unused by deform) would
+  // otherwise pull a bone into every frame's poses.
+  for (const VertexSkin& s : skin) {
+    palette.bones.push_back(s.boneA);
+    if (!s.rigid()) palette.bones.push_back(s.boneB);
+  }
+  std::sort(palette.bones.begin(), palette.bones.end());
+  palette.bones.erase(std::unique(palette.bones.begin(), palette.bones.end()), palette.bones.end());
+  const auto indexOf = [&](std::uint32_t bone) {
+    return static_cast<std::uint32_t>(
+        std::lower_bound(palette.bones.begin(), palette.bones.end(), bone) - palette.bones.begin());
+  };
+  palette.skin.reserve(skin.size());
+  for (const VertexSkin& s : skin) {
+    VertexSkin compact;
+    compact.boneA = indexOf(s.boneA);
+    compact.boneB = s.rigid() ? compact.boneA : indexOf(s.boneB);
+    compact.weightB = s.rigid() ? 0.0f : s.weightB;
+    palette.skin.push_back(compact);
+  }
+  return palette;
+}
+
+std::vector<glm::mat4> paletteMatricesAt(const Skeleton& skeleton, const AnimationClip& clip,
+                                         const SkinPalette& palette, double seconds,
+                                         ClipWrap wrap) {
+  const std::vector<glm::mat4> all =
+      skinningMatrices(skeleton, samplePose(skeleton, clip, seconds, wrap));
+  std::vector<glm::mat4> out;
+  out.reserve(palette.bones.size());
+  for (const std::uint32_t bone : palette.bones) out.push_back(all[bone]);
+  return out;
+}
+
 double sampledMaxDisplacement(const Skeleton& skeleton, const AnimationClip& clip,
                               const std::vector<glm::vec3>& positions,
                               const std::vector<VertexSkin>& skin, double t0, double t1,

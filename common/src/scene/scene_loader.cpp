@@ -6,11 +6,63 @@
 #include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/core/hash.h"
 #include "thinlod/common/scene/scene_parser.h"
+#include "thinlod/common/scene/skinned_import.h"
 
 namespace thinlod::scene {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The clip `wanted` names in `model`: "#N" is the N-th clip (0-based), any
+// other text a clip's name (the first with that name). kNotFound lists what
+// the file has.
+Result<std::size_t> findClip(const SkinnedModel& model, const std::string& wanted) {
+  if (wanted.size() > 1 && wanted[0] == '#' &&
+      wanted.find_first_not_of("0123456789", 1) == std::string::npos && wanted.size() <= 10) {
+    const std::size_t index = std::stoul(wanted.substr(1));
+    if (index < model.clips.size()) return index;
+    return Status(ErrorCode::kNotFound, "animation '" + wanted + "': the file has " +
+                                            std::to_string(model.clips.size()) + " clips");
+  }
+  for (std::size_t i = 0; i < model.clips.size(); ++i) {
+    if (model.clips[i].name == wanted) return i;
+  }
+  std::string names;
+  for (std::size_t i = 0; i < model.clips.size() && i < 16; ++i) {
+    // The names come from the file: quoted and cut, never trusted as text.
+    names += (names.empty() ? "" : ", ") +
+             ("#" + std::to_string(i) + " '" + model.clips[i].name.substr(0, 64) + "'");
+  }
+  return Status(ErrorCode::kNotFound, "animation '" + wanted +
+                                          "': no clip of that name (the file has " +
+                                          std::to_string(model.clips.size()) + " clips" +
+                                          (names.empty() ? std::string() : ": " + names) + ")");
+}
+
+// An animated Inline's file: the skinned mesh and the named clip.
+Result<std::pair<IndexedMesh, SkinnedAnimation>> loadAnimatedMesh(const std::string& path,
+                                                                  const std::string& clip,
+                                                                  const ImportLimits& limits) {
+  SkinnedImportLimits skinnedLimits;
+  skinnedLimits.files = limits;
+  Result<SkinnedModel> model = importSkinnedModel(path, skinnedLimits);
+  if (!model.ok()) return model.status();
+  Result<std::size_t> index = findClip(*model, clip);
+  if (!index.ok()) return Status(index.status().code(), path + ": " + index.status().message());
+  // The importer validated all of it; checked again here because the scene
+  // hands these to the backbone's clock and the frontend's skinning.
+  THINLOD_RETURN_IF_ERROR(model->mesh.validate(path));
+  THINLOD_RETURN_IF_ERROR(model->skeleton.validate(path));
+  THINLOD_RETURN_IF_ERROR(anim::validateSkin(model->skin, model->mesh.vertexCount(),
+                                             model->skeleton.bones.size(), path));
+  SkinnedAnimation animation;
+  animation.clip = std::move(model->clips[*index]);
+  THINLOD_RETURN_IF_ERROR(animation.clip.validate(model->skeleton, path));
+  animation.skeleton = std::move(model->skeleton);
+  animation.skin = std::move(model->skin);
+  animation.palette = anim::compactSkin(animation.skin);
+  return std::make_pair(std::move(model->mesh), std::move(animation));
+}
 
 }  // namespace
 
@@ -70,6 +122,8 @@ std::uint64_t sceneFingerprint(const std::string& text, const Scene& scene) {
     // defines them, see copyAttributesToNonManifoldCopies.)
     hash = hashVector(mesh->positions, hash);
     hash = hashVector(mesh->indices, hash);
+    // A skinned mesh's skin too: the frontend deforms the simplifier's levels with it.
+    if (shape->geometry.animation) hash = hashVector(shape->geometry.animation->skin, hash);
   }
   return hash == 0 ? 1 : hash;  // 0 means "no scene"
 }
@@ -129,6 +183,9 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
 
   std::map<std::string, std::shared_ptr<const IndexedMesh>> loaded;  // by resolved path
   std::map<std::string, std::vector<std::string>> warningsOf;
+  std::map<std::string, std::pair<std::shared_ptr<const IndexedMesh>,
+                                  std::shared_ptr<const SkinnedAnimation>>>
+      animated;  // by resolved path and clip
   for (ShapeNode* shape : shapes) {
     Geometry& g = shape->geometry;
     if (g.kind != GeometryKind::kMeshFile || g.mesh) continue;
@@ -140,7 +197,8 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
       // .obj stays with the mesh loader; .gltf .glb .dae .fbx are imported
       // and flattened (scene_import.h).
       const bool flatten = !isSupportedMeshExtension(url) && isImportedSceneExtension(url);
-      if (!isSupportedMeshExtension(url) && !flatten) {
+      // An animated Inline goes to Assimp whatever the extension (.x, .smd, ...).
+      if (g.animationClip.empty() && !isSupportedMeshExtension(url) && !flatten) {
         return Status(ErrorCode::kUnsupported,
                       where + ": url '" + url +
                           "' is not a mesh file (obj, ply, off, stl, gltf, glb, dae, fbx)");
@@ -151,6 +209,29 @@ Status resolveMeshes(Scene& scene, const std::string& sceneDirectory,
         if (!fs::is_regular_file(candidate, ec)) {
           tried.push_back(candidate);
           continue;
+        }
+        if (!g.animationClip.empty()) {
+          // Skinned: its own mesh (mesh space, not flattened), cached per clip.
+          const std::string key = candidate + "\n" + g.animationClip;
+          auto cached = animated.find(key);
+          if (cached == animated.end()) {
+            auto loadedAnimation =
+                loadAnimatedMesh(candidate, g.animationClip, options.importLimits);
+            if (!loadedAnimation.ok()) {
+              return Status(loadedAnimation.status().code(),
+                            where + ": " + loadedAnimation.status().message());
+            }
+            cached = animated
+                         .emplace(key, std::make_pair(std::make_shared<const IndexedMesh>(
+                                                          std::move(loadedAnimation->first)),
+                                                      std::make_shared<const SkinnedAnimation>(
+                                                          std::move(loadedAnimation->second))))
+                         .first;
+          }
+          g.mesh = cached->second.first;
+          g.animation = cached->second.second;
+          g.resolvedPath = candidate;
+          break;
         }
         auto cached = loaded.find(candidate);
         if (cached == loaded.end()) {

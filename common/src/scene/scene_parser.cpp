@@ -1041,13 +1041,23 @@ class Parser {
 
   bool parseInlineBody(const Token& type, Geometry* g) {
     g->kind = GeometryKind::kMeshFile;
+    bool emptyAnimation = false;
     bool ok = parseBody(type, [&](std::string_view f, const Token&) {
       if (f == "url") return parseMFString(&g->urls);
+      // thinlod extension: the clip of a skinned, animated file to play.
+      if (f == "animation") {
+        if (!parseString(&g->animationClip)) return false;
+        emptyAnimation = g->animationClip.empty();
+        return true;
+      }
       if (isField(f, {"bboxCenter", "bboxSize"})) return skipBboxField(f);
       return false;
     });
     if (!ok) return false;
     if (g->urls.empty()) return fail(type, "Inline needs a url");
+    if (emptyAnimation) {
+      return fail(type, "Inline animation is empty; name a clip or \"#N\" for the N-th");
+    }
     return true;
   }
 

@@ -128,6 +128,21 @@ Result<std::vector<float>> pathLengthWeights(const IndexedMesh& mesh,
                                              const std::vector<std::uint32_t>& borderA,
                                              const std::vector<std::uint32_t>& borderB);
 
+// The bones a skin names, ascending (`bones`), and the skin with each bone
+// replaced by its index in that list (`skin`): what a renderer indexes per
+// vertex, so a frame's bone poses need one matrix per palette entry only.
+struct SkinPalette {
+  std::vector<std::uint32_t> bones;
+  std::vector<VertexSkin> skin;
+};
+SkinPalette compactSkin(const std::vector<VertexSkin>& skin);
+
+// The palette's matrices at `seconds` of the clip: skinningMatrices of
+// samplePose, entry i for bone palette.bones[i] (all bones < skeleton size:
+// validate the skin first).
+std::vector<glm::mat4> paletteMatricesAt(const Skeleton& skeleton, const AnimationClip& clip,
+                                         const SkinPalette& palette, double seconds, ClipWrap wrap);
+
 // Largest displacement of any vertex from its position at t0 over [t0, t1],
 // with the clip sampled every `step` seconds (and at t1): a measured motion
 // bound for the planned lifetime, not a proof (fast motion between samples

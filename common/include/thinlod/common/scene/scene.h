@@ -35,6 +35,7 @@
 #include "thinlod/common/core/accuracy_curve.h"
 #include "thinlod/common/core/conic_range.h"
 #include "thinlod/common/core/indexed_mesh.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/mesh/primitives.h"
 
@@ -85,6 +86,19 @@ struct Appearance {
 
 enum class GeometryKind : std::uint8_t { kNone, kPrimitive, kMeshFile, kIndexedFaceSet };
 
+// A skinned, animated mesh file (an Inline with an `animation` field,
+// docs/scene-format.md "Animated Inline"): Geometry::mesh holds its vertices
+// in mesh (bind) space, deformed by `skin` and the clip into the file's
+// world frame (core/skinning.h). `palette` lists the bones the skin names,
+// ascending; paletteSkin is `skin` with every bone replaced by its index in
+// `palette`: the per-frame bone poses carry one matrix per palette entry.
+struct SkinnedAnimation {
+  anim::Skeleton skeleton;
+  std::vector<anim::VertexSkin> skin;  // one per mesh vertex, skeleton bones
+  anim::AnimationClip clip;            // the one the scene names, validated
+  anim::SkinPalette palette;
+};
+
 struct Geometry {
   GeometryKind kind = GeometryKind::kNone;
   PrimitiveShape primitive;                 // kPrimitive
@@ -92,6 +106,11 @@ struct Geometry {
   std::string resolvedPath;                 // kMeshFile: set by resolveMeshes()
   std::shared_ptr<const IndexedMesh> mesh;  // kMeshFile once loaded; kIndexedFaceSet always
   std::vector<std::string> loadWarnings;    // kMeshFile: from the mesh loader
+  // kMeshFile: the clip an Inline's `animation` field names (its name, or
+  // "#N" for the file's N-th clip); empty: a static mesh. resolveMeshes()
+  // then imports the file skinned and sets `animation` beside `mesh`.
+  std::string animationClip;
+  std::shared_ptr<const SkinnedAnimation> animation;
 };
 
 struct Node;

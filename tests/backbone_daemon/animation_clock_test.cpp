@@ -1,0 +1,116 @@
+// BackboneCore's animation clock (docs/animation.md, "Served"): a skinned
+// object's clip plays looped on pose time, its bone poses are computed for
+// the frames in which the frontend holds it, and it is offered as a mesh
+// only (an impostor would freeze one pose).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "backbone_core.h"
+#include "fake_simplifier.h"
+#include "thinlod/common/core/skinning.h"
+#include "thinlod/common/scene/scene_parser.h"
+
+namespace thinlod::backbone_daemon {
+namespace {
+
+using namespace testing;
+
+const std::string kWusonDir = "/usr/share/assimp/models/X";
+
+// Testwuson.X running (object 1) beside a static sphere (object 2).
+Result<std::unique_ptr<BackboneCore>> animatedCore(CoreOptions options) {
+  EXPECT_TRUE(std::filesystem::exists(kWusonDir + "/Testwuson.X"))
+      << "deploy/setup installs the Debian package assimp-testmodels";
+  const std::string path =
+      (std::filesystem::path(::testing::TempDir()) / "animation_clock.wrl").string();
+  std::ofstream(path) << "#VRML V2.0 utf8\n"
+                         "Transform { scale 0.1 0.1 0.1 children [\n"
+                         "  Inline { url \"Testwuson.X\" animation \"Wuson_Run\" } ] }\n"
+                         "Transform { translation 1 0 0 children [ Shape { geometry Sphere { "
+                         "radius 0.2 } } ] }\n";
+  scene::SceneLoadOptions load;
+  load.meshSearchPaths = {kWusonDir};
+  Result<scene::Scene> loaded = scene::loadSceneFile(path, load);
+  if (!loaded.ok()) return loaded.status();
+  return BackboneCore::create(std::move(loaded).value(), path, options);
+}
+
+const scene::SkinnedAnimation& wuson(const BackboneCore& core) {
+  return *core.sceneObjects().at(0).shape->geometry.animation;
+}
+
+TEST(BackboneAnimationClock, AnimatedObjectsAreOfferedAsMeshesOnly) {
+  CoreOptions options = polygonBudget(5000);
+  options.hybridKappa = 4.0;
+  auto created = animatedCore(options);
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  const BackboneCore& core = **created;
+  EXPECT_EQ(core.animatedObjects(), 1u);
+  const backbone::SchedulingScene& scene = core.schedulingScene();
+  ASSERT_EQ(scene.objects.size(), 2u);
+  ASSERT_EQ(scene.objects[0].optionCount, 1u);
+  EXPECT_EQ(scene.options[scene.objects[0].firstOption].kind,
+            backbone::OptionKind::kSimplifiedMesh);
+  // The static sphere keeps its impostors.
+  EXPECT_GT(scene.objects[1].optionCount, 1u);
+}
+
+TEST(BackboneAnimationClock, PosesOfHeldAnimatedObjectsFollowPoseTime) {
+  auto created = animatedCore(polygonBudget(5000));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));  // the startup curve
+  // Nothing held yet: no poses.
+  EXPECT_TRUE(core.bonePosesAt(0).empty());
+
+  const glm::vec3 eye(0.3f, 0.3f, 2.0f), figure(0.0f, 0.2f, 0.0f);
+  bool held = false;
+  for (int step = 0; step < 4 && !held; ++step) {
+    ASSERT_TRUE(core.beginPose(poseAt(step, 0.1 * step, eye, figure)).ok());
+    answer(core, fake, submitAll(core));
+    ASSERT_TRUE(core.replan().ok());
+    const PoseOutcome outcome = core.finishPose();
+    held = core.frontendMirror().trianglesOf(0) > 0.0;
+    // Every frame's outcome carries the poses of what the frontend holds.
+    ASSERT_EQ(outcome.bonePoses.size(), held ? 1u : 0u);
+    if (held) {
+      EXPECT_EQ(outcome.bonePoses[0].matrices,
+                core.bonePosesAt(poseAt(step, 0.1 * step, eye, figure).timestampNs)[0].matrices);
+    }
+  }
+  ASSERT_TRUE(held) << "the backbone never sent the figure";
+
+  const scene::SkinnedAnimation& animation = wuson(core);
+  const double duration = animation.clip.duration;
+  for (const double t : {0.0, 0.3 * duration, 0.9 * duration}) {
+    const auto ns = static_cast<std::int64_t>(std::llround(t * 1e9));
+    const std::vector<ObjectBonePose> poses = core.bonePosesAt(ns);
+    ASSERT_EQ(poses.size(), 1u);
+    EXPECT_EQ(poses[0].objectId, 1u);
+    // The clock is pose time: the clip at t (looped), one matrix per palette bone.
+    EXPECT_EQ(poses[0].matrices,
+              anim::paletteMatricesAt(animation.skeleton, animation.clip, animation.palette,
+                                      double(ns) * 1e-9, anim::ClipWrap::kLoop));
+    // One lap later: the same pose.
+    const auto lap = static_cast<std::int64_t>(std::llround((t + duration) * 1e9));
+    const std::vector<ObjectBonePose> again = core.bonePosesAt(lap);
+    ASSERT_EQ(again.size(), 1u);
+    for (std::size_t i = 0; i < again[0].matrices.size(); ++i) {
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) {
+          EXPECT_NEAR(again[0].matrices[i][c][r], poses[0].matrices[i][c][r],
+                      1e-3f * (1.0f + std::fabs(poses[0].matrices[i][c][r])));
+        }
+      }
+    }
+  }
+  EXPECT_NE(core.bonePosesAt(0)[0].matrices,
+            core.bonePosesAt(static_cast<std::int64_t>(0.5 * duration * 1e9))[0].matrices);
+}
+
+}  // namespace
+}  // namespace thinlod::backbone_daemon
