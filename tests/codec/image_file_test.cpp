@@ -130,6 +130,14 @@ TEST(ImageFile, ImagesOverTheLimitsAreRefusedBeforeDecoding) {
   Result<RgbaImage> decoded = decodeImageFile(png.data(), png.size(), limits);
   ASSERT_FALSE(decoded.ok());
   EXPECT_EQ(decoded.status().code(), ErrorCode::kResourceExhausted);
+  // Both edges of the side check: a side equal to the limit decodes, one
+  // past it is refused (the image file fuzzer relies on this being the only
+  // place the limit matters).
+  limits.maxTextureDimension = 64;
+  ASSERT_TRUE(decodeImageFile(png.data(), png.size(), limits).ok());
+  limits.maxTextureDimension = 63;
+  EXPECT_EQ(decodeImageFile(png.data(), png.size(), limits).status().code(),
+            ErrorCode::kResourceExhausted);
   limits = DecodeLimits{};
   limits.maxPayloadBytes = png.size() - 1;
   EXPECT_EQ(decodeImageFile(png.data(), png.size(), limits).status().code(),
@@ -162,6 +170,28 @@ TEST(ImageFile, GreyAndGreyAlphaBecomeRgba) {
   EXPECT_EQ(q[0], 40 + 17 * 4);
   EXPECT_EQ(q[2], q[0]);
   EXPECT_EQ(q[3], 40 + 17 * 4 + 60);
+}
+
+// rgb16_5x3.png (written by hand, 16 bits per channel): channel c of pixel
+// (x, y) holds 257 k + 10 (k = (40x + 17y + 60c) mod 256; 65535 for k = 255),
+// so its 8-bit value is k. Read in the file's own type and converted by
+// readAsUint8 (not by ImageInput::read_image's 64 MB conversion buffer).
+TEST(ImageFile, SixteenBitPngBecomesEightBitRgba) {
+  const std::vector<std::uint8_t> bytes = seedFile("rgb16_5x3.png");
+  ASSERT_FALSE(bytes.empty());
+  Result<RgbaImage> image = decodeImageFile(bytes.data(), bytes.size());
+  ASSERT_TRUE(image.ok()) << image.status().toString();
+  ASSERT_EQ(image->width, 5);
+  ASSERT_EQ(image->height, 3);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      const std::uint8_t* p = image->at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(p[c], (40 * x + 17 * y + 60 * c) % 256) << x << "," << y << " channel " << c;
+      }
+      EXPECT_EQ(p[3], 255);
+    }
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "encoding_frame.h"
 #include "thinlod/common/codec/encoding.h"
@@ -189,9 +190,21 @@ Result<std::unique_ptr<OIIO::ImageInput>> openWithProxy(const char* fileName,
   // hints when it arrives as the "oiio:ioproxy" hint itself.
   void* proxyPointer = &proxy;
   config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxyPointer);
-  std::unique_ptr<OIIO::ImageInput> input = OIIO::ImageInput::open(fileName, &config);
+  // The reader of the extension's format only. ImageInput::open(name) (and
+  // create with do_open) falls back, when that reader refuses the bytes, to
+  // trying every reader OpenImageIO has (LibRaw, DICOM, FITS, ...): hostile
+  // bytes we checked as PNG, JPEG or TGA would reach parsers we never
+  // checked for. LibRaw alone allocated and zeroed megabytes per refused
+  // file, most of the image file fuzzer's time.
+  std::unique_ptr<OIIO::ImageInput> input =
+      OIIO::ImageInput::create(fileName, /*do_open=*/false, &config, &proxy);
   if (!input) {
-    return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + OIIO::geterror());
+    return textureError(ErrorCode::kInternal, std::string("OpenImageIO has no reader for ") +
+                                                  fileName + ": " + OIIO::geterror());
+  }
+  OIIO::ImageSpec opened;
+  if (!input->open(fileName, opened, config)) {
+    return textureError(ErrorCode::kParseError, "OpenImageIO decode: " + input->geterror());
   }
   return input;
 }
@@ -252,6 +265,55 @@ void expandToRgba(const std::vector<std::uint8_t>& in, int channels, RgbaImage& 
   }
 }
 
+// The pixels of an opened `input` as 8-bit values of its first `channels`
+// channels, row-major into `dest` (width * height * channels bytes; the
+// caller checked the dimensions against its limits). Read in the file's own
+// type, a band of rows at a time, and converted here: ImageInput::read_image
+// asked for a conversion (a 16-bit PNG to UINT8, or a channel subset)
+// allocates a buffer of about 64 MB whatever the image's size (OpenImageIO
+// 2.4's chunk is 2^26 bytes of rows, not clamped to the height), which made
+// every such file, even 1x1, cost a 64 MB allocation.
+Status readAsUint8(OIIO::ImageInput& input, int channels, std::uint8_t* dest) {
+  const OIIO::ImageSpec& spec = input.spec();
+  if (!spec.channelformats.empty()) {
+    return textureError(ErrorCode::kUnsupported, "per-channel pixel formats");
+  }
+  const int fileChannels = spec.nchannels;
+  const std::size_t rowValues = std::size_t(spec.width) * std::size_t(fileChannels);
+  const std::size_t rowBytes = rowValues * spec.format.size();
+  constexpr std::size_t kBandBytes = std::size_t{1} << 20;
+  const int bandRows =
+      static_cast<int>(std::clamp<std::size_t>(kBandBytes / std::max<std::size_t>(rowBytes, 1),
+                                               1, std::size_t(spec.height)));
+  const bool convert = spec.format != OIIO::TypeDesc::UINT8;
+  std::vector<std::uint8_t> band(rowBytes * std::size_t(bandRows));
+  std::vector<std::uint8_t> converted(convert ? rowValues * std::size_t(bandRows) : 0);
+  for (int y0 = 0; y0 < spec.height; y0 += bandRows) {
+    const int rows = std::min(bandRows, spec.height - y0);
+    // All channels in the file's type: OpenImageIO's direct path, into `band`.
+    if (!input.read_scanlines(0, 0, spec.y + y0, spec.y + y0 + rows, 0, 0, fileChannels,
+                              OIIO::TypeDesc::UNKNOWN, band.data())) {
+      return textureError(ErrorCode::kParseError, "OpenImageIO: " + input.geterror());
+    }
+    const std::size_t values = rowValues * std::size_t(rows);
+    const std::uint8_t* bytes = band.data();
+    if (convert) {
+      if (!OIIO::convert_pixel_values(spec.format, band.data(), OIIO::TypeDesc::UINT8,
+                                      converted.data(), static_cast<int>(values))) {
+        return textureError(ErrorCode::kUnsupported,
+                            std::string("pixel type ") + spec.format.c_str());
+      }
+      bytes = converted.data();
+    }
+    const std::size_t pixels = std::size_t(spec.width) * std::size_t(rows);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      std::copy_n(bytes + p * std::size_t(fileChannels), channels, dest);
+      dest += channels;
+    }
+  }
+  return Status();
+}
+
 Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec codec,
                    RgbaImage& out) {
   OIIO::Filesystem::IOMemReader proxy(payload, size);
@@ -270,15 +332,10 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
                             ", header says " + std::to_string(out.width) + "x" +
                             std::to_string(out.height) + "x" + std::to_string(wantChannels));
   }
-  bool ok = false;
-  if (wantChannels == 4) {
-    ok = input.read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, out.pixels.data());
-  } else {
-    std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
-    ok = input.read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
-    if (ok) expandToRgba(rgb, 3, out);
-  }
-  if (!ok) return textureError(ErrorCode::kParseError, "OpenImageIO: " + input.geterror());
+  if (wantChannels == 4) return readAsUint8(input, 4, out.pixels.data());
+  std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
+  THINLOD_RETURN_IF_ERROR(readAsUint8(input, 3, rgb.data()));
+  expandToRgba(rgb, 3, out);
   return Status();
 }
 
@@ -429,9 +486,7 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
     const int channels = std::min(spec.nchannels, 4);
     std::vector<std::uint8_t> raw(static_cast<std::size_t>(bytes / 4) *
                                   static_cast<std::size_t>(channels));
-    if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
-      return textureError(ErrorCode::kParseError, "OpenImageIO: " + input->geterror());
-    }
+    THINLOD_RETURN_IF_ERROR(readAsUint8(*input, channels, raw.data()));
     expandToRgba(raw, channels, out);
     return out;
   } catch (const std::bad_alloc&) {
