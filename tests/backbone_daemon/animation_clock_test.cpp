@@ -12,6 +12,7 @@
 #include "fake_simplifier.h"
 #include "thinlod/common/core/skinning.h"
 #include "thinlod/common/scene/scene_parser.h"
+#include "thinlod/protocol/codec.h"
 
 namespace thinlod::backbone_daemon {
 namespace {
@@ -75,11 +76,16 @@ TEST(BackboneAnimationClock, PosesOfHeldAnimatedObjectsFollowPoseTime) {
     ASSERT_TRUE(core.replan().ok());
     const PoseOutcome outcome = core.finishPose();
     held = core.frontendMirror().trianglesOf(0) > 0.0;
-    // Every frame's outcome carries the poses of what the frontend holds.
-    ASSERT_EQ(outcome.bonePoses.size(), held ? 1u : 0u);
+    // Every update carries the poses of what the frontend holds, on the link.
+    ASSERT_EQ(outcome.update.bonePoses.size(), held ? 1u : 0u);
+    EXPECT_TRUE(protocol::validate(protocol::Message(outcome.update)).ok());
     if (held) {
-      EXPECT_EQ(outcome.bonePoses[0].matrices,
-                core.bonePosesAt(poseAt(step, 0.1 * step, eye, figure).timestampNs)[0].matrices);
+      EXPECT_EQ(outcome.update.bonePoses[0],
+                core.bonePosesAt(poseAt(step, 0.1 * step, eye, figure).timestampNs)[0]);
+      EXPECT_EQ(outcome.bonePoseBytes,
+                std::uint64_t(kBonePoseOverheadBytes +
+                              kBytesPerBoneMatrix * double(wuson(core).palette.bones.size())));
+      EXPECT_GE(outcome.linkBytes, outcome.bonePoseBytes);
     }
   }
   ASSERT_TRUE(held) << "the backbone never sent the figure";
@@ -88,16 +94,24 @@ TEST(BackboneAnimationClock, PosesOfHeldAnimatedObjectsFollowPoseTime) {
   const double duration = animation.clip.duration;
   for (const double t : {0.0, 0.3 * duration, 0.9 * duration}) {
     const auto ns = static_cast<std::int64_t>(std::llround(t * 1e9));
-    const std::vector<ObjectBonePose> poses = core.bonePosesAt(ns);
+    const std::vector<protocol::BonePose> poses = core.bonePosesAt(ns);
     ASSERT_EQ(poses.size(), 1u);
     EXPECT_EQ(poses[0].objectId, 1u);
     // The clock is pose time: the clip at t (looped), one matrix per palette bone.
-    EXPECT_EQ(poses[0].matrices,
-              anim::paletteMatricesAt(animation.skeleton, animation.clip, animation.palette,
-                                      double(ns) * 1e-9, anim::ClipWrap::kLoop));
+    // (The top three rows: deform() drops w, the wire carries those.)
+    const std::vector<glm::mat4> expected =
+        anim::paletteMatricesAt(animation.skeleton, animation.clip, animation.palette,
+                                double(ns) * 1e-9, anim::ClipWrap::kLoop);
+    ASSERT_EQ(poses[0].matrices.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 3; ++r) ASSERT_EQ(poses[0].matrices[i][c][r], expected[i][c][r]);
+        ASSERT_EQ(poses[0].matrices[i][c][3], c == 3 ? 1.0f : 0.0f);
+      }
+    }
     // One lap later: the same pose.
     const auto lap = static_cast<std::int64_t>(std::llround((t + duration) * 1e9));
-    const std::vector<ObjectBonePose> again = core.bonePosesAt(lap);
+    const std::vector<protocol::BonePose> again = core.bonePosesAt(lap);
     ASSERT_EQ(again.size(), 1u);
     for (std::size_t i = 0; i < again[0].matrices.size(); ++i) {
       for (int c = 0; c < 4; ++c) {
@@ -110,6 +124,69 @@ TEST(BackboneAnimationClock, PosesOfHeldAnimatedObjectsFollowPoseTime) {
   }
   EXPECT_NE(core.bonePosesAt(0)[0].matrices,
             core.bonePosesAt(static_cast<std::int64_t>(0.5 * duration * 1e9))[0].matrices);
+}
+
+// Plans until the frontend holds the figure (object 1); false if it never does.
+bool sendFigure(BackboneCore& core, FakeSimplifier& fake, int& step) {
+  const glm::vec3 eye(0.3f, 0.3f, 2.0f), figure(0.0f, 0.2f, 0.0f);
+  for (int tries = 0; tries < 4; ++tries, ++step) {
+    if (!core.beginPose(poseAt(step, 0.1 * step, eye, figure)).ok()) return false;
+    answer(core, fake, submitAll(core));
+    if (!core.replan().ok()) return false;
+    core.finishPose();
+    if (core.frontendMirror().trianglesOf(0) > 0.0) return true;
+  }
+  return false;
+}
+
+TEST(BackboneAnimationClock, AnUnplannedAnswerCarriesThePosesToo) {
+  auto created = animatedCore(polygonBudget(5000));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+  int step = 0;
+  ASSERT_TRUE(sendFigure(core, fake, step));
+  const protocol::ViewerPose pose =
+      poseAt(step, 0.1 * step + 0.05, glm::vec3(0.3f, 0.3f, 2.0f), glm::vec3(0.0f));
+  const protocol::SceneUpdate update = core.emptyUpdate(pose);
+  EXPECT_TRUE(update.operations.empty());
+  ASSERT_EQ(update.bonePoses.size(), 1u);
+  EXPECT_EQ(update.bonePoses, core.bonePosesAt(pose.timestampNs));
+}
+
+TEST(BackboneAnimationClock, PosesPassTheLinkShaperAndWaitWhenItIsEmpty) {
+  CoreOptions options = polygonBudget(5000);
+  const double rate = 10000.0;  // bytes/s: 1000 a pose step, less than one pose (1840)
+  const double burst = 20000.0;
+  options.budget.maxLinkBytesPerSecond = rate;
+  options.linkBurstBytes = burst;
+  auto created = animatedCore(options);
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+  int step = 0;
+  ASSERT_TRUE(sendFigure(core, fake, step));
+  int sent = 0, deferred = 0;
+  for (int i = 0; i < 40; ++i, ++step) {
+    ASSERT_TRUE(core.beginPose(poseAt(step, 0.1 * step, glm::vec3(0.3f, 0.3f, 2.0f),
+                                      glm::vec3(0.0f, 0.2f, 0.0f)))
+                    .ok());
+    answer(core, fake, submitAll(core));
+    const PoseOutcome outcome = core.finishPose();
+    if (outcome.posesDeferredByLink) {
+      ++deferred;
+      EXPECT_TRUE(outcome.update.bonePoses.empty());
+      EXPECT_EQ(outcome.bonePoseBytes, 0u);
+    } else if (!outcome.update.bonePoses.empty()) {
+      ++sent;
+    }
+  }
+  EXPECT_GT(sent, 0);
+  EXPECT_GT(deferred, 0) << "a pose costs more than the link refills between poses";
+  // The shaper's guarantee holds with the poses in it (burst grown at most to the largest mesh).
+  EXPECT_LE(double(core.shapedLinkBytes()), rate * 0.1 * step + burst + 8192.0);
 }
 
 }  // namespace

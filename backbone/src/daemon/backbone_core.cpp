@@ -1034,6 +1034,7 @@ protocol::SceneUpdate BackboneCore::emptyUpdate(const protocol::ViewerPose& pose
   update.plan = 0;
   update.frame = pose.sequence;
   update.targetAccuracy = 0.0;
+  update.bonePoses = bonePosesAt(pose.timestampNs);
   return update;
 }
 
@@ -1226,23 +1227,48 @@ PoseOutcome BackboneCore::finishPose() {
     ++out.resyncRemoves;
   }
   out.frontendTriangles = mirror_.triangles();
-  out.bonePoses = bonePosesAt(poseTimeNs_);
+  std::vector<protocol::BonePose> poses = bonePosesAt(poseTimeNs_);
+  std::uint64_t poseBytes = 0;
+  for (const protocol::BonePose& pose : poses) {
+    poseBytes += static_cast<std::uint64_t>(kBonePoseOverheadBytes +
+                                            kBytesPerBoneMatrix * double(pose.matrices.size()));
+  }
+  if (!poses.empty() && shaper_ && !shaper_->trySend(poseBytes, now)) {
+    out.posesDeferredByLink = true;
+  } else if (!poses.empty()) {
+    if (shaper_) shapedBytes_ += poseBytes;
+    out.linkBytes += poseBytes;
+    out.bonePoseBytes = poseBytes;
+    out.update.bonePoses = std::move(poses);
+  }
   return out;
 }
 
-std::vector<ObjectBonePose> BackboneCore::bonePosesAt(std::int64_t poseNs) const {
-  std::vector<ObjectBonePose> poses;
+std::vector<protocol::BonePose> BackboneCore::bonePosesAt(std::int64_t poseNs) const {
+  std::vector<protocol::BonePose> poses;
   const double seconds = double(poseNs) * 1e-9;
   for (std::uint32_t k = 0; k < animationOf_.size(); ++k) {
     const scene::SkinnedAnimation* animation = animationOf_[k];
     if (animation == nullptr || !(mirror_.trianglesOf(k) > 0.0)) continue;
-    poses.push_back({converted_.records[k].id,
-                     anim::paletteMatricesAt(animation->skeleton, animation->clip,
-                                             animation->palette, seconds, anim::ClipWrap::kLoop)});
+    protocol::BonePose pose;
+    pose.objectId = converted_.records[k].id;
+    pose.matrices = anim::paletteMatricesAt(animation->skeleton, animation->clip,
+                                            animation->palette, seconds, anim::ClipWrap::kLoop);
+    // deform() drops w, so the bottom row plays no part: the wire's affine
+    // form is exact. Finite bones of a file can still overflow float in their
+    // product: such a pose is not sent (the frontend keeps its last one).
+    bool finite = true;
+    for (glm::mat4& m : pose.matrices) {
+      m[0][3] = m[1][3] = m[2][3] = 0.0f;
+      m[3][3] = 1.0f;
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 3; ++r) finite = finite && std::isfinite(m[c][r]);
+      }
+    }
+    if (finite) poses.push_back(std::move(pose));
   }
-  std::sort(poses.begin(), poses.end(), [](const ObjectBonePose& a, const ObjectBonePose& b) {
-    return a.objectId < b.objectId;
-  });
+  std::sort(poses.begin(), poses.end(),
+            [](const auto& a, const auto& b) { return a.objectId < b.objectId; });
   return poses;
 }
 

@@ -145,12 +145,11 @@ struct SessionFrameCost {
   FrameCostConstants constants;  // meaningful unless kUnused
 };
 
-// One skinned object's bone poses at one instant: the palette matrices of
-// its SkinnedAnimation (scene.h), entry i for palette.bones[i].
-struct ObjectBonePose {
-  std::uint64_t objectId = 0;
-  std::vector<glm::mat4> matrices;
-};
+// Encoded bytes of one object's bone pose in a SceneUpdate: 48 per matrix
+// (three rows of four floats) plus its table (measured: at most 64,
+// tests/protocol/bone_pose_fields_test.cpp).
+inline constexpr double kBonePoseOverheadBytes = 64.0;
+inline constexpr double kBytesPerBoneMatrix = 48.0;
 
 struct OutgoingRequest {
   std::uint64_t requestId = 0;  // == the message's requestId
@@ -173,8 +172,13 @@ struct PoseOutcome {
   std::uint64_t linkRate = 0;         // the shaper's rate at this pose (bytes/s; 0: no link budget)
   double frontendTriangles = 0.0;     // after the update is applied
   std::uint32_t expiredCopiesKept = 0;  // PlanStats::expiredCopiesKept of the final plan
-  // bonePosesAt(the pose's time) after the update: the held animated objects.
-  std::vector<ObjectBonePose> bonePoses;
+  // Bytes of update.bonePoses (the held animated objects' poses at the
+  // pose's time, bonePosesAt), counted in linkBytes; with a link budget they
+  // pass the shaper after the operations, and a frame whose poses find no
+  // tokens goes without them (posesDeferredByLink: the frontend keeps the
+  // last pose it has).
+  std::uint64_t bonePoseBytes = 0;
+  bool posesDeferredByLink = false;
 };
 
 class BackboneCore {
@@ -233,7 +237,9 @@ class BackboneCore {
   std::size_t awaitedResults() const;
   PoseOutcome finishPose();
   // Answers a pose without planning (e.g. superseded by a newer one): no
-  // operations, plan 0 (no plan: it never stands for a plan's update).
+  // operations, plan 0 (no plan: it never stands for a plan's update); the
+  // held animated objects' bone poses at the pose's time (not shaped: a
+  // superseded pose's answer is small and keeps the motion going).
   protocol::SceneUpdate emptyUpdate(const protocol::ViewerPose& pose);
 
   // Forgets the frontend (mirror, planner state, shaper); the frame-cost
@@ -294,7 +300,7 @@ class BackboneCore {
   // deterministic and every frontend of one trace sees the same motion.
   // Bone poses at `poseNs` of the animated objects the frontend holds a
   // representation of (the mirror after the last update), ascending ids.
-  std::vector<ObjectBonePose> bonePosesAt(std::int64_t poseNs) const;
+  std::vector<protocol::BonePose> bonePosesAt(std::int64_t poseNs) const;
   // Scene objects with a skinned animation.
   std::size_t animatedObjects() const;
 

@@ -4,6 +4,7 @@
 #include <draco/mesh/mesh.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -22,6 +23,7 @@ constexpr std::uint8_t kCodecDraco = 1;
 constexpr std::uint32_t kHasNormals = 1;
 constexpr std::uint32_t kHasUvs = 2;
 constexpr std::uint32_t kHasColors = 4;
+constexpr std::uint32_t kHasSkin = 8;
 constexpr int kMinPositionBits = 8;
 constexpr int kMaxPositionBits = 20;
 
@@ -32,13 +34,20 @@ Status invalid(const std::string& message) {
 // Triangles with a repeated corner index are dropped and unreferenced
 // vertices removed, so the vertex and face counts Draco reports are the ones
 // the decoder reproduces.
-IndexedMesh compactForEncoding(const IndexedMesh& mesh) {
+// A vertex's skin as the frame stores it: boneA, boneB, weightB * 65535.
+using SkinValue = std::array<std::uint16_t, 3>;
+constexpr float kWeightSteps = 65535.0f;
+
+// `skin` (empty or one per vertex) is compacted alongside into `skinOut`.
+IndexedMesh compactForEncoding(const IndexedMesh& mesh, const std::vector<SkinValue>& skin,
+                               std::vector<SkinValue>& skinOut) {
   IndexedMesh out;
   std::vector<std::uint32_t> remap(mesh.vertexCount(), UINT32_MAX);
   auto mapVertex = [&](std::uint32_t v) {
     if (remap[v] == UINT32_MAX) {
       remap[v] = static_cast<std::uint32_t>(out.positions.size());
       out.positions.push_back(mesh.positions[v]);
+      if (!skin.empty()) skinOut.push_back(skin[v]);
       if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
       if (!mesh.uvs.empty()) out.uvs.push_back(mesh.uvs[v]);
       if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
@@ -72,6 +81,22 @@ int addAttribute(draco::Mesh& target, draco::GeometryAttribute::Type type, draco
 
 Status decodeError(ErrorCode code, const std::string& message) {
   return Status(code, "decodeMesh: " + message);
+}
+
+// The skin attribute's values back as VertexSkin: a rigid vertex (one
+// bone) must have weight 0.
+Result<std::vector<anim::VertexSkin>> toSkin(const std::vector<SkinValue>& values) {
+  std::vector<anim::VertexSkin> skin;
+  skin.reserve(values.size());
+  for (std::size_t v = 0; v < values.size(); ++v) {
+    const SkinValue& value = values[v];
+    if (value[0] == value[1] && value[2] != 0) {
+      return decodeError(ErrorCode::kParseError,
+                         "skin of vertex " + std::to_string(v) + " names one bone with a weight");
+    }
+    skin.push_back({value[0], value[1], float(value[2]) / kWeightSteps});
+  }
+  return skin;
 }
 
 Result<IndexedMesh> toIndexedMesh(const draco::Mesh& decoded, std::uint32_t attributes) {
@@ -124,8 +149,12 @@ double positionErrorBound(const IndexedMesh& mesh, int bits) {
   return 0.5 * step * std::sqrt(3.0);
 }
 
-Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& input,
-                                             const MeshEncodeOptions& options) {
+namespace {
+
+// encodeMesh, with the skin attribute when `skin` is not empty (one entry a vertex).
+Result<std::vector<std::uint8_t>> encodeMeshFrame(const IndexedMesh& input,
+                                                  const std::vector<SkinValue>& skin,
+                                                  const MeshEncodeOptions& options) {
   THINLOD_RETURN_IF_ERROR(input.validate("encodeMesh: input"));
   if (options.positionBits < kMinPositionBits || options.positionBits > kMaxPositionBits) {
     return invalid("positionBits " + std::to_string(options.positionBits) + " outside [8, 20]");
@@ -138,7 +167,8 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& input,
       options.decodeSpeed > 10) {
     return invalid("Draco speeds must be in [0, 10]");
   }
-  const IndexedMesh mesh = compactForEncoding(input);
+  std::vector<SkinValue> compactSkin;
+  const IndexedMesh mesh = compactForEncoding(input, skin, compactSkin);
   if (mesh.triangleCount() == 0) return invalid("no non-degenerate triangles");
 
   try {
@@ -160,6 +190,14 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& input,
     if (!mesh.colors.empty()) {
       addAttribute(draco, draco::GeometryAttribute::COLOR, draco::DT_UINT8, 4, true, mesh.colors);
       attributes |= kHasColors;
+    }
+    if (!compactSkin.empty()) {
+      // Integers: Draco predicts them from neighbours and entropy-codes
+      // them (a skin is constant over most of a region), where float32
+      // GENERIC values travel raw (12 bytes a vertex).
+      addAttribute(draco, draco::GeometryAttribute::GENERIC, draco::DT_UINT16, 3, false,
+                   compactSkin);
+      attributes |= kHasSkin;
     }
     draco.SetNumFaces(mesh.triangleCount());
     for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
@@ -196,8 +234,45 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& input,
   }
 }
 
+}  // namespace
+
+Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& mesh,
+                                             const MeshEncodeOptions& options) {
+  return encodeMeshFrame(mesh, {}, options);
+}
+
+Result<std::vector<std::uint8_t>> encodeSkinnedMesh(const IndexedMesh& mesh,
+                                                    const std::vector<anim::VertexSkin>& skin,
+                                                    const MeshEncodeOptions& options) {
+  if (skin.size() != mesh.vertexCount()) {
+    return invalid("skin has " + std::to_string(skin.size()) + " entries for " +
+                   std::to_string(mesh.vertexCount()) + " vertices");
+  }
+  THINLOD_RETURN_IF_ERROR(
+      anim::validateSkin(skin, mesh.vertexCount(), kMaxSkinBones, "encodeSkinnedMesh: skin"));
+  std::vector<SkinValue> values;
+  values.reserve(skin.size());
+  for (const anim::VertexSkin& s : skin) {
+    // A rigid vertex (weight 0) names one bone: its unused second bone
+    // would otherwise reach the renderer's palette.
+    const bool rigid = s.rigid();
+    const auto weight = static_cast<std::uint16_t>(std::lround(s.weightB * kWeightSteps));
+    values.push_back({static_cast<std::uint16_t>(s.boneA),
+                      static_cast<std::uint16_t>(rigid ? s.boneA : s.boneB),
+                      static_cast<std::uint16_t>(rigid || s.boneA == s.boneB ? 0 : weight)});
+  }
+  return encodeMeshFrame(mesh, values, options);
+}
+
 Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
                                const DecodeLimits& limits) {
+  Result<SkinnedMeshFrame> decoded = decodeSkinnedMesh(data, size, limits);
+  if (!decoded.ok()) return decoded.status();
+  return std::move(decoded->mesh);
+}
+
+Result<SkinnedMeshFrame> decodeSkinnedMesh(const std::uint8_t* data, std::size_t size,
+                                           const DecodeLimits& limits) {
   Result<detail::FrameHeader> parsed =
       detail::parseFrame(data, size, detail::kMeshMagic, limits, "decodeMesh");
   if (!parsed.ok()) return parsed.status();
@@ -205,7 +280,7 @@ Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
   if (header.codec != kCodecDraco) {
     return decodeError(ErrorCode::kUnsupported, "unknown codec " + std::to_string(header.codec));
   }
-  if (header.attributes & ~(kHasNormals | kHasUvs | kHasColors)) {
+  if (header.attributes & ~(kHasNormals | kHasUvs | kHasColors | kHasSkin)) {
     return decodeError(ErrorCode::kUnsupported,
                        "unknown attribute bits " + std::to_string(header.attributes));
   }
@@ -238,7 +313,19 @@ Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
                              std::to_string(mesh.num_faces()) + " triangles, header says " +
                              std::to_string(header.countA) + " / " + std::to_string(header.countB));
     }
-    return toIndexedMesh(mesh, header.attributes);
+    SkinnedMeshFrame out;
+    Result<IndexedMesh> converted = toIndexedMesh(mesh, header.attributes);
+    if (!converted.ok()) return converted.status();
+    out.mesh = std::move(converted).value();
+    if (header.attributes & kHasSkin) {
+      std::vector<SkinValue> values;
+      THINLOD_RETURN_IF_ERROR(detail::readDracoAttribute<3>(
+          mesh, draco::GeometryAttribute::GENERIC, "skin", draco::DT_UINT16, "decodeMesh", values));
+      Result<std::vector<anim::VertexSkin>> skin = toSkin(values);
+      if (!skin.ok()) return skin.status();
+      out.skin = std::move(skin).value();
+    }
+    return out;
   } catch (const std::bad_alloc&) {
     return decodeError(ErrorCode::kResourceExhausted, "out of memory");
   } catch (const std::exception& e) {

@@ -38,6 +38,14 @@ w::Quat toWire(const glm::quat& q) { return w::Quat(q.x, q.y, q.z, q.w); }
 w::Mat4 toWire(const glm::mat4& m) {
   return w::Mat4(fb::span<const float, 16>(glm::value_ptr(m), 16));
 }
+// The top three rows; validate() has checked the bottom row is 0 0 0 1.
+w::BoneMatrix toWireBoneMatrix(const glm::mat4& m) {
+  float rows[12];
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 3; ++r) rows[c * 3 + r] = m[c][r];
+  }
+  return w::BoneMatrix(fb::span<const float, 12>(rows, 12));
+}
 w::ConicRange toWire(const ConicRange& c) {
   return w::ConicRange(toWire(c.center), c.distanceMin, c.distanceMax, toWire(c.direction),
                        c.halfAngle);
@@ -135,7 +143,17 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Scene
   for (const SharedTexture& t : m.textures)
     textures.push_back(w::CreateSharedTexture(b, t.textureId, build(b, t.texture)));
   auto texturesVector = textures.empty() ? 0 : b.CreateVector(textures);
-  auto t = w::CreateSceneUpdate(b, m.plan, m.frame, m.targetAccuracy, opsVector, texturesVector);
+  std::vector<fb::Offset<w::BonePose>> poses;
+  poses.reserve(m.bonePoses.size());
+  for (const BonePose& pose : m.bonePoses) {
+    std::vector<w::BoneMatrix> matrices;
+    matrices.reserve(pose.matrices.size());
+    for (const glm::mat4& matrix : pose.matrices) matrices.push_back(toWireBoneMatrix(matrix));
+    poses.push_back(w::CreateBonePose(b, pose.objectId, b.CreateVectorOfStructs(matrices)));
+  }
+  auto posesVector = poses.empty() ? 0 : b.CreateVector(poses);
+  auto t = w::CreateSceneUpdate(b, m.plan, m.frame, m.targetAccuracy, opsVector, texturesVector,
+                                posesVector);
   return {w::Body::SceneUpdate, t.Union()};
 }
 
@@ -469,6 +487,31 @@ Result<Message> fromWire(const FieldPath& path, const w::SceneUpdate* m) {
       THINLOD_RETURN_IF_ERROR(
           fromWire(texturePath.child("texture"), t->texture(), &converted.texture));
       out.textures.push_back(std::move(converted));
+    }
+  }
+  const auto* poses = m->bone_poses();
+  THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("bone_poses"), poses, kMaxBonePoses));
+  if (poses != nullptr) {
+    out.bonePoses.reserve(poses->size());
+    for (fb::uoffset_t i = 0; i < poses->size(); ++i) {
+      const FieldPath posePath = path.element("bone_poses", i);
+      const w::BonePose* pose = poses->Get(i);
+      BonePose converted;
+      converted.objectId = pose->object_id();
+      const auto* matrices = pose->matrices();
+      THINLOD_RETURN_IF_ERROR(
+          checkVectorCount(posePath.child("matrices"), matrices, kMaxBonesPerPose));
+      if (matrices != nullptr) {
+        converted.matrices.reserve(matrices->size());
+        for (fb::uoffset_t k = 0; k < matrices->size(); ++k) {
+          glm::mat4 matrix(1.0f);
+          for (int c = 0; c < 4; ++c) {
+            for (int r = 0; r < 3; ++r) matrix[c][r] = matrices->Get(k)->m()->Get(c * 3 + r);
+          }
+          converted.matrices.push_back(matrix);
+        }
+      }
+      out.bonePoses.push_back(std::move(converted));
     }
   }
   return Message(std::move(out));

@@ -92,9 +92,12 @@ bool operator==(const ViewerPose& a, const ViewerPose& b) {
 bool operator==(const SceneOperation& a, const SceneOperation& b) {
   return a.type == b.type && a.objectId == b.objectId && a.representation == b.representation;
 }
+bool operator==(const BonePose& a, const BonePose& b) {
+  return a.objectId == b.objectId && a.matrices == b.matrices;
+}
 bool operator==(const SceneUpdate& a, const SceneUpdate& b) {
   return a.plan == b.plan && a.frame == b.frame && a.targetAccuracy == b.targetAccuracy &&
-         a.operations == b.operations && a.textures == b.textures;
+         a.operations == b.operations && a.textures == b.textures && a.bonePoses == b.bonePoses;
 }
 bool operator==(const FrameStats& a, const FrameStats& b) {
   return a.frame == b.frame && a.plan == b.plan && a.timestampNs == b.timestampNs &&

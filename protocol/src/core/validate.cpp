@@ -234,6 +234,37 @@ Status checkRepresentation(const FieldPath& path, const Representation& rep) {
   return Status();
 }
 
+// Bone poses: counts within the limits, object ids unique, every matrix
+// finite and affine (the wire carries the top three rows only).
+Status checkBonePoses(const FieldPath& path, const std::vector<BonePose>& poses) {
+  THINLOD_RETURN_IF_ERROR(checkCount(path.child("bone_poses"), poses.size(), kMaxBonePoses));
+  std::vector<std::uint64_t> ids;
+  ids.reserve(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const FieldPath posePath = path.element("bone_poses", i);
+    const BonePose& pose = poses[i];
+    THINLOD_RETURN_IF_ERROR(
+        checkCount(posePath.child("matrices"), pose.matrices.size(), kMaxBonesPerPose));
+    for (std::size_t k = 0; k < pose.matrices.size(); ++k) {
+      const FieldPath matrixPath = posePath.element("matrices", k);
+      const glm::mat4& m = pose.matrices[k];
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) THINLOD_RETURN_IF_ERROR(checkFinite(matrixPath, m[c][r]));
+        if (m[c][3] != (c == 3 ? 1.0f : 0.0f))
+          return invalidField(matrixPath, "is not affine (its bottom row must be 0 0 0 1)");
+      }
+    }
+    ids.push_back(pose.objectId);
+  }
+  std::sort(ids.begin(), ids.end());
+  const auto duplicate = std::adjacent_find(ids.begin(), ids.end());
+  if (duplicate != ids.end()) {
+    return invalidField(path.child("bone_poses"),
+                        "object " + std::to_string(*duplicate) + " has two poses");
+  }
+  return Status();
+}
+
 Status checkObjectIds(const FieldPath& path, const std::vector<std::uint64_t>& ids,
                       bool allowEmpty) {
   THINLOD_RETURN_IF_ERROR(checkCount(path, ids.size(), kMaxObjectIdsPerRequest));
@@ -368,7 +399,7 @@ Status check(const FieldPath& path, const SceneUpdate& m) {
     return invalidField(path.child("operations"),
                         "object " + std::to_string(*duplicate) + " appears twice in one batch");
   }
-  return Status();
+  return checkBonePoses(path, m.bonePoses);
 }
 
 Status check(const FieldPath& path, const FrameStats& m) {

@@ -17,6 +17,7 @@
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
 #include "thinlod/protocol/codec.h"
+#include "thinlod/simplifier/skinned_level.h"
 
 namespace thinlod::simplifier {
 
@@ -189,8 +190,23 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   // attribute quadrics keep the texture from sliding across the surface.
   const bool textured = object.shape != nullptr && !object.shape->appearance.texturePath.empty() &&
                         !object.fullMesh->uvs.empty();
-  return buildModel(object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f,
-                    "object " + std::to_string(object.id));
+  const std::string what = "object " + std::to_string(object.id);
+  Result<MeshModel*> built =
+      buildModel(object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, what);
+  if (!built.ok() || object.shape == nullptr || !object.shape->geometry.animation) return built;
+  // A skinned object's levels carry their vertices' skins in the palette's
+  // bone indices (the backbone's bone poses hold one matrix per palette bone).
+  const anim::SkinPalette& palette = object.shape->geometry.animation->palette;
+  MeshModel& model = **built;
+  Result<std::vector<anim::VertexSkin>> skin =
+      tomSkin(model.pm, *object.fullMesh, palette.skin, palette.bones.size());
+  if (!skin.ok()) {
+    meshModels.erase(object.fullMesh.get());
+    return Status(skin.status().code(), what + ": " + skin.status().message());
+  }
+  model.tomSkin = std::move(skin).value();
+  model.originalSkin = palette.skin;
+  return built;
 }
 
 Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::Bytes& bytes) {
@@ -281,7 +297,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     ++stats.levelsMeasuredAlone;
     const double d =
         std::max(relativeError(error->max(), model.diameter), options.curve.minRelativeError);
-    return encodedMeshResult(mesh, deliveredLevel(d));
+    return encodedMeshResult(mesh, deliveredLevel(d), model.skinOf(mesh));
   }
   THINLOD_RETURN_IF_ERROR(ensureCurve(model));
   const ProgressiveMesh& pm = model.pm;
@@ -304,7 +320,8 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
   const IndexedMesh mesh = original ? *model.original : pm.extract(target);
   const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
   Result<protocol::SimplifyResult> encoded =
-      encodedMeshResult(mesh, deliveredLevel(credit.relativeError));
+      encodedMeshResult(mesh, deliveredLevel(credit.relativeError),
+                        original ? model.originalSkin : model.skinOf(mesh));
   if (!encoded.ok()) return encoded.status();
   protocol::SimplifyResult result = std::move(encoded).value();
   if (request.curvePoints > 0) {

@@ -13,6 +13,7 @@
 
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/relative_accuracy.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/mesh/primitives.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
@@ -59,8 +60,11 @@ DeliveredLevel deliveredLevel(double relativeError);
 std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame);
 // A SimplifyResult carrying `mesh` encoded at `delivered`'s position bits and
 // credited its accuracy (triangleCount from the encoded frame).
+// A skinned object's level carries `skin` (one per vertex of `mesh`, the
+// scene's palette indices; empty: a static mesh) in the frame.
 Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
-                                                   const DeliveredLevel& delivered);
+                                                   const DeliveredLevel& delivered,
+                                                   const std::vector<anim::VertexSkin>& skin = {});
 
 // Credits from measured levels (increasing triangles): each rung gets the
 // worst error measured at it or any finer rung, so credits never improve by
@@ -93,6 +97,18 @@ struct MeshModel {
   bool curveReady = false;
   bool cacheLookedUp = false;  // curveWithoutMeasuring found no file once: do not ask again
   std::vector<LevelCredit> ladder;
+  // A skinned object (scene Geometry::animation): the palette skin of every
+  // TOM vertex (tomSkin), so a level's skin is its first vertexCount()
+  // entries, and of every vertex of `original`. Empty: a static mesh.
+  std::vector<anim::VertexSkin> tomSkin;
+  std::vector<anim::VertexSkin> originalSkin;
+  // The skin of `level` (a pm.extract: TOM vertices); empty when static.
+  std::vector<anim::VertexSkin> skinOf(const IndexedMesh& level) const {
+    if (tomSkin.empty()) return {};
+    return std::vector<anim::VertexSkin>(
+        tomSkin.begin(), tomSkin.begin() + static_cast<std::ptrdiff_t>(
+                                               std::min(level.vertexCount(), tomSkin.size())));
+  }
   // Levels kept for impostor rendering (their GPU copies live as long as these).
   std::map<std::size_t, std::shared_ptr<const IndexedMesh>> renderLevels;
   // Hybrid graphs by kappa, with their measured ladder (increasing units).

@@ -38,10 +38,12 @@ std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
 }
 
 Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
-                                                   const DeliveredLevel& delivered) {
+                                                   const DeliveredLevel& delivered,
+                                                   const std::vector<anim::VertexSkin>& skin) {
   codec::MeshEncodeOptions encode;
   encode.positionBits = delivered.positionBits;
-  Result<std::vector<std::uint8_t>> frame = codec::encodeMesh(mesh, encode);
+  Result<std::vector<std::uint8_t>> frame =
+      skin.empty() ? codec::encodeMesh(mesh, encode) : codec::encodeSkinnedMesh(mesh, skin, encode);
   if (!frame.ok()) return frame.status();
   protocol::SimplifyResult result;
   result.mesh = std::move(frame).value();

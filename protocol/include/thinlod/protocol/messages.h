@@ -55,6 +55,8 @@ inline constexpr std::uint32_t kMaxViewportDimension = 16384;
 inline constexpr std::uint32_t kMaxWorkerCapacity = 1024;
 inline constexpr std::size_t kMaxRejectedPlans = 1024;  // per FrameStats
 inline constexpr std::size_t kMaxHeldRepresentations = 65536;  // per Hello (= kMaxSceneOperations)
+inline constexpr std::size_t kMaxBonePoses = 65536;            // per SceneUpdate (one per object)
+inline constexpr std::size_t kMaxBonesPerPose = 1024;          // matrices of one object's pose
 // Verifier limits: nesting depth and number of tables per message.
 inline constexpr unsigned kMaxTableDepth = 16;
 inline constexpr unsigned kMaxTables = 4 * kMaxSceneOperations + 64;
@@ -184,6 +186,15 @@ struct SceneOperation {
   Representation representation;  // kAddOrReplace only
 };
 
+// One skinned object's bone poses at a frame (docs/protocol.md, "Bone
+// poses"): matrix i deforms the mesh vertices whose skin names bone i. Each
+// matrix is affine (bottom row 0 0 0 1, sent as its top three rows) and
+// finite; at most kMaxBonesPerPose.
+struct BonePose {
+  std::uint64_t objectId = 0;
+  std::vector<glm::mat4> matrices;
+};
+
 // Applied atomically by the frontend. Object ids are unique within a batch.
 struct SceneUpdate {
   std::uint64_t plan = 0;   // planning step that produced it
@@ -191,6 +202,9 @@ struct SceneUpdate {
   double targetAccuracy = 0.0;
   std::vector<SceneOperation> operations;
   std::vector<SharedTexture> textures;  // at most kMaxSharedTextures; before the operations
+  // The animated objects' poses for this frame (at most kMaxBonePoses, object
+  // ids unique), applied after the operations.
+  std::vector<BonePose> bonePoses;
 };
 
 struct FrameStats {
@@ -301,6 +315,7 @@ bool operator==(const Hello& a, const Hello& b);
 bool operator==(const HelloReply& a, const HelloReply& b);
 bool operator==(const ViewerPose& a, const ViewerPose& b);
 bool operator==(const SceneOperation& a, const SceneOperation& b);
+bool operator==(const BonePose& a, const BonePose& b);
 bool operator==(const SceneUpdate& a, const SceneUpdate& b);
 bool operator==(const FrameStats& a, const FrameStats& b);
 bool operator==(const SimplifyRequest& a, const SimplifyRequest& b);

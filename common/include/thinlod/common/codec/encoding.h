@@ -6,7 +6,7 @@
 //   0 magic "TLME" (mesh) / "TLTX" (texture)   4 u16 version (kFrameVersion)
 //   6 u8 codec   7 u8 flags (0)   8 u32 mesh: vertices / texture: width
 //  12 u32 mesh: triangles / texture: height   16 u32 payload bytes
-//  20 u32 mesh: attribute bits (1 normals, 2 uvs, 4 colors) / texture: 0
+//  20 u32 mesh: attribute bits (1 normals, 2 uvs, 4 colors, 8 skin) / texture: 0
 //  24 u64 FNV-1a 64 of the payload            32 payload
 // Contract:
 // - Mesh positions are quantized by Draco: each vertex moves by at most
@@ -35,6 +35,7 @@
 #include "thinlod/common/core/disc_points.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/core/texture_codec.h"
 
@@ -77,6 +78,27 @@ Result<std::vector<std::uint8_t>> encodeMesh(const IndexedMesh& mesh,
                                              const MeshEncodeOptions& options = {});
 Result<IndexedMesh> decodeMesh(const std::uint8_t* data, std::size_t size,
                                const DecodeLimits& limits = {});
+
+// --- Skinned meshes (docs/animation.md, "Served") ---
+// encodeMesh plus each vertex's two-bone skin (anim::VertexSkin, validateSkin
+// against kMaxSkinBones; a rigid vertex is sent as one bone, weight 0) as a
+// Draco GENERIC attribute, uint16 x3 (boneA, boneB, round(weightB * 65535)):
+// bones exact, a weight within 0.5 / 65535; attribute bit 8. Draco moves it
+// with its vertex. decodeSkinnedMesh returns the mesh and, when the frame has
+// one, the skin (a vertex naming one bone with a non-zero weight is
+// kParseError); decodeMesh reads the same frames and drops the skin. Bones
+// index the sender's palette: the receiver checks them against the poses it
+// gets.
+inline constexpr std::uint32_t kMaxSkinBones = 65536;
+Result<std::vector<std::uint8_t>> encodeSkinnedMesh(const IndexedMesh& mesh,
+                                                    const std::vector<anim::VertexSkin>& skin,
+                                                    const MeshEncodeOptions& options = {});
+struct SkinnedMeshFrame {
+  IndexedMesh mesh;
+  std::vector<anim::VertexSkin> skin;  // empty: the frame carries none
+};
+Result<SkinnedMeshFrame> decodeSkinnedMesh(const std::uint8_t* data, std::size_t size,
+                                           const DecodeLimits& limits = {});
 
 // --- Hybrid triangles + points (docs/hybrid.md, "Link encoding") ---
 // Frame magic "TLHY", codec 1 (Draco): countA = points, countB = triangles,
