@@ -27,6 +27,7 @@
 Model sizes are read from the model files in --models-dir (default ../shared/models), so the
 scale factors written into the scenes are exact; the scenes name the models by file name only
 (the daemons find them through --models-dir). Deterministic: fixed seeds, no time stamps.
+`--only-city --city-blocks 90 --out DIR` writes a city of 10,125 instances alone (scale runs).
 
 Usage: deploy/make-suite.py [--models-dir DIR] [--out DIR]
 """
@@ -215,22 +216,26 @@ class Gallery:
         return self.objects
 
 
-def write_city(path, seed=12):
-    """1,024 buildings on a 32 x 32 grid of 10 m blocks and 256 kiosks along the avenues."""
+def write_city(path, seed=12, blocks=32):
+    """blocks^2 buildings on a grid of 10 m blocks and (blocks/2)^2 kiosks along the avenues
+    (the suite's city: 32, 1,024 buildings and 256 kiosks)."""
     rng = random.Random(seed)
     colours = [(0.6, 0.6, 0.65), (0.7, 0.55, 0.45), (0.45, 0.5, 0.6), (0.75, 0.7, 0.6)]
+    half = 5 * blocks  # the grid spans x, z in [-half, half]
     lines = ["#VRML V2.0 utf8",
              "# Workbench city (made by deploy/make-suite.py; do not edit by hand).",
-             "# 32 x 32 blocks of 10 m (x, z in [-160, 160]), streets 4 m wide at x, z = 10 k;",
-             "# 1,024 buildings (4 DEF'd unit boxes USEd with their own scale) and 256 kiosks.",
+             f"# {blocks} x {blocks} blocks of 10 m (x, z in [-{half}, {half}]), streets 4 m wide "
+             "at x, z = 10 k;",
+             f"# {blocks * blocks:,} buildings (4 DEF'd unit boxes USEd with their own scale) and "
+             f"{(blocks // 2) ** 2:,} kiosks.",
              'Viewpoint { description "avenue" position 0 1.7 150 fieldOfView 0.9 }',
              "DirectionalLight { direction 0.4 -1.0 -0.3 intensity 0.9 ambientIntensity 0.3 }"]
     count = 0
     defined = set()
-    for i in range(32):
-        for j in range(32):
-            x = -155 + 10 * i
-            z = -155 + 10 * j
+    for i in range(blocks):
+        for j in range(blocks):
+            x = -half + 5 + 10 * i
+            z = -half + 5 + 10 * j
             k = (i * 7 + j * 3) % 4
             h = rng.choice((4, 6, 9, 12, 18, 25)) * (0.8 + 0.4 * rng.random())
             w, d = 6 * (0.8 + 0.2 * rng.random()), 6 * (0.8 + 0.2 * rng.random())
@@ -242,10 +247,10 @@ def write_city(path, seed=12):
             count += 1
     kiosk_colours = [(0.2, 0.6, 0.3), (0.8, 0.3, 0.2), (0.9, 0.8, 0.3), (0.3, 0.4, 0.8)]
     kiosks = 0
-    for a in range(16):
-        for b in range(16):
-            x = -160 + 20 * a + 10 + (1.5 if b % 2 else -1.5)
-            z = -155 + 20 * b
+    for a in range(blocks // 2):
+        for b in range(blocks // 2):
+            x = -half + 20 * a + 10 + (1.5 if b % 2 else -1.5)
+            z = -half + 5 + 20 * b
             k = (a + b) % 4
             shape = (f"USE Kiosk{k}" if ("kiosk", k) in defined else
                      f"DEF Kiosk{k} Shape {{ {material(kiosk_colours[k])} geometry Box {{ size 1.2 2.2 1.2 }} }}")
@@ -393,11 +398,22 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models-dir", default=os.path.join(HERE, "..", "..", "shared", "models"))
     parser.add_argument("--out", default=os.path.join(HERE, "data"))
+    parser.add_argument("--city-blocks", type=int, default=32,
+                        help="side of the city's grid of blocks (default 32: 1,280 instances; "
+                             "90 gives 10,125, the scale runs of docs/results/scale.md)")
+    parser.add_argument("--only-city", action="store_true",
+                        help="write city.wrl only (with --city-blocks, for scale runs)")
     args = parser.parse_args()
+    if not 2 <= args.city_blocks <= 1000:
+        parser.error("--city-blocks must be in [2, 1000]")
     os.makedirs(args.out, exist_ok=True)
+    if args.only_city:
+        instances = write_city(os.path.join(args.out, "city.wrl"), blocks=args.city_blocks)
+        print(f"make-suite: city {instances} instances in {args.out}")
+        return
 
     objects = Gallery(args.models_dir).write(os.path.join(args.out, "gallery.wrl"))
-    instances = write_city(os.path.join(args.out, "city.wrl"))
+    instances = write_city(os.path.join(args.out, "city.wrl"), blocks=args.city_blocks)
     parts = write_parts_field(os.path.join(args.out, "parts-field.wrl"))
     textured = write_textured(os.path.join(args.out, "textured.wrl"))
 
