@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <limits>
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace thinlod {
@@ -400,6 +401,89 @@ TEST(PrimitiveCurves, CoarsestTessellationStartsTheCurve) {
 
 TEST(PrimitiveCurves, InvalidShapeIsAnError) {
   EXPECT_FALSE(primitiveAccuracyCurve(PrimitiveShape::sphere(0.0f)).ok());
+}
+
+void expectSameSegments(const AccuracyCurve& a, const AccuracyCurve& b) {
+  ASSERT_EQ(a.segments().size(), b.segments().size());
+  for (std::size_t i = 0; i < a.segments().size(); ++i) {
+    EXPECT_EQ(a.segments()[i].start, b.segments()[i].start) << "segment " << i;
+    EXPECT_EQ(a.segments()[i].value, b.segments()[i].value) << "segment " << i;
+    EXPECT_EQ(a.segments()[i].slope, b.segments()[i].slope) << "segment " << i;
+  }
+}
+
+// primitiveAccuracyCurve remembers the curves it fitted (by their exact
+// inputs): a repeated call gives the same curve bit for bit, and inputs that
+// differ in any field, even by one ulp or in the options, are not confused.
+TEST(PrimitiveCurves, RepeatedCallsGiveTheSameCurveAndNeighboursTheirOwn) {
+  PrimitiveCurveOptions options;
+  options.maxTriangles = 2048;
+  const PrimitiveShape cone = PrimitiveShape::cone(0.377f, 1.913f);
+  Result<AccuracyCurve> first = primitiveAccuracyCurve(cone, options);
+  Result<AccuracyCurve> again = primitiveAccuracyCurve(cone, options);
+  ASSERT_TRUE(first.ok() && again.ok());
+  expectSameSegments(*first, *again);
+
+  // A cone one ulp taller and the same cone with a part left out: their own
+  // curves, each the same as a second call of its own.
+  PrimitiveShape taller = cone;
+  taller.height = std::nextafter(cone.height, 10.0f);
+  PrimitiveShape open = cone;
+  open.bottom = false;
+  for (const PrimitiveShape& other : {taller, open}) {
+    Result<AccuracyCurve> c = primitiveAccuracyCurve(other, options);
+    Result<AccuracyCurve> c2 = primitiveAccuracyCurve(other, options);
+    ASSERT_TRUE(c.ok() && c2.ok());
+    expectSameSegments(*c, *c2);
+  }
+  Result<AccuracyCurve> openCurve = primitiveAccuracyCurve(open, options);
+  ASSERT_TRUE(openCurve.ok());
+  EXPECT_LT(openCurve->resourcesFor(openCurve->minAccuracy()),
+            first->resourcesFor(first->minAccuracy()))
+      << "no bottom disc: fewer triangles than the closed cone's curve";
+  // Other options: a shorter ladder ends at a lower top accuracy.
+  PrimitiveCurveOptions shortLadder = options;
+  shortLadder.maxTriangles = 64;
+  Result<AccuracyCurve> shortCurve = primitiveAccuracyCurve(cone, shortLadder);
+  ASSERT_TRUE(shortCurve.ok());
+  EXPECT_LT(shortCurve->maxAccuracy(), first->maxAccuracy());
+}
+
+// Threads asking for curves at once (the memo is shared) get what one
+// thread alone gets.
+TEST(PrimitiveCurves, ConcurrentCallsGiveTheSequentialCurves) {
+  PrimitiveCurveOptions options;
+  options.maxTriangles = 512;
+  std::vector<PrimitiveShape> shapes;
+  for (int i = 0; i < 24; ++i) {
+    const float r = 0.5f + 0.0371f * float(i % 6);
+    shapes.push_back(i % 3 == 0   ? PrimitiveShape::sphere(r)
+                     : i % 3 == 1 ? PrimitiveShape::cylinder(r, 1.0f + 0.1f * float(i))
+                                  : PrimitiveShape::cone(r, 1.0f + 0.1f * float(i)));
+  }
+  std::vector<AccuracyCurve> sequential;
+  for (const PrimitiveShape& s : shapes) {
+    Result<AccuracyCurve> c = primitiveAccuracyCurve(s, options);
+    ASSERT_TRUE(c.ok());
+    sequential.push_back(*c);
+  }
+  std::vector<std::vector<AccuracyCurve>> perThread(4);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (std::size_t i = 0; i < shapes.size(); ++i) {
+        const PrimitiveShape& s = shapes[(i + 5 * std::size_t(t)) % shapes.size()];
+        Result<AccuracyCurve> c = primitiveAccuracyCurve(s, options);
+        perThread[t].push_back(c.ok() ? *c : AccuracyCurve());
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  for (int t = 0; t < 4; ++t) {
+    for (std::size_t i = 0; i < shapes.size(); ++i) {
+      expectSameSegments(perThread[t][i], sequential[(i + 5 * std::size_t(t)) % shapes.size()]);
+    }
+  }
 }
 
 }  // namespace

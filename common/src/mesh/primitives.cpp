@@ -5,8 +5,11 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace thinlod {
@@ -503,6 +506,53 @@ IndexedMesh tessellate(const PrimitiveShape& s, const TessellationParams& p) {
   return IndexedMesh();
 }
 
+namespace {
+
+// primitiveAccuracyCurve's exact inputs (a valid shape: no NaN, so == is a
+// total order on the floats).
+using CurveKey = std::tuple<int, float, float, float, float, float, bool, bool, bool, int, int>;
+
+CurveKey curveKey(const PrimitiveShape& s, const PrimitiveCurveOptions& options) {
+  return CurveKey{static_cast<int>(s.kind), s.radius,    s.height, s.boxSize.x,
+                  s.boxSize.y,             s.boxSize.z, s.side,   s.top,
+                  s.bottom,                options.maxTriangles,  options.maxSegments};
+}
+
+// Curves already fitted, by their exact inputs. The fit is a pure function of
+// them and costs milliseconds (a ladder of up to thousands of tessellations,
+// then fitConservative's bisection), while scenes repeat the same literal
+// primitive many times without DEF/USE (and the scene fuzzer re-parses the
+// same ones in most inputs). Bounded: cleared when full.
+class CurveMemo {
+ public:
+  std::optional<AccuracyCurve> find(const CurveKey& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto found = curves_.find(key);
+    if (found == curves_.end()) return std::nullopt;
+    return found->second;
+  }
+  void store(const CurveKey& key, const AccuracyCurve& curve) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (curves_.size() >= kMaxEntries) curves_.clear();
+    curves_.emplace(key, curve);
+  }
+
+ private:
+  static constexpr std::size_t kMaxEntries = 4096;
+  std::mutex mutex_;
+  std::map<CurveKey, AccuracyCurve> curves_;
+};
+
+CurveMemo& curveMemo() {
+  static CurveMemo memo;
+  return memo;
+}
+
+Result<AccuracyCurve> fitPrimitiveCurve(const PrimitiveShape& s,
+                                        const PrimitiveCurveOptions& options);
+
+}  // namespace
+
 Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
                                              const PrimitiveCurveOptions& options) {
   THINLOD_RETURN_IF_ERROR(validatePrimitive(s));
@@ -513,6 +563,18 @@ Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
   if (options.maxSegments < 1) {
     return Status(ErrorCode::kInvalidArgument, "primitive curve: maxSegments must be >= 1");
   }
+  const CurveKey key = curveKey(s, options);
+  if (std::optional<AccuracyCurve> known = curveMemo().find(key)) return std::move(*known);
+  Result<AccuracyCurve> fitted = fitPrimitiveCurve(s, options);
+  if (fitted.ok()) curveMemo().store(key, *fitted);
+  return fitted;
+}
+
+namespace {
+
+// primitiveAccuracyCurve without the memo (inputs checked by it).
+Result<AccuracyCurve> fitPrimitiveCurve(const PrimitiveShape& s,
+                                        const PrimitiveCurveOptions& options) {
   if (s.kind == PrimitiveKind::kBox) return AccuracyCurve::point(kExactRelativeAccuracy, 12.0);
   std::vector<AccuracySample> ladder;
   auto add = [&](const TessellationParams& p) {
@@ -537,5 +599,7 @@ Result<AccuracyCurve> primitiveAccuracyCurve(const PrimitiveShape& s,
   if (ladder.empty()) add(chooseTessellation(s, 0));  // budget below the coarsest
   return AccuracyCurve::fitConservative(std::move(ladder), options.maxSegments);
 }
+
+}  // namespace
 
 }  // namespace thinlod

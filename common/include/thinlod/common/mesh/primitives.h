@@ -27,7 +27,9 @@
 //   holds it to 1.10x on 4096-triangle ladders.
 // - Invalid shapes (non-finite or non-positive sizes, no parts) are rejected
 //   by validatePrimitive(); other functions assert it.
-// - Pure functions, no I/O, thread-safe.
+// - Pure functions, no I/O, thread-safe. primitiveAccuracyCurve remembers
+//   the curves it fitted by their exact inputs (process-wide, at most 4096,
+//   behind a mutex): the same inputs give the same curve bit for bit.
 #pragma once
 
 #include <cstdint>
