@@ -6,7 +6,10 @@
 // mutations reach Draco.
 //
 // Oracle: a decoded mesh passes IndexedMesh::validate, has the vertex and
-// triangle counts the header declared, and stays within the limits.
+// triangle counts the header declared, and stays within the limits. The
+// same frame also goes through decodeSkinnedMesh (skinned levels, attribute
+// bit 8): its mesh is the one decodeMesh gives, and a skin it returns has
+// one valid two-bone entry per vertex.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -30,6 +33,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::fprintf(stderr,
                  "codec mesh fuzz oracle: decoded %zu vertices / %zu triangles, header %u / %u\n",
                  mesh->vertexCount(), mesh->triangleCount(), vertices, triangles);
+    std::abort();
+  }
+  Result<codec::SkinnedMeshFrame> skinned =
+      codec::decodeSkinnedMesh(frame.data(), frame.size(), limits);
+  if (!skinned.ok()) return 0;
+  if (skinned->mesh.positions != mesh->positions || skinned->mesh.indices != mesh->indices) {
+    std::fprintf(stderr, "codec mesh fuzz oracle: decodeSkinnedMesh's mesh differs\n");
+    std::abort();
+  }
+  if (!skinned->skin.empty() &&
+      !anim::validateSkin(skinned->skin, mesh->vertexCount(), codec::kMaxSkinBones, "fuzz")
+           .ok()) {
+    std::fprintf(stderr, "codec mesh fuzz oracle: decoded skin of %zu entries is invalid\n",
+                 skinned->skin.size());
     std::abort();
   }
   return 0;

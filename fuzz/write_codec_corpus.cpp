@@ -104,6 +104,31 @@ int main(int argc, char** argv) {
     }
     ok &= write(root / "codec_mesh" / (std::string(seed.name) + ".bin"), *frame);
   }
+  // Skinned frames (attribute bit 8, encodeSkinnedMesh): rigid and two-bone
+  // vertices, with and without the other attributes, sequential and
+  // edgebreaker coding.
+  const MeshSeed skinnedMeshes[] = {
+      {"skinned_positions_speed5", false, false, false, 5, 14},
+      {"skinned_all_speed10", true, true, true, 10, 14},
+  };
+  for (const MeshSeed& seed : skinnedMeshes) {
+    const IndexedMesh mesh = grid(4, seed.normals, seed.uvs, seed.colors);
+    std::vector<thinlod::anim::VertexSkin> skin(mesh.vertexCount());
+    for (std::size_t v = 0; v < skin.size(); ++v) {
+      skin[v].boneA = static_cast<std::uint32_t>(v % 3);
+      skin[v].boneB = static_cast<std::uint32_t>(v % 3 == 0 ? 0 : 3 + v % 2);
+      skin[v].weightB = skin[v].boneA == skin[v].boneB ? 0.0f : 0.25f * float(1 + v % 3);
+    }
+    codec::MeshEncodeOptions options;
+    options.encodeSpeed = options.decodeSpeed = seed.speed;
+    options.positionBits = seed.bits;
+    const auto frame = codec::encodeSkinnedMesh(mesh, skin, options);
+    if (!frame.ok()) {
+      std::fprintf(stderr, "%s: %s\n", seed.name, frame.status().toString().c_str());
+      return 1;
+    }
+    ok &= write(root / "codec_mesh" / (std::string(seed.name) + ".bin"), *frame);
+  }
   // Hybrid frames: points only, triangles and points, with and without
   // normals, at each Draco point-cloud method (speed 10: sequential; below:
   // kd-tree).
