@@ -116,6 +116,28 @@ std::vector<NamedMessage> seedMessages() {
 
   out.push_back({"scene_update_empty", SceneUpdate{18, 341, 12.5, {}, {}}});
 
+  // Animated objects' bone poses (docs/protocol.md, "Bone poses"): a skinned
+  // mesh added and two objects' poses, one of three bones, one of one.
+  SceneUpdate posed;
+  posed.plan = 19;
+  posed.frame = 342;
+  posed.targetAccuracy = 12.5;
+  SceneOperation skinnedMesh;
+  skinnedMesh.objectId = 300;
+  skinnedMesh.representation = sampleRepresentation(RepresentationKind::kMesh, 120, 0);
+  posed.operations.push_back(std::move(skinnedMesh));
+  BonePose three;
+  three.objectId = 300;
+  for (int b = 0; b < 3; ++b) {
+    glm::mat4 m(1.0f);
+    m[3] = glm::vec4(0.1f * float(b), 0.5f, -0.25f * float(b), 1.0f);
+    m[0][0] = 1.0f - 0.05f * float(b);
+    three.matrices.push_back(m);
+  }
+  posed.bonePoses.push_back(std::move(three));
+  posed.bonePoses.push_back(BonePose{301, {glm::mat4(1.0f)}});
+  out.push_back({"scene_update_bone_poses", posed});
+
   SimplifyRequest byPath;
   byPath.requestId = 5;
   byPath.objectId = 100;
