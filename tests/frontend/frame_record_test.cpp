@@ -62,13 +62,13 @@ TEST(FrameRecord, HeaderHasTheRequiredColumnsInOrder) {
             "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
             "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,"
             "wait_ms,updates_received,updates_rejected,lockstep_timeout,shown_at_ms,"
-            "visible_objects,missing_objects,blank\n");
+            "visible_objects,missing_objects,blank,skinned_objects,deformed_vertices\n");
 }
 
 TEST(FrameRecord, RowFormatsEveryColumn) {
   EXPECT_EQ(formatFrameCsvRow(sampleRecord()),
             "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,31.5000,3,2,524288,"
-            "20.2500,3.5000,1,0,1,400.1250,7,2,0\n");
+            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0\n");
 }
 
 TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
@@ -76,7 +76,7 @@ TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
   r.frame = 1;
   r.quality.snrDb = kInf;
   r.quality.psnrDb = kInf;
-  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,\n");
+  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0\n");
   r.quality.snrDb = -kInf;
   EXPECT_NE(formatFrameCsvRow(r).find(",-inf,"), std::string::npos);
 }

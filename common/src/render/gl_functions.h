@@ -82,7 +82,8 @@
   X(glTexParameteri, PFNGLTEXPARAMETERIPROC)                     \
   X(glTexImage3D, PFNGLTEXIMAGE3DPROC)                           \
   X(glTexSubImage3D, PFNGLTEXSUBIMAGE3DPROC)                     \
-  X(glGenerateMipmap, PFNGLGENERATEMIPMAPPROC)
+  X(glGenerateMipmap, PFNGLGENERATEMIPMAPPROC)                   \
+  X(glTexBuffer, PFNGLTEXBUFFERPROC)
 
 namespace thinlod::render {
 

@@ -1,5 +1,6 @@
 #include "thinlod/common/render/mesh_renderer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -34,7 +35,16 @@ struct MeshRecord {
   GLuint indexBuffer = 0;
   GLsizei indexCount = 0;
   bool hasLayers = false;
+  GLuint skinBuffer = 0;          // skinned meshes: (bone A, bone B, weight) per vertex
+  std::uint32_t bonesNeeded = 0;  // highest bone + 1; 0: not skinned
 };
+
+void deleteRecord(const GlFunctions& gl, const MeshRecord& record) {
+  gl.glDeleteVertexArrays(1, &record.vertexArray);
+  gl.glDeleteBuffers(1, &record.vertexBuffer);
+  gl.glDeleteBuffers(1, &record.indexBuffer);
+  if (record.skinBuffer != 0) gl.glDeleteBuffers(1, &record.skinBuffer);
+}
 
 struct TextureRecord {
   GLuint texture = 0;
@@ -70,7 +80,7 @@ struct Program {
   GLuint id = 0;
   struct {
     GLint model, viewProjection, normalMatrix, diffuse, specular, shininess, layer, alphaCutoff,
-        texture, ambient, lightVector, lightColor, lightAttenuation, eyePosition;
+        texture, ambient, lightVector, lightColor, lightAttenuation, eyePosition, bones;
   } uniform{};
   bool frameUniformsSet = false;  // within the current draw()
 };
@@ -87,14 +97,17 @@ constexpr VariantKey kVertexLayers = 1u << 4;
 constexpr int kAlphaShift = 5;       // 2 bits
 constexpr int kLightCountShift = 7;  // 3 bits
 constexpr int kLightTypeShift = 10;  // one bit per light: 1 = point
+constexpr VariantKey kSkinned = 1u << (kLightTypeShift + kMaxLights);
 
 bool hasSpecular(const Material& m) { return m.specular != glm::vec3(0.0f); }
 
-VariantKey variantOf(const Material& m, bool meshHasLayers, const Lighting& lighting) {
+VariantKey variantOf(const Material& m, bool meshHasLayers, const Lighting& lighting,
+                     bool skinned) {
   VariantKey key = static_cast<VariantKey>(m.alphaMode == AlphaMode::kOpaque ? 0
                                            : m.alphaMode == AlphaMode::kMask ? 1
                                                                              : 2)
                    << kAlphaShift;
+  if (skinned) key |= kSkinned;
   if (m.useVertexColors) key |= kVertexColors;
   if (m.texture.valid()) {
     key |= kTextured;
@@ -122,6 +135,7 @@ std::string definesOf(VariantKey key) {
   }
   return flag("LIT", kLit) + flag("SPECULAR", kSpecular) + flag("TEXTURED", kTextured) +
          flag("VERTEX_COLORS", kVertexColors) + flag("VERTEX_LAYERS", kVertexLayers) +
+         flag("SKINNED", kSkinned) +
          "#define ALPHA_MODE " + std::to_string((key >> kAlphaShift) & 3u) + "\n" +
          "#define LIGHT_COUNT " + std::to_string(lightCount) + "\n" + "#define LIGHT_TYPES " +
          types + ")\n";
@@ -168,8 +182,10 @@ Status buildProgram(const GlFunctions& gl, VariantKey key, Program& program) {
   u.lightColor = location("uLightColor");
   u.lightAttenuation = location("uLightAttenuation");
   u.eyePosition = location("uEyePosition");
+  u.bones = location("uBones");
   gl.glUseProgram(id);
   gl.glUniform1i(u.texture, 0);
+  gl.glUniform1i(u.bones, static_cast<GLint>(kBoneTextureUnit));
   gl.glUseProgram(0);
   program.id = id;
   return checkGlErrors(gl, "building a mesh shader variant");
@@ -187,6 +203,10 @@ struct MeshRenderer::Impl {
   GLint maxTextureLayers = 0;
   std::vector<GpuVertex> vertexScratch;
   std::vector<std::uint8_t> pixelScratch;
+  // Skinned draws: one buffer texture refilled with each item's bones.
+  GLuint boneBuffer = 0;
+  GLuint boneTexture = 0;
+  GLint maxTextureBufferTexels = 0;
 
   Status ensureProgram(const GlFunctions& gl, VariantKey key) {
     Program& program = programs[key];
@@ -208,11 +228,9 @@ MeshRenderer::MeshRenderer(OffscreenContext& context)
 MeshRenderer::~MeshRenderer() {
   if (!context_->isCurrent()) return;  // deleting in another context would be worse than leaking
   const GlFunctions& gl = context_->gl();
-  for (auto& entry : impl_->meshes) {
-    gl.glDeleteVertexArrays(1, &entry.second.vertexArray);
-    gl.glDeleteBuffers(1, &entry.second.vertexBuffer);
-    gl.glDeleteBuffers(1, &entry.second.indexBuffer);
-  }
+  for (auto& entry : impl_->meshes) deleteRecord(gl, entry.second);
+  if (impl_->boneBuffer != 0) gl.glDeleteBuffers(1, &impl_->boneBuffer);
+  if (impl_->boneTexture != 0) gl.glDeleteTextures(1, &impl_->boneTexture);
   for (auto& entry : impl_->textures) gl.glDeleteTextures(1, &entry.second.texture);
   for (const auto& [key, program] : impl_->programs) {
     if (program.id != 0) gl.glDeleteProgram(program.id);
@@ -226,8 +244,10 @@ Result<std::unique_ptr<MeshRenderer>> MeshRenderer::create(OffscreenContext& con
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "before MeshRenderer::create"));
   Impl& impl = *renderer->impl_;
   // The default variant is built now so a broken GL fails here, not mid-frame.
-  THINLOD_RETURN_IF_ERROR(impl.ensureProgram(gl, variantOf(Material(), false, Lighting())));
+  THINLOD_RETURN_IF_ERROR(
+      impl.ensureProgram(gl, variantOf(Material(), false, Lighting(), false)));
   gl.glGetIntegerv(GL_MAX_TEXTURE_SIZE, &impl.maxTextureSize);
+  gl.glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &impl.maxTextureBufferTexels);
   gl.glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &impl.maxTextureLayers);
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "MeshRenderer::create"));
   return renderer;
@@ -331,12 +351,60 @@ Result<MeshHandle> MeshRenderer::uploadMesh(const IndexedMesh& mesh,
   return MeshHandle{id};
 }
 
+Result<MeshHandle> MeshRenderer::uploadSkinnedMesh(const IndexedMesh& mesh,
+                                                   const std::vector<anim::VertexSkin>& skin) {
+  if (!context_->isCurrent()) return notCurrent("MeshRenderer::uploadSkinnedMesh");
+  THINLOD_RETURN_IF_ERROR(mesh.validate("uploaded skinned mesh"));
+  THINLOD_RETURN_IF_ERROR(
+      anim::validateSkin(skin, mesh.vertexCount(), 1u << 16, "uploaded skinned mesh"));
+  // A rigid vertex fetches its one bone twice: an unused second bone (weight
+  // 0) could name a matrix the draw does not have.
+  std::vector<float> values;
+  values.reserve(skin.size() * 3);
+  std::uint32_t bonesNeeded = 0;
+  for (const anim::VertexSkin& v : skin) {
+    const std::uint32_t boneB = v.rigid() ? v.boneA : v.boneB;
+    values.push_back(static_cast<float>(v.boneA));
+    values.push_back(static_cast<float>(boneB));
+    values.push_back(v.rigid() ? 0.0f : v.weightB);
+    bonesNeeded = std::max({bonesNeeded, v.boneA + 1, boneB + 1});
+  }
+  Result<MeshHandle> handle = uploadMesh(mesh);
+  if (!handle.ok()) return handle;
+  MeshRecord& record = impl_->meshes.find(handle->id)->second;
+  const GlFunctions& gl = context_->gl();
+  gl.glGenBuffers(1, &record.skinBuffer);
+  gl.glBindVertexArray(record.vertexArray);
+  gl.glBindBuffer(GL_ARRAY_BUFFER, record.skinBuffer);
+  gl.glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(values.size() * sizeof(float)),
+                  values.data(), GL_STATIC_DRAW);
+  gl.glEnableVertexAttribArray(kAttributeSkin);
+  gl.glVertexAttribPointer(kAttributeSkin, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  gl.glBindVertexArray(0);
+  record.bonesNeeded = bonesNeeded;
+  Status status = checkGlErrors(gl, "MeshRenderer::uploadSkinnedMesh");
+  if (!status.ok()) {
+    deleteMesh(*handle);
+    return status;
+  }
+  return handle;
+}
+
+std::uint32_t MeshRenderer::bonesNeeded(MeshHandle handle) const {
+  auto it = impl_->meshes.find(handle.id);
+  return it == impl_->meshes.end() ? 0 : it->second.bonesNeeded;
+}
+
 Status MeshRenderer::updateMesh(MeshHandle handle, const IndexedMesh& mesh,
                                 const std::vector<std::uint16_t>& textureLayers) {
   if (!context_->isCurrent()) return notCurrent("MeshRenderer::updateMesh");
   auto it = impl_->meshes.find(handle.id);
   if (it == impl_->meshes.end()) {
     return Status(ErrorCode::kNotFound, "updateMesh: no mesh " + std::to_string(handle.id));
+  }
+  if (it->second.bonesNeeded != 0) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "updateMesh: mesh " + std::to_string(handle.id) + " is skinned");
   }
   THINLOD_RETURN_IF_ERROR(validateUpload(mesh, textureLayers));
   const GlFunctions& gl = context_->gl();
@@ -349,10 +417,7 @@ Status MeshRenderer::updateMesh(MeshHandle handle, const IndexedMesh& mesh,
 void MeshRenderer::deleteMesh(MeshHandle handle) {
   auto it = impl_->meshes.find(handle.id);
   if (it == impl_->meshes.end() || !context_->isCurrent()) return;
-  const GlFunctions& gl = context_->gl();
-  gl.glDeleteVertexArrays(1, &it->second.vertexArray);
-  gl.glDeleteBuffers(1, &it->second.vertexBuffer);
-  gl.glDeleteBuffers(1, &it->second.indexBuffer);
+  deleteRecord(context_->gl(), it->second);
   impl_->meshes.erase(it);
 }
 
@@ -516,6 +581,25 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
         !std::isfinite(m.shininess) || !std::isfinite(m.alphaCutoff)) {
       return Status(ErrorCode::kInvalidArgument, name + ": non-finite model matrix or material");
     }
+    const std::uint32_t needed = mesh->second.bonesNeeded;
+    if ((needed != 0) != (item.bones != nullptr)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    name + (needed != 0 ? ": a skinned mesh needs bones"
+                                        : ": bones given for a mesh that is not skinned"));
+    }
+    if (item.bones != nullptr) {
+      if (item.bones->size() < needed ||
+          item.bones->size() * 4 > static_cast<std::size_t>(impl_->maxTextureBufferTexels)) {
+        return Status(ErrorCode::kInvalidArgument,
+                      name + ": " + std::to_string(item.bones->size()) +
+                          " bone matrices, the skin needs " + std::to_string(needed) +
+                          " (at most " + std::to_string(impl_->maxTextureBufferTexels / 4) + ")");
+      }
+      for (const glm::mat4& bone : *item.bones) {
+        if (!allFinite(bone))
+          return Status(ErrorCode::kInvalidArgument, name + ": a bone matrix is not finite");
+      }
+    }
     if (m.texture.valid()) {
       auto texture = impl_->textures.find(m.texture.id);
       if (texture == impl_->textures.end()) {
@@ -532,10 +616,25 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
 
   const GlFunctions& gl = context_->gl();
   // Every variant the list needs exists before anything is drawn.
+  bool anySkinned = false;
   for (std::size_t i = 0; i < count; ++i) {
     const bool hasLayers = impl_->meshes.find(items[i].mesh.id)->second.hasLayers;
+    const bool skinned = items[i].bones != nullptr;
+    anySkinned = anySkinned || skinned;
     THINLOD_RETURN_IF_ERROR(
-        impl_->ensureProgram(gl, variantOf(items[i].material, hasLayers, lighting)));
+        impl_->ensureProgram(gl, variantOf(items[i].material, hasLayers, lighting, skinned)));
+  }
+  if (anySkinned && impl_->boneTexture == 0) {
+    gl.glGenBuffers(1, &impl_->boneBuffer);
+    gl.glGenTextures(1, &impl_->boneTexture);
+    gl.glActiveTexture(GL_TEXTURE0 + kBoneTextureUnit);
+    gl.glBindBuffer(GL_TEXTURE_BUFFER, impl_->boneBuffer);
+    gl.glBindTexture(GL_TEXTURE_BUFFER, impl_->boneTexture);
+    gl.glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, impl_->boneBuffer);
+    gl.glBindTexture(GL_TEXTURE_BUFFER, 0);
+    gl.glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    gl.glActiveTexture(GL_TEXTURE0);
+    THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "MeshRenderer::draw: bone buffer texture"));
   }
   THINLOD_RETURN_IF_ERROR(impl_->target->bind());
   const glm::mat4 viewProjection = kMirrorClipY * camera.projection * camera.view;
@@ -555,8 +654,8 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   for (auto& [key, program] : impl_->programs) program.frameUniformsSet = false;
   // Switches to the item's variant; camera and lights go to each variant once per draw().
   const Program* current = nullptr;
-  auto useProgram = [&](const Material& m, bool hasLayers) -> const Program& {
-    Program& program = impl_->programs.find(variantOf(m, hasLayers, lighting))->second;
+  auto useProgram = [&](const Material& m, bool hasLayers, bool skinned) -> const Program& {
+    Program& program = impl_->programs.find(variantOf(m, hasLayers, lighting, skinned))->second;
     if (&program == current) return program;
     current = &program;
     gl.glUseProgram(program.id);
@@ -604,7 +703,18 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
       } else {
         gl.glEnable(GL_CULL_FACE);
       }
-      const auto& u = useProgram(m, mesh.hasLayers).uniform;
+      const auto& u = useProgram(m, mesh.hasLayers, item.bones != nullptr).uniform;
+      if (item.bones != nullptr) {
+        // The buffer is refilled per item; GL orders it after earlier draws' reads.
+        gl.glBindBuffer(GL_TEXTURE_BUFFER, impl_->boneBuffer);
+        gl.glBufferData(GL_TEXTURE_BUFFER,
+                        static_cast<GLsizeiptr>(item.bones->size() * sizeof(glm::mat4)),
+                        item.bones->data(), GL_STREAM_DRAW);
+        gl.glBindBuffer(GL_TEXTURE_BUFFER, 0);
+        gl.glActiveTexture(GL_TEXTURE0 + kBoneTextureUnit);
+        gl.glBindTexture(GL_TEXTURE_BUFFER, impl_->boneTexture);
+        gl.glActiveTexture(GL_TEXTURE0);
+      }
       gl.glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
       gl.glUniform4fv(u.diffuse, 1, glm::value_ptr(m.diffuse));
       if (m.lit) {
@@ -632,6 +742,11 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
     }
   }
   gl.glBindVertexArray(0);
+  if (anySkinned) {
+    gl.glActiveTexture(GL_TEXTURE0 + kBoneTextureUnit);
+    gl.glBindTexture(GL_TEXTURE_BUFFER, 0);
+    gl.glActiveTexture(GL_TEXTURE0);
+  }
   gl.glDisable(GL_BLEND);
   gl.glDepthMask(GL_TRUE);
   gl.glFrontFace(GL_CCW);  // GL's default, for any other code in this context
@@ -640,10 +755,11 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
 }
 
 Status MeshRenderer::prepare(const Material& material, bool meshHasLayers,
-                             const Lighting& lighting) {
+                             const Lighting& lighting, bool skinned) {
   if (!context_->isCurrent()) return notCurrent("MeshRenderer::prepare");
   THINLOD_RETURN_IF_ERROR(validateLighting(lighting, "prepare"));
-  return impl_->ensureProgram(context_->gl(), variantOf(material, meshHasLayers, lighting));
+  return impl_->ensureProgram(context_->gl(),
+                              variantOf(material, meshHasLayers, lighting, skinned));
 }
 
 Status MeshRenderer::finish() {

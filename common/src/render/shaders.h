@@ -13,9 +13,12 @@ constexpr unsigned kAttributeNormal = 1;
 constexpr unsigned kAttributeUv = 2;
 constexpr unsigned kAttributeColor = 3;
 constexpr unsigned kAttributeLayer = 4;
+constexpr unsigned kAttributeSkin = 5;  // skinned meshes: (bone A, bone B, weight of B)
+// Texture unit of the bone matrices' buffer texture (unit 0 is the colour texture).
+constexpr unsigned kBoneTextureUnit = 1;
 
 // Prepended to both stages: "#version 330 core\n", then one line per define:
-// LIT, SPECULAR, TEXTURED, VERTEX_COLORS, VERTEX_LAYERS (0/1); ALPHA_MODE (0 opaque:
+// LIT, SPECULAR, TEXTURED, VERTEX_COLORS, VERTEX_LAYERS, SKINNED (0/1); ALPHA_MODE (0 opaque:
 // alpha written as 1; 1 mask: discard below the cutoff, alpha written as 1;
 // 2 blend: alpha as computed); LIGHT_COUNT (0..4) and LIGHT_TYPES (int[4]
 // constructor, 0 directional, 1 point), constants so the light loop unrolls.
@@ -29,6 +32,19 @@ layout(location = 4) in float aLayer;
 uniform mat4 uModel;
 uniform mat4 uViewProjection;
 uniform mat3 uNormalMatrix;
+
+#if SKINNED
+// ASLOD's two-bone rule, P = (1 - s) T_A P_A + s T_B P_B (anim::deform is the
+// CPU reference): bone matrices are four RGBA32F texels (columns) each in a
+// buffer texture, so the palette's size is not bounded by uniform space.
+layout(location = 5) in vec3 aSkin;
+uniform samplerBuffer uBones;
+mat4 boneMatrix(float bone) {
+  int base = int(bone) * 4;
+  return mat4(texelFetch(uBones, base), texelFetch(uBones, base + 1),
+              texelFetch(uBones, base + 2), texelFetch(uBones, base + 3));
+}
+#endif
 
 #if LIT
 out vec3 vWorldPosition;
@@ -45,10 +61,19 @@ out vec4 vColor;
 #endif
 
 void main() {
-  vec4 world = uModel * vec4(aPosition, 1.0);
+  vec3 position = aPosition;
+  vec3 normal = aNormal;
+#if SKINNED
+  mat4 boneA = boneMatrix(aSkin.x);
+  mat4 boneB = boneMatrix(aSkin.y);
+  position = mix((boneA * vec4(aPosition, 1.0)).xyz, (boneB * vec4(aPosition, 1.0)).xyz, aSkin.z);
+  // The bones' linear parts blended (exact for rotations and uniform scales).
+  normal = mix(mat3(boneA) * aNormal, mat3(boneB) * aNormal, aSkin.z);
+#endif
+  vec4 world = uModel * vec4(position, 1.0);
 #if LIT
   vWorldPosition = world.xyz;
-  vNormal = uNormalMatrix * aNormal;
+  vNormal = uNormalMatrix * normal;
 #endif
 #if TEXTURED
   vUv = aUv;

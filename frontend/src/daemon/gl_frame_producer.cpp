@@ -104,6 +104,8 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   produced.renderMs = report->timing.totalMs;
   produced.drawCalls = report->drawCalls;
   produced.uploadedBytes = report->uploadedBytes;
+  produced.skinnedObjects = report->skinnedObjects;
+  produced.deformedVertices = report->deformedVertices;
   std::vector<protocol::HeldRepresentation> held = heldRepresentations(renderer_->scene());
   if (held != lastHeld_) {
     lastHeld_ = held;

@@ -248,6 +248,8 @@ class Replay {
     record.renderMs = produced.renderMs;
     record.drawCalls = produced.drawCalls;
     record.uploadedBytes = produced.uploadedBytes;
+    record.skinnedObjects = produced.skinnedObjects;
+    record.deformedVertices = produced.deformedVertices;
     if (produced.droppedBatches > 0) observer_.onUploadDropped(frame, produced.lastUploadError);
     refusedPlans_.insert(refusedPlans_.end(), produced.droppedPlans.begin(),
                          produced.droppedPlans.end());

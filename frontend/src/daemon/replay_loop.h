@@ -119,6 +119,8 @@ struct ProducedFrame {
   double renderMs = 0.0;
   std::size_t drawCalls = 0;
   std::size_t uploadedBytes = 0;
+  std::size_t skinnedObjects = 0;    // FrameReport::skinnedObjects
+  std::size_t deformedVertices = 0;  // FrameReport::deformedVertices
   // Set when what the frontend holds changed since the previous frame
   // (heldRepresentations of the scene drawn); the loop hands it to
   // BackboneLink::setHeld.

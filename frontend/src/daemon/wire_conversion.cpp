@@ -154,17 +154,22 @@ Result<Representation> convertOne(const protocol::Representation& wire, std::uin
                                std::to_string(wire.triangleCount) + " triangles");
     }
   } else {
-    Result<IndexedMesh> mesh =
-        codec::decodeMesh(wire.mesh.data(), wire.mesh.size(), options.limits);
-    if (!mesh.ok()) {
-      return Status(mesh.status().code(), what + ": mesh: " + mesh.status().message());
+    Result<codec::SkinnedMeshFrame> frame =
+        codec::decodeSkinnedMesh(wire.mesh.data(), wire.mesh.size(), options.limits);
+    if (!frame.ok()) {
+      return Status(frame.status().code(), what + ": mesh: " + frame.status().message());
     }
-    if (mesh->triangleCount() != wire.triangleCount) {
-      return invalid(what, "mesh has " + std::to_string(mesh->triangleCount()) +
+    if (frame->mesh.triangleCount() != wire.triangleCount) {
+      return invalid(what, "mesh has " + std::to_string(frame->mesh.triangleCount()) +
                                " triangles, the representation announces " +
                                std::to_string(wire.triangleCount));
     }
-    rep.mesh = std::make_shared<const IndexedMesh>(std::move(mesh).value());
+    // A skinned level (an animated object, docs/animation.md): kMesh only.
+    if (!frame->skin.empty()) {
+      if (rep.kind != RepresentationKind::kMesh) return invalid(what, kindName + " carries a skin");
+      rep.skin = std::make_shared<const std::vector<anim::VertexSkin>>(std::move(frame->skin));
+    }
+    rep.mesh = std::make_shared<const IndexedMesh>(std::move(frame->mesh));
   }
 
   Result<std::shared_ptr<const RgbaImage>> texture =
@@ -283,6 +288,11 @@ Result<SceneBatch> convertUpdate(const protocol::SceneUpdate& update,
     }
     batch.operations.push_back(std::move(op));
   }
+  // Bone poses (validated on decode: finite, affine, ids unique) ride with
+  // the batch and apply when it commits.
+  batch.bonePoses.reserve(update.bonePoses.size());
+  for (const protocol::BonePose& pose : update.bonePoses)
+    batch.bonePoses.emplace_back(pose.objectId, pose.matrices);
   return batch;
 }
 
@@ -292,6 +302,8 @@ std::size_t payloadBytes(const protocol::SceneUpdate& update) {
     bytes += op.representation.mesh.size() + op.representation.texture.data.size();
   }
   for (const protocol::SharedTexture& shared : update.textures) bytes += shared.texture.data.size();
+  // Bone poses: three rows of four floats a matrix, as the wire carries them.
+  for (const protocol::BonePose& pose : update.bonePoses) bytes += 48 * pose.matrices.size();
   return bytes;
 }
 

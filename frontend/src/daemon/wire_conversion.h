@@ -7,6 +7,8 @@
 // - The update is converted whole or not at all: the first bad operation
 //   makes the result an error naming the update (plan, frame), the operation
 //   index, the object id and the field; no partial batch is ever returned.
+// - Skinned meshes: a kMesh frame with a skin (codec::decodeSkinnedMesh)
+//   becomes Representation::skin; the update's bone poses go into the batch.
 // - Meshes: Draco frames (codec::decodeMesh, bounded by `limits`); kMesh and
 //   kMeshedImpostor need mesh bytes; a kSimpleImpostor with no mesh bytes gets
 //   a null mesh (the unit quad placed by `transform`). triangleCount on the

@@ -72,7 +72,7 @@ std::string frameCsvHeader() {
   return "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
          "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,wait_ms,"
          "updates_received,updates_rejected,lockstep_timeout,shown_at_ms,visible_objects,"
-         "missing_objects,blank\n";
+         "missing_objects,blank,skinned_objects,deformed_vertices\n";
 }
 
 std::string formatFrameCsvRow(const FrameRecord& r) {
@@ -100,6 +100,8 @@ std::string formatFrameCsvRow(const FrameRecord& r) {
   row += ',' + formatCount(r.quality.visibleObjects);
   row += ',' + formatCount(r.quality.missingObjects);
   row += ',' + formatCount(r.quality.blank);
+  row += ',' + std::to_string(r.skinnedObjects);
+  row += ',' + std::to_string(r.deformedVertices);
   row += '\n';
   return row;
 }

@@ -41,6 +41,12 @@ struct GpuPart {
   IndexedMesh world;  // baked to world space, uvs mapped into the layer
   std::vector<std::uint16_t> layers;
   DiscPoints worldDiscs;  // kHybrid: world space, base colour x representation colour
+  // A skinned mesh (Representation::skin): its own GPU mesh in the content
+  // frame, drawn alone with its bone pose (not merged: the vertex shader
+  // deforms it), and its material; `world` stays empty.
+  render::MeshHandle skinnedMesh;
+  render::Material skinnedMaterial;
+  std::size_t skinnedVertices = 0;
 };
 
 bool sameLighting(const render::Lighting& a, const render::Lighting& b) {
@@ -155,6 +161,7 @@ struct FrontendRenderer::Impl {
   void releasePart(RepresentationKey key) {
     auto it = parts.find(key);
     if (it == parts.end()) return;
+    if (it->second.skinnedMesh.valid()) renderer->deleteMesh(it->second.skinnedMesh);
     if (it->second.layer >= 0) pages[it->second.batch.page].freeLayers.push_back(it->second.layer);
     parts.erase(it);
   }
@@ -198,6 +205,7 @@ struct FrontendRenderer::Impl {
       part.batch.page = 0;
       batchPart.textureLayer = kWhiteLayer;
     }
+    if (rep.skin != nullptr) return uploadSkinned(object, batchPart, std::move(part));
     render::MeshBatch baked;
     Status status =
         rep.mesh->indices.empty()
@@ -209,6 +217,28 @@ struct FrontendRenderer::Impl {
     }
     part.world = baked.mesh();
     part.layers = baked.textureLayers();
+    parts[object.key] = std::move(part);
+    return Status();
+  }
+
+  // A skinned mesh goes up as it is (content frame, uvs into its layer) with
+  // its skin; the material carries what the batch would bake per vertex.
+  Status uploadSkinned(const SceneObject& object, const render::MeshBatch::Part& batchPart,
+                       GpuPart part) {
+    const Representation& rep = object.representation;
+    IndexedMesh mesh = *rep.mesh;
+    for (glm::vec2& uv : mesh.uvs) uv = uv * batchPart.uvScale + batchPart.uvOffset;
+    auto handle = renderer->uploadSkinnedMesh(mesh, *rep.skin);
+    if (!handle.ok()) {
+      if (part.layer >= 0) pages[part.batch.page].freeLayers.push_back(part.layer);
+      return handle.status();
+    }
+    part.skinnedMesh = *handle;
+    part.skinnedVertices = mesh.vertexCount();
+    render::Material& m = part.skinnedMaterial;
+    m = materialFor(part.batch);
+    m.diffuse = rep.color;
+    m.textureLayer = batchPart.textureLayer;
     parts[object.key] = std::move(part);
     return Status();
   }
@@ -444,6 +474,25 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
     item.mesh = batch.mesh;
     item.material = impl.materialFor(key);
     impl.items.push_back(item);
+  }
+  // Skinned objects, one draw each with their pose; one without a pose (or
+  // whose pose has fewer bones than its skin names) is not drawn this frame.
+  for (const auto& [id, object] : impl.scene.objects()) {
+    auto part = impl.parts.find(object.key);
+    if (part == impl.parts.end() || !part->second.skinnedMesh.valid()) continue;
+    const BoneMatrices* pose = impl.scene.bonePose(id);
+    if (pose == nullptr || pose->size() < impl.renderer->bonesNeeded(part->second.skinnedMesh)) {
+      ++report.skinnedWithoutPose;
+      continue;
+    }
+    render::DrawItem item;
+    item.mesh = part->second.skinnedMesh;
+    item.model = object.representation.transform;
+    item.material = part->second.skinnedMaterial;
+    item.bones = pose;
+    impl.items.push_back(item);
+    ++report.skinnedObjects;
+    report.deformedVertices += part->second.skinnedVertices;
   }
   THINLOD_RETURN_IF_ERROR(impl.renderer->beginFrame(*impl.target, impl.options.clearColor));
   THINLOD_RETURN_IF_ERROR(impl.renderer->draw(impl.items, camera, lighting));

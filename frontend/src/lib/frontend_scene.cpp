@@ -52,6 +52,15 @@ Status validateRepresentation(const Representation& rep, const std::string& what
       return Status(ErrorCode::kInvalidArgument, what + ": Hybrid has no triangles and no points");
     }
   }
+  if (rep.skin != nullptr) {
+    if (rep.kind != RepresentationKind::kMesh) {
+      return Status(ErrorCode::kInvalidArgument,
+                    what + ": " + representationKindName(rep.kind) + " carries a skin");
+    }
+    if (rep.mesh == nullptr) return Status(ErrorCode::kInvalidArgument, what + ": skin without a mesh");
+    THINLOD_RETURN_IF_ERROR(anim::validateSkin(*rep.skin, rep.mesh->vertexCount(),
+                                               kMaxBonesPerPose, what + " skin"));
+  }
   if (impostor && rep.texture == nullptr) {
     return Status(ErrorCode::kInvalidArgument,
                   what + ": " + representationKindName(rep.kind) + " needs a texture");
@@ -133,10 +142,25 @@ Status FrontendScene::enqueue(SceneBatch batch) {
     }
     THINLOD_RETURN_IF_ERROR(validateRepresentation(op.representation, what));
   }
+  std::unordered_set<ObjectId> posed;
+  for (const auto& [id, matrices] : batch.bonePoses) {
+    const std::string what = batchName + ", bone pose of object " + std::to_string(id);
+    if (!posed.insert(id).second)
+      return Status(ErrorCode::kInvalidArgument, what + ": object has two poses in the batch");
+    if (matrices.size() > kMaxBonesPerPose) {
+      return Status(ErrorCode::kResourceExhausted,
+                    what + ": " + std::to_string(matrices.size()) + " matrices (limit " +
+                        std::to_string(kMaxBonesPerPose) + ")");
+    }
+    for (const glm::mat4& m : matrices) {
+      if (!allFinite(m)) return Status(ErrorCode::kInvalidArgument, what + ": not finite");
+    }
+  }
 
   QueuedBatch queued;
   queued.sequence = nextSequence_++;
   queued.plan = batch.plan;
+  queued.bonePoses = std::move(batch.bonePoses);
   queued.types.reserve(batch.operations.size());
   queued.objects.reserve(batch.operations.size());
   for (SceneOperation& op : batch.operations) {
@@ -242,12 +266,20 @@ CommitResult FrontendScene::commitReady() {
           ++result.missingRemovals;
         } else {
           objects_.erase(held);
+          poses_.erase(incoming.id);
         }
         continue;
       }
       result.activated.push_back(incoming.key);
       polygons_ += incoming.triangleCount;
+      // A level of the same skinned object keeps the pose; an unskinned one drops it.
+      if (incoming.representation.skin == nullptr) poses_.erase(incoming.id);
       objects_[incoming.id] = std::move(incoming);
+    }
+    for (auto& [id, matrices] : batch.bonePoses) {
+      auto held = objects_.find(id);
+      if (held != objects_.end() && held->second.representation.skin != nullptr)
+        poses_[id] = std::move(matrices);
     }
     result.plans.push_back(batch.plan);
     lastPlan_ = batch.plan;
@@ -296,6 +328,11 @@ void FrontendScene::showFirstRepresentationsEarly(CommitResult& result) {
       touched.insert(incoming.id);
     }
   }
+}
+
+const BoneMatrices* FrontendScene::bonePose(ObjectId id) const {
+  auto it = poses_.find(id);
+  return it == poses_.end() ? nullptr : &it->second;
 }
 
 const SceneObject* FrontendScene::find(ObjectId id) const {

@@ -84,6 +84,10 @@ struct FrameRecord {
   std::size_t updatesRejected = 0;
   bool lockstepTimedOut = false;
   double shownAtMs = kMissing;  // readback done, ms after frame 0's pose was sampled
+  // Skinned objects drawn and the vertices of their levels the vertex
+  // shader deformed (FrameReport; docs/animation.md).
+  std::size_t skinnedObjects = 0;
+  std::size_t deformedVertices = 0;
   FrameQuality quality;         // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
 // FrameLog spills pending records as raw bytes.
@@ -92,7 +96,8 @@ static_assert(std::is_trivially_copyable_v<FrameRecord>);
 // "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,
 //  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,
 //  reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,
-//  shown_at_ms,visible_objects,missing_objects,blank\n"
+//  shown_at_ms,visible_objects,missing_objects,blank,skinned_objects,
+//  deformed_vertices\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);

@@ -13,7 +13,9 @@
 //   frame back (RGBA8, rows top-down, `width` x `height`).
 // - Batching: all textures live in layers of a few array textures ("pages");
 //   geometry is merged per (page, lit/unlit), so a frame costs about two draw
-//   calls per page used. Meshes are lit (with `lighting`); impostors are unlit
+//   calls per page used; a skinned mesh (Representation::skin) is drawn on
+//   its own with its bone pose (FrontendScene::bonePose), the vertex shader
+//   deforming only its level's vertices. Meshes are lit (with `lighting`); impostors are unlit
 //   (their lighting is baked in) and alpha-tested (or blended, unsorted).
 //   Only changed objects are re-uploaded; merged vertex buffers are rebuilt
 //   on frames where the set of drawn objects changes.
@@ -90,6 +92,12 @@ struct FrameReport {
   std::size_t texturePages = 0;
   std::uint64_t appliedPlan = 0;  // FrontendScene::lastAppliedPlan()
   std::size_t earlyPolygons = 0;  // FrontendScene::earlyPolygons()
+  // Skinned objects drawn (deformed in the vertex shader with their pose),
+  // the vertices of their held levels (the only ones deformed), and held
+  // skinned objects not drawn for want of a (large enough) pose.
+  std::size_t skinnedObjects = 0;
+  std::size_t deformedVertices = 0;
+  std::size_t skinnedWithoutPose = 0;
 };
 
 class FrontendRenderer {

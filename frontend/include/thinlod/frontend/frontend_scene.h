@@ -33,6 +33,13 @@
 //   display never exceeds the budget (FrontendSceneEarly.* tests it). Its
 //   batch still commits (and reports its plan) as a whole later; dropBatch()
 //   does not return the key of a representation already shown.
+// - Skinned meshes (docs/animation.md): a kMesh may carry a two-bone skin
+//   (one anim::VertexSkin per mesh vertex); a batch may carry bone poses
+//   (at most kMaxBonesPerPose finite, affine matrices per object, ids
+//   unique). Poses apply when their batch commits, after its operations, to
+//   objects then held with a skin; others are ignored. An object's pose
+//   stays until a newer one, its removal or its replacement by an unskinned
+//   representation.
 // - Removing an id that is not held is not an error (counted, see CommitResult).
 // - Keys: every queued representation gets a unique RepresentationKey, never
 //   reused, so GPU resources can be tracked by key across replacements.
@@ -46,12 +53,14 @@
 #include <glm/vec4.hpp>
 #include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "thinlod/common/core/disc_points.h"
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/representation_kind.h"
 #include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/core/status.h"
 
 namespace thinlod::frontend {
@@ -80,6 +89,9 @@ struct Representation {
   // pre-lights them). A hybrid needs triangles (mesh) or points or both; its
   // triangles are drawn lit like a kMesh.
   std::shared_ptr<const DiscPoints> points;
+  // kMesh only, optional: the mesh's skin (one entry per vertex, bones
+  // indexing the object's bone pose); the renderer then skins it.
+  std::shared_ptr<const std::vector<anim::VertexSkin>> skin;
 };
 
 struct SceneOperation {
@@ -89,9 +101,14 @@ struct SceneOperation {
   Representation representation;  // kAddOrReplace only
 };
 
+// One skinned object's bone matrices (mesh space -> object space).
+inline constexpr std::size_t kMaxBonesPerPose = 1024;
+using BoneMatrices = std::vector<glm::mat4>;
+
 struct SceneBatch {
   std::uint64_t plan = 0;  // the backbone's planning step, reported back when applied
   std::vector<SceneOperation> operations;
+  std::vector<std::pair<ObjectId, BoneMatrices>> bonePoses;  // applied after the operations
 };
 
 // One held (or queued) representation after validation.
@@ -162,6 +179,8 @@ class FrontendScene {
   // lastAppliedPlan() left (FrameStats.early_polygons).
   std::size_t earlyPolygons() const { return earlyPolygons_; }
   std::size_t pendingBatches() const { return pending_.size(); }
+  // The bone pose of a held skinned object, or null before its first.
+  const BoneMatrices* bonePose(ObjectId id) const;
   std::size_t pendingUploadBytes() const;
   std::uint64_t lastAppliedPlan() const { return lastPlan_; }
 
@@ -173,12 +192,14 @@ class FrontendScene {
     std::vector<SceneObject> objects;  // one per operation (removals: id only)
     std::vector<bool> uploaded;        // per operation; removals start true
     std::vector<bool> shownEarly;      // per operation: a first representation already held
+    std::vector<std::pair<ObjectId, BoneMatrices>> bonePoses;
   };
   // Activates first representations early (see the contract); appends to `result`.
   void showFirstRepresentationsEarly(CommitResult& result);
 
   SceneLimits limits_;
   std::map<ObjectId, SceneObject> objects_;
+  std::map<ObjectId, BoneMatrices> poses_;  // held skinned objects only
   std::deque<QueuedBatch> pending_;
   std::uint64_t nextSequence_ = 1;
   RepresentationKey nextKey_ = 1;

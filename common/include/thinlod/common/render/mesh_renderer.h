@@ -23,6 +23,12 @@
 //   no pixel pays for a feature it does not use. A variant is compiled the
 //   first time a draw needs it; prepare() compiles it ahead (e.g. before a
 //   frame with a deadline).
+// - Skinned meshes (uploadSkinnedMesh; docs/animation.md): each vertex
+//   depends on one or two bones (anim::VertexSkin) and the vertex shader
+//   deforms it, P = (1 - s) T_A P + s T_B P (anim::deform's formula), with
+//   the DrawItem's `bones` (at least one matrix per bone the skin names,
+//   finite) before `model`. Normals blend the bones' linear parts. Such a
+//   mesh cannot be updateMesh'd; a DrawItem with `bones` needs a skinned mesh.
 // - Errors: invalid input is kInvalidArgument; GL errors are kInternal, GL
 //   out-of-memory is kResourceExhausted; the message names the GL call.
 #pragma once
@@ -35,6 +41,7 @@
 
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/offscreen_context.h"
@@ -70,6 +77,9 @@ struct DrawItem {
   MeshHandle mesh;
   glm::mat4 model{1.0f};  // object -> world
   Material material;
+  // A skinned mesh's bone matrices (mesh space -> object space; entry i for
+  // the skin's bone i); null for any other mesh. Read during draw() only.
+  const std::vector<glm::mat4>* bones = nullptr;
 };
 
 struct TextureOptions {
@@ -97,6 +107,13 @@ class MeshRenderer {
   // Replaces the contents of an existing mesh (e.g. a batch rebuilt each frame).
   Status updateMesh(MeshHandle handle, const IndexedMesh& mesh,
                     const std::vector<std::uint16_t>& textureLayers = {});
+  // A mesh the vertex shader skins (see the contract); `skin` one entry per
+  // vertex, bones below 65536, weights in [0, 1] (anim::validateSkin).
+  Result<MeshHandle> uploadSkinnedMesh(const IndexedMesh& mesh,
+                                       const std::vector<anim::VertexSkin>& skin);
+  // Matrices a DrawItem of this skinned mesh needs (highest bone + 1); 0 for
+  // an unskinned or unknown mesh.
+  std::uint32_t bonesNeeded(MeshHandle handle) const;
   void deleteMesh(MeshHandle handle);
 
   Result<TextureHandle> uploadTexture(const RgbaImage& image, const TextureOptions& options = {});
@@ -119,7 +136,8 @@ class MeshRenderer {
   }
   // Compiles the shader variant that drawing `material` on a mesh with (or
   // without) per-vertex layers under `lighting` needs; cheap once it exists.
-  Status prepare(const Material& material, bool meshHasLayers, const Lighting& lighting);
+  Status prepare(const Material& material, bool meshHasLayers, const Lighting& lighting,
+                 bool skinned = false);
   // Waits for the GPU (for timing); readback already synchronises.
   Status finish();
 

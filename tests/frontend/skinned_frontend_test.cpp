@@ -1,0 +1,222 @@
+// The frontend's skinned objects (docs/animation.md, "Served"): a skinned
+// mesh with its bone pose is drawn deformed by the vertex shader exactly as
+// the CPU-deformed mesh (anim::deform) is drawn; poses apply with their
+// batch, only to held skinned objects; without a pose (or with too few
+// bones) the object is not drawn. FrontendScene's checks of skins and poses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "articulated_figure.h"
+#include "frontend_test_util.h"
+#include "thinlod/frontend/frontend_renderer.h"
+
+namespace thinlod::frontend {
+namespace {
+
+using render::Backend;
+using testing::addOp;
+using testing::backendParamName;
+using testing::flatLighting;
+using testing::orthoCamera;
+using testing::quadMesh;
+using testing::removeOp;
+using testing::solidImage;
+
+constexpr int kSize = 96;
+
+anim::testing::ArticulatedFigure figure() {
+  anim::testing::FigureShape shape;
+  shape.ringsPerUnit = 8;
+  shape.around = 12;
+  return anim::testing::makeArticulatedFigure(shape);
+}
+
+BoneMatrices poseAt(const anim::testing::ArticulatedFigure& f, double t) {
+  return anim::skinningMatrices(f.skeleton,
+                                anim::samplePose(f.skeleton, f.clip, t, anim::ClipWrap::kLoop));
+}
+
+SceneOperation skinnedOp(ObjectId id, const anim::testing::ArticulatedFigure& f,
+                         const glm::mat4& transform) {
+  SceneOperation op = addOp(id, RepresentationKind::kMesh,
+                            std::make_shared<const IndexedMesh>(f.mesh), nullptr, transform);
+  op.representation.skin = std::make_shared<const std::vector<anim::VertexSkin>>(f.skin);
+  return op;
+}
+
+const glm::mat4 kPlace = glm::translate(glm::mat4(1.0f), glm::vec3(-0.6f, -0.1f, 0.0f)) *
+                         glm::scale(glm::mat4(1.0f), glm::vec3(0.4f));
+
+class SkinnedFrontendTest : public ::testing::TestWithParam<Backend> {
+ protected:
+  void SetUp() override {
+    auto context = render::createOffscreenContext(GetParam(), kSize, kSize);
+    ASSERT_TRUE(context.ok()) << context.status().toString();
+    context_ = std::move(context).value();
+    FrontendRendererOptions options;
+    options.width = kSize;
+    options.height = kSize;
+    options.layerSize = 16;
+    options.layersPerPage = 4;
+    options.uploadBytesPerFrame = 1 << 22;
+    auto renderer = FrontendRenderer::create(*context_, options);
+    ASSERT_TRUE(renderer.ok()) << renderer.status().toString();
+    renderer_ = std::move(renderer).value();
+  }
+  void TearDown() override {
+    if (context_) (void)context_->makeCurrent();
+    renderer_.reset();
+    context_.reset();
+  }
+
+  void submit(std::uint64_t plan, std::vector<SceneOperation> ops,
+              std::vector<std::pair<ObjectId, BoneMatrices>> poses = {}) {
+    SceneBatch batch;
+    batch.plan = plan;
+    batch.operations = std::move(ops);
+    batch.bonePoses = std::move(poses);
+    const Status status = renderer_->submit(std::move(batch));
+    ASSERT_TRUE(status.ok()) << status.toString();
+  }
+
+  FrameReport frame(RgbaImage& image) {
+    auto report = renderer_->renderFrame(orthoCamera(), flatLighting(), image);
+    EXPECT_TRUE(report.ok()) << report.status().toString();
+    return report.ok() ? *report : FrameReport{};
+  }
+
+  static int covered(const RgbaImage& image) {
+    int n = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) n += image.at(x, y)[0] > 128 ? 1 : 0;
+    }
+    return n;
+  }
+  static int differing(const RgbaImage& a, const RgbaImage& b) {
+    int n = 0;
+    for (int y = 0; y < a.height; ++y) {
+      for (int x = 0; x < a.width; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          if (std::abs(int(a.at(x, y)[c]) - int(b.at(x, y)[c])) > 8) {
+            ++n;
+            break;
+          }
+        }
+      }
+    }
+    return n;
+  }
+
+  std::unique_ptr<render::OffscreenContext> context_;
+  std::unique_ptr<FrontendRenderer> renderer_;
+};
+
+TEST_P(SkinnedFrontendTest, DrawsTheLevelAsTheCpuDeformedMesh) {
+  const anim::testing::ArticulatedFigure f = figure();
+  std::uint64_t plan = 1;
+  for (const double t : {0.4, 1.3}) {
+    const BoneMatrices bones = poseAt(f, t);
+    submit(plan++, {skinnedOp(1, f, kPlace)}, {{1, bones}});
+    RgbaImage onGpu;
+    const FrameReport skinned = frame(onGpu);
+    EXPECT_EQ(skinned.skinnedObjects, 1u);
+    EXPECT_EQ(skinned.deformedVertices, f.mesh.vertexCount());
+    EXPECT_EQ(skinned.skinnedWithoutPose, 0u);
+    ASSERT_NE(renderer_->scene().bonePose(1), nullptr);
+
+    auto deformed = std::make_shared<IndexedMesh>(f.mesh);
+    anim::deform(f.mesh.positions, f.skin, bones, {}, deformed->positions);
+    submit(plan++, {addOp(1, RepresentationKind::kMesh, deformed, nullptr, kPlace)});
+    RgbaImage onCpu;
+    const FrameReport plain = frame(onCpu);
+    EXPECT_EQ(plain.skinnedObjects, 0u);
+    EXPECT_EQ(renderer_->scene().bonePose(1), nullptr) << "an unskinned level drops the pose";
+
+    const int area = covered(onCpu);
+    EXPECT_GT(area, kSize * kSize / 50) << "t=" << t;
+    EXPECT_LE(differing(onGpu, onCpu), area / 100 + 2) << "t=" << t;
+  }
+}
+
+TEST_P(SkinnedFrontendTest, WithoutAPoseOrWithTooFewBonesNothingIsDrawn) {
+  const anim::testing::ArticulatedFigure f = figure();
+  submit(1, {skinnedOp(1, f, kPlace)});
+  RgbaImage image;
+  FrameReport report = frame(image);
+  EXPECT_EQ(report.skinnedWithoutPose, 1u);
+  EXPECT_EQ(report.skinnedObjects, 0u);
+  EXPECT_EQ(covered(image), 0);
+  // Too few bones for the skin.
+  BoneMatrices few = poseAt(f, 0.2);
+  few.pop_back();
+  submit(2, {}, {{1, few}});
+  report = frame(image);
+  EXPECT_EQ(report.skinnedWithoutPose, 1u);
+  EXPECT_EQ(covered(image), 0);
+  // A pose-only batch brings it.
+  submit(3, {}, {{1, poseAt(f, 0.2)}});
+  report = frame(image);
+  EXPECT_EQ(report.skinnedObjects, 1u);
+  EXPECT_GT(covered(image), 0);
+  // Removal drops the pose.
+  submit(4, {removeOp(1)});
+  report = frame(image);
+  EXPECT_EQ(renderer_->scene().bonePose(1), nullptr);
+  EXPECT_EQ(report.skinnedObjects, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, SkinnedFrontendTest,
+                         ::testing::Values(Backend::kEgl, Backend::kOsMesa), backendParamName);
+
+TEST(FrontendSceneSkinned, PosesApplyOnlyToHeldSkinnedObjects) {
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  SceneBatch batch;
+  batch.plan = 1;
+  batch.operations = {skinnedOp(1, f, glm::mat4(1.0f)),
+                      addOp(2, RepresentationKind::kMesh, quadMesh(0, 0, 1, 1, 0), nullptr)};
+  batch.bonePoses = {{1, poseAt(f, 0.1)}, {2, poseAt(f, 0.1)}, {3, poseAt(f, 0.1)}};
+  ASSERT_TRUE(scene.enqueue(std::move(batch)).ok());
+  EXPECT_EQ(scene.bonePose(1), nullptr) << "not before the batch commits";
+  for (const PendingUpload& upload : scene.planUploads(1 << 30))
+    ASSERT_TRUE(scene.markUploaded(upload.key).ok());
+  scene.commitReady();
+  ASSERT_NE(scene.bonePose(1), nullptr);
+  EXPECT_EQ(*scene.bonePose(1), poseAt(f, 0.1));
+  EXPECT_EQ(scene.bonePose(2), nullptr) << "object 2 is not skinned";
+  EXPECT_EQ(scene.bonePose(3), nullptr) << "object 3 is not held";
+}
+
+TEST(FrontendSceneSkinned, BadSkinsAndPosesRefuseTheBatch) {
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  const auto refused = [&](SceneBatch batch) { return !scene.enqueue(std::move(batch)).ok(); };
+  SceneBatch shortSkin;
+  shortSkin.operations = {skinnedOp(1, f, glm::mat4(1.0f))};
+  auto skin = std::make_shared<std::vector<anim::VertexSkin>>(f.skin);
+  skin->pop_back();
+  shortSkin.operations[0].representation.skin = skin;
+  EXPECT_TRUE(refused(shortSkin));
+  SceneBatch impostor;
+  impostor.operations = {skinnedOp(1, f, glm::mat4(1.0f))};
+  impostor.operations[0].representation.kind = RepresentationKind::kMeshedImpostor;
+  impostor.operations[0].representation.texture = solidImage(4, 4, 255, 255, 255, 255);
+  EXPECT_TRUE(refused(impostor));
+  SceneBatch nan;
+  BoneMatrices bad = poseAt(f, 0.1);
+  bad[0][3][1] = std::nanf("");
+  nan.bonePoses = {{1, bad}};
+  EXPECT_TRUE(refused(nan));
+  SceneBatch twice;
+  twice.bonePoses = {{1, poseAt(f, 0.1)}, {1, poseAt(f, 0.2)}};
+  EXPECT_TRUE(refused(twice));
+  SceneBatch many;
+  many.bonePoses = {{1, BoneMatrices(kMaxBonesPerPose + 1, glm::mat4(1.0f))}};
+  EXPECT_TRUE(refused(many));
+  EXPECT_EQ(scene.pendingBatches(), 0u);
+}
+
+}  // namespace
+}  // namespace thinlod::frontend
