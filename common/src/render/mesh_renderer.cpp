@@ -135,10 +135,9 @@ std::string definesOf(VariantKey key) {
   }
   return flag("LIT", kLit) + flag("SPECULAR", kSpecular) + flag("TEXTURED", kTextured) +
          flag("VERTEX_COLORS", kVertexColors) + flag("VERTEX_LAYERS", kVertexLayers) +
-         flag("SKINNED", kSkinned) +
-         "#define ALPHA_MODE " + std::to_string((key >> kAlphaShift) & 3u) + "\n" +
-         "#define LIGHT_COUNT " + std::to_string(lightCount) + "\n" + "#define LIGHT_TYPES " +
-         types + ")\n";
+         flag("SKINNED", kSkinned) + "#define ALPHA_MODE " +
+         std::to_string((key >> kAlphaShift) & 3u) + "\n" + "#define LIGHT_COUNT " +
+         std::to_string(lightCount) + "\n" + "#define LIGHT_TYPES " + types + ")\n";
 }
 
 Status buildProgram(const GlFunctions& gl, VariantKey key, Program& program) {
@@ -244,8 +243,7 @@ Result<std::unique_ptr<MeshRenderer>> MeshRenderer::create(OffscreenContext& con
   THINLOD_RETURN_IF_ERROR(checkGlErrors(gl, "before MeshRenderer::create"));
   Impl& impl = *renderer->impl_;
   // The default variant is built now so a broken GL fails here, not mid-frame.
-  THINLOD_RETURN_IF_ERROR(
-      impl.ensureProgram(gl, variantOf(Material(), false, Lighting(), false)));
+  THINLOD_RETURN_IF_ERROR(impl.ensureProgram(gl, variantOf(Material(), false, Lighting(), false)));
   gl.glGetIntegerv(GL_MAX_TEXTURE_SIZE, &impl.maxTextureSize);
   gl.glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &impl.maxTextureBufferTexels);
   gl.glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &impl.maxTextureLayers);
@@ -754,8 +752,8 @@ Status MeshRenderer::draw(const DrawItem* items, std::size_t count, const Camera
   return checkGlErrors(gl, "MeshRenderer::draw");
 }
 
-Status MeshRenderer::prepare(const Material& material, bool meshHasLayers,
-                             const Lighting& lighting, bool skinned) {
+Status MeshRenderer::prepare(const Material& material, bool meshHasLayers, const Lighting& lighting,
+                             bool skinned) {
   if (!context_->isCurrent()) return notCurrent("MeshRenderer::prepare");
   THINLOD_RETURN_IF_ERROR(validateLighting(lighting, "prepare"));
   return impl_->ensureProgram(context_->gl(),

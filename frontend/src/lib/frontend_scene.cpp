@@ -57,9 +57,10 @@ Status validateRepresentation(const Representation& rep, const std::string& what
       return Status(ErrorCode::kInvalidArgument,
                     what + ": " + representationKindName(rep.kind) + " carries a skin");
     }
-    if (rep.mesh == nullptr) return Status(ErrorCode::kInvalidArgument, what + ": skin without a mesh");
-    THINLOD_RETURN_IF_ERROR(anim::validateSkin(*rep.skin, rep.mesh->vertexCount(),
-                                               kMaxBonesPerPose, what + " skin"));
+    if (rep.mesh == nullptr)
+      return Status(ErrorCode::kInvalidArgument, what + ": skin without a mesh");
+    THINLOD_RETURN_IF_ERROR(
+        anim::validateSkin(*rep.skin, rep.mesh->vertexCount(), kMaxBonesPerPose, what + " skin"));
   }
   if (impostor && rep.texture == nullptr) {
     return Status(ErrorCode::kInvalidArgument,
@@ -148,9 +149,9 @@ Status FrontendScene::enqueue(SceneBatch batch) {
     if (!posed.insert(id).second)
       return Status(ErrorCode::kInvalidArgument, what + ": object has two poses in the batch");
     if (matrices.size() > kMaxBonesPerPose) {
-      return Status(ErrorCode::kResourceExhausted,
-                    what + ": " + std::to_string(matrices.size()) + " matrices (limit " +
-                        std::to_string(kMaxBonesPerPose) + ")");
+      return Status(ErrorCode::kResourceExhausted, what + ": " + std::to_string(matrices.size()) +
+                                                       " matrices (limit " +
+                                                       std::to_string(kMaxBonesPerPose) + ")");
     }
     for (const glm::mat4& m : matrices) {
       if (!allFinite(m)) return Status(ErrorCode::kInvalidArgument, what + ": not finite");
