@@ -7,8 +7,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "articulated_figure.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/core/skinning.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
@@ -89,6 +92,74 @@ TEST(SkinPalette, RigidVerticesNameOneBone) {
   EXPECT_EQ(palette.skin[1].boneB, 0u);
   EXPECT_EQ(palette.skin[1].weightB, 0.25f);
   EXPECT_TRUE(palette.skin[2].rigid());
+}
+
+TEST(MotionBound, IsTheLargestDeviationFromBindAtTheSampledTimes) {
+  const anim::testing::ArticulatedFigure figure = anim::testing::makeArticulatedFigure();
+  const std::size_t steps = 16;
+  const double bound = anim::sampledMaxDeviationFromBind(figure.skeleton, figure.clip,
+                                                         figure.mesh.positions, figure.skin, steps);
+  double direct = 0.0;
+  std::vector<glm::vec3> out(figure.mesh.vertexCount());
+  for (std::size_t i = 0; i <= steps; ++i) {
+    const double t = figure.clip.duration * double(i) / double(steps);
+    anim::deform(figure.mesh.positions, figure.skin,
+                 anim::skinningMatrices(figure.skeleton, anim::samplePose(figure.skeleton,
+                                                                          figure.clip, t,
+                                                                          anim::ClipWrap::kClamp)),
+                 {}, out);
+    for (std::size_t v = 0; v < out.size(); ++v)
+      direct = std::max(direct, double(glm::length(out[v] - figure.mesh.positions[v])));
+  }
+  EXPECT_GT(bound, 0.0);
+  EXPECT_EQ(bound, direct);
+}
+
+TEST(MotionBound, AnimatedAccuracyShrinksWithTheMotion) {
+  EXPECT_EQ(anim::animatedRelativeAccuracy(50.0, 0.0), 50.0);
+  // L = 1, m = 0.1, rest error 0.02: error <= 0.22 against a sphere of diameter 1.2.
+  EXPECT_DOUBLE_EQ(anim::animatedRelativeAccuracy(50.0, 0.2), 1.2 / 0.22);
+  double previous = 50.0;
+  for (const double ratio : {0.01, 0.1, 1.0, 10.0}) {
+    const double a = anim::animatedRelativeAccuracy(50.0, ratio);
+    EXPECT_LT(a, previous);
+    EXPECT_LE(a, (1.0 + ratio) / ratio);  // even an exact level cannot beat the motion
+    previous = a;
+  }
+}
+
+TEST(AnimatedInline, TheObjectsSphereAndBoundsEncloseEveryPose) {
+  Result<Scene> scene =
+      loadAnimated("url \"Testwuson.X\" animation \"Wuson_Run\"", packageDir("X"));
+  ASSERT_TRUE(scene.ok()) << scene.status().toString();
+  Result<std::vector<SceneObject>> objects = collectSceneObjects(*scene);
+  ASSERT_TRUE(objects.ok());
+  const SceneObject& object = (*objects)[0];
+  const SkinnedAnimation& animation = *object.shape->geometry.animation;
+  const BoundingSphere bind = referenceSphere(*object.fullMesh);
+  EXPECT_GT(animation.motionBound, 0.0);
+  EXPECT_FLOAT_EQ(object.contentSphere.radius, bind.radius + float(animation.motionBound));
+  // At times between the 128 sampled ones too (looped, several laps): the
+  // bound is measured, so allow what motion between samples may add.
+  double worstExcess = 0.0;
+  std::vector<glm::vec3> out(object.fullMesh->vertexCount());
+  for (int i = 0; i < 40; ++i) {
+    const double t = 0.0377 * i * animation.clip.duration;
+    anim::deform(object.fullMesh->positions, animation.skin,
+                 anim::skinningMatrices(animation.skeleton,
+                                        anim::samplePose(animation.skeleton, animation.clip, t,
+                                                         anim::ClipWrap::kLoop)),
+                 {}, out);
+    for (const glm::vec3& p : out) {
+      worstExcess = std::max(
+          worstExcess,
+          double(glm::length(p - object.contentSphere.center) - object.contentSphere.radius));
+      const glm::vec3 world(object.objectToWorld * glm::vec4(p, 1.0f));
+      EXPECT_TRUE(glm::all(glm::greaterThanEqual(world, object.worldBounds.min - 1e-3f)) &&
+                  glm::all(glm::lessThanEqual(world, object.worldBounds.max + 1e-3f)));
+    }
+  }
+  EXPECT_LE(worstExcess, 1e-3 * object.contentSphere.radius);
 }
 
 TEST(AnimatedInline, ParsesTheClipField) {

@@ -10,6 +10,7 @@
 
 #include "backbone_core.h"
 #include "fake_simplifier.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/core/skinning.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/protocol/codec.h"
@@ -137,6 +138,43 @@ bool sendFigure(BackboneCore& core, FakeSimplifier& fake, int& step) {
     if (core.frontendMirror().trianglesOf(0) > 0.0) return true;
   }
   return false;
+}
+
+TEST(BackboneAnimationClock, ReachAndAccuracyAccountForTheMotion) {
+  auto created = animatedCore(polygonBudget(5000));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  const scene::SceneObject& figure = core.sceneObjects().at(0);
+  const double motion = wuson(core).motionBound;
+  const double bindLength = referenceLength(referenceSphere(*figure.fullMesh));
+  const double ratio = core.motionRatio(0);
+  ASSERT_GT(motion, 0.0);
+  EXPECT_DOUBLE_EQ(ratio, 2.0 * motion / bindLength);
+  EXPECT_EQ(core.motionRatio(1), 0.0) << "the sphere does not move";
+  // Reach: the leaf sphere is the bind sphere grown by the motion (scale 0.1).
+  EXPECT_NEAR(core.objects()[0].bounds.radius, 0.1 * (0.5 * bindLength + motion),
+              1e-5 * bindLength);
+  // No accuracy beats the motion: even the estimate's best is below (1 + r) / r.
+  const backbone::SchedulingScene& scene = core.schedulingScene();
+  const std::uint32_t option = scene.objects[0].firstOption;
+  const double ceiling = (1.0 + ratio) / ratio;
+  EXPECT_LE(scene.options[option].relativeTriangles.maxAccuracy(), ceiling);
+
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));  // the measured curve, converted
+  const AccuracyCurve& measured = scene.options[option].relativeTriangles;
+  const double full = double(figure.fullMesh->triangleCount());
+  EXPECT_NEAR(measured.maxAccuracy(),
+              anim::animatedRelativeAccuracy(FakeSimplifier::meshAccuracy(full), ratio),
+              1e-9 * ceiling);
+  int step = 0;
+  ASSERT_TRUE(sendFigure(core, fake, step));
+  // The copy sent is credited what its level keeps while moving, on the wire too.
+  const backbone::RepresentationCopy& shown = scene.options[option].atFrontend;
+  ASSERT_TRUE(shown.present);
+  const double rest = FakeSimplifier::meshAccuracy(shown.triangles);
+  EXPECT_DOUBLE_EQ(shown.relativeAccuracy, anim::animatedRelativeAccuracy(rest, ratio));
+  EXPECT_LT(shown.relativeAccuracy, rest);
 }
 
 TEST(BackboneAnimationClock, AnUnplannedAnswerCarriesThePosesToo) {

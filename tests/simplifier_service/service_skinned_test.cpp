@@ -11,10 +11,12 @@
 
 #include "service_test_util.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/relative_accuracy.h"
 #include "thinlod/common/core/skinning.h"
 #include "thinlod/common/scene/scene_objects.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/simplifier/service.h"
+#include "thinlod/simplifier/surface_error.h"
 
 namespace thinlod::simplifier {
 namespace {
@@ -95,6 +97,52 @@ TEST(SimplifierServiceSkinned, LevelsCarryTheirVerticesSkins) {
     ASSERT_TRUE(matched) << "level vertex " << v << " matches no input vertex and skin";
   }
   EXPECT_GT(twoBone, 0u);
+}
+
+// The validity under motion the backbone credits (docs/animation.md,
+// "Served"): a level credited relative accuracy a at rest keeps
+// anim::animatedRelativeAccuracy(a, 2m / L) against the sphere grown by the
+// motion bound m, i.e. its deformed error stays below L / a + 2m at every
+// pose, here at 24 times of the clip that are not the bound's samples.
+TEST(SimplifierServiceSkinned, LevelsKeepTheirAnimatedAccuracyAtEveryPose) {
+  const std::string path = writeWusonScene();
+  SimplifierService service(wusonOptions());
+  scene::SceneLoadOptions load;
+  load.meshSearchPaths = {kWusonDir};
+  Result<scene::Scene> loaded = scene::loadSceneFile(path, load);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().toString();
+  Result<std::vector<scene::SceneObject>> objects = scene::collectSceneObjects(*loaded);
+  ASSERT_TRUE(objects.ok());
+  const scene::SkinnedAnimation& animation = *(*objects)[0].shape->geometry.animation;
+  const IndexedMesh& full = *(*objects)[0].fullMesh;
+  const double length = referenceLength(referenceSphere(full));
+  const double ratio = 2.0 * animation.motionBound / length;
+  SurfaceErrorOptions errorOptions;
+  errorOptions.samplesPerMesh = 2000;
+  for (const std::uint32_t count : {463u, 1866u}) {
+    protocol::SimplifyRequest request = triangles(1, count);
+    request.sourcePath = path;
+    const protocol::SimplifyResult result = service.simplify(request);
+    ASSERT_TRUE(result.status.ok()) << result.status.toString();
+    Result<codec::SkinnedMeshFrame> level =
+        codec::decodeSkinnedMesh(result.mesh.data(), result.mesh.size());
+    ASSERT_TRUE(level.ok());
+    const double moving = anim::animatedRelativeAccuracy(result.accuracy, ratio);
+    const double allowed = (length + 2.0 * animation.motionBound) / moving;
+    IndexedMesh fullNow = full, levelNow = level->mesh;
+    for (int i = 0; i < 24; ++i) {
+      const double t = (0.013 + 0.0411 * i) * animation.clip.duration;
+      const std::vector<glm::mat4> bones = anim::paletteMatricesAt(
+          animation.skeleton, animation.clip, animation.palette, t, anim::ClipWrap::kLoop);
+      anim::deform(full.positions, animation.palette.skin, bones, {}, fullNow.positions);
+      anim::deform(level->mesh.positions, level->skin, bones, {}, levelNow.positions);
+      fullNow.normals.clear();
+      levelNow.normals.clear();
+      Result<SurfaceError> error = measureSurfaceError(fullNow, levelNow, errorOptions);
+      ASSERT_TRUE(error.ok()) << error.status().toString();
+      EXPECT_LE(error->max(), allowed) << count << " triangles at t=" << t;
+    }
+  }
 }
 
 TEST(SimplifierServiceSkinned, StaticObjectsStayUnskinned) {

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "thinlod/common/core/relative_accuracy.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/mesh/primitives.h"
 
 namespace thinlod::backbone_daemon {
@@ -23,6 +24,18 @@ using backbone::OptionKind;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxCurveSegments = 16;
+
+// `curve` with every accuracy a replaced by anim::animatedRelativeAccuracy(a,
+// ratio), fitted conservatively through its knots: the staircase of the
+// mapped knots never credits more than the curve did between them.
+Result<AccuracyCurve> animatedCurve(const AccuracyCurve& curve, double ratio) {
+  std::vector<AccuracySample> knots;
+  for (const CurveSegment& segment : curve.segments())
+    knots.push_back({anim::animatedRelativeAccuracy(segment.start, ratio), segment.value});
+  knots.push_back({anim::animatedRelativeAccuracy(curve.maxAccuracy(), ratio),
+                   curve.resourcesFor(curve.maxAccuracy())});
+  return AccuracyCurve::fitConservative(std::move(knots), kMaxCurveSegments);
+}
 // Bytes per triangle are only learned from meshes at least this large (the
 // frame overhead dominates smaller ones).
 constexpr double kMinTrianglesToLearnBytes = 64.0;
@@ -278,12 +291,19 @@ Status BackboneCore::initialize() {
   const double texelsPerDiagonal = double(options_.textureSize) / 3.5;
 
   animationOf_.assign(count, nullptr);
+  motionRatio_.assign(count, 0.0);
   for (std::uint32_t k = 0; k < count; ++k) {
     const ObjectRecord& record = converted_.records[k];
     backbone::SceneObject& object = scene_.objects[k];
     object.firstOption = static_cast<std::uint32_t>(scene_.options.size());
     if (!record.cluster && record.object != nullptr && record.object->shape != nullptr)
       animationOf_[k] = record.object->shape->geometry.animation.get();
+    if (animationOf_[k] != nullptr) {
+      // Its leaf sphere encloses every pose (scene_objects.h); its
+      // accuracies, measured against the bind mesh, shrink by the motion.
+      const double length = referenceLength(referenceSphere(*record.object->fullMesh));
+      motionRatio_[k] = 2.0 * animationOf_[k]->motionBound / length;
+    }
     // A skinned object moves: only its meshes, which the frontend deforms
     // with each frame's bone poses, show it. An impostor would freeze one
     // pose, a Hybrid's points are not skinned.
@@ -314,6 +334,11 @@ Status BackboneCore::initialize() {
           return Status(estimate.status().code(),
                         "object " + idText(record.id) + ": " + estimate.status().message());
         state.baseTriangles = std::move(estimate).value();
+        if (motionRatio_[k] > 0.0) {
+          Result<AccuracyCurve> moving = animatedCurve(state.baseTriangles, motionRatio_[k]);
+          if (!moving.ok()) return moving.status();
+          state.baseTriangles = std::move(moving).value();
+        }
         state.estimatedCurve = true;
         queueStartupRequest(k, static_cast<std::uint32_t>(scene_.options.size()), false);
       }
@@ -799,7 +824,8 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
       if (!std::isfinite(s.accuracy) || s.accuracy <= 0.0 || !std::isfinite(s.resources) ||
           s.resources < 0.0 || s.resources > double(protocol::kMaxTriangleCount))
         return invalid(where + ": curve[" + std::to_string(i) + "] is not a finite sample");
-      samples.push_back({s.accuracy, s.resources});
+      samples.push_back(
+          {anim::animatedRelativeAccuracy(s.accuracy, motionRatio_[request.object]), s.resources});
     }
     Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
     if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
@@ -815,7 +841,9 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   }
 
   learnMeshBytes(request.object, double(result.mesh.size()), units);
-  const double relative = result.accuracy;
+  // What the level keeps while the object moves (the bind-pose accuracy when static).
+  const double relative =
+      anim::animatedRelativeAccuracy(result.accuracy, motionRatio_[request.object]);
   if (request.requestedAccuracy > 0.0 && relative < request.requestedAccuracy * 0.99) {
     // Delivered less than the curve promised: shift the curve so the same
     // triangles are credited with what they reached.
@@ -829,7 +857,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   rep.mesh = result.mesh;
   rep.transform = record.object->objectToWorld;
   rep.validity = everywhereOnWire();
-  rep.accuracy = result.accuracy;
+  rep.accuracy = relative;
   rep.triangleCount = result.triangleCount;
   // Hybrid triangles carry no uvs (docs/hybrid.md): only mesh copies are textured.
   if (!hybrid && request.object < objectTexture_.size())

@@ -303,6 +303,16 @@ class BackboneCore {
   std::vector<protocol::BonePose> bonePosesAt(std::int64_t poseNs) const;
   // Scene objects with a skinned animation.
   std::size_t animatedObjects() const;
+  // Validity under motion: an animated object's leaf sphere encloses it at
+  // every pose of its clip (its reference sphere grown by the clip's motion
+  // bound m, scene_objects.h), and every accuracy the simplifier reports for
+  // it (curve samples, the estimate until then, delivered copies) is
+  // converted by anim::animatedRelativeAccuracy with motionRatio = 2 m / L:
+  // what the level keeps at any pose against that sphere. The whole clip
+  // bounds every planned lifetime's window. 0 for a static object.
+  double motionRatio(std::uint32_t object) const {
+    return object < motionRatio_.size() ? motionRatio_[object] : 0.0;
+  }
 
   // ---- introspection (tests, logs) ----
   const backbone::SchedulingScene& schedulingScene() const { return scene_; }
@@ -427,6 +437,9 @@ class BackboneCore {
   std::map<std::uint64_t, std::uint32_t> objectById_;  // wire object id -> object index
   // Per record: its Shape's skinned animation (null: static, a cluster).
   std::vector<const scene::SkinnedAnimation*> animationOf_;
+  // Per record: 2 m / L, its motion bound over its bind reference length
+  // (0: static); accuracies convert by anim::animatedRelativeAccuracy.
+  std::vector<double> motionRatio_;
   std::size_t heldForeign_ = 0;
   std::size_t heldTakenBack_ = 0;
 };

@@ -338,6 +338,30 @@ Result<std::vector<float>> pathLengthWeights(const IndexedMesh& mesh,
   return weights;
 }
 
+double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip& clip,
+                                   const std::vector<glm::vec3>& positions,
+                                   const std::vector<VertexSkin>& skin, std::size_t steps) {
+  std::vector<glm::vec3> now(positions.size());
+  double worst = 0.0;
+  steps = std::max<std::size_t>(steps, 1);
+  for (std::size_t i = 0; i <= steps; ++i) {
+    const double t = clip.duration * static_cast<double>(i) / static_cast<double>(steps);
+    deform(positions, skin,
+           skinningMatrices(skeleton, samplePose(skeleton, clip, t, ClipWrap::kClamp)), {}, now);
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      const double d = static_cast<double>(glm::length(now[v] - positions[v]));
+      if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();
+      worst = std::max(worst, d);
+    }
+  }
+  return worst;
+}
+
+double animatedRelativeAccuracy(double restAccuracy, double motionRatio) {
+  if (!(motionRatio > 0.0)) return restAccuracy;
+  return (1.0 + motionRatio) / (1.0 / restAccuracy + motionRatio);
+}
+
 SkinPalette compactSkin(const std::vector<VertexSkin>& skin) {
   SkinPalette palette;
   // A rigid vertex names boneA only: its boneB (unused by deform) would

@@ -1,5 +1,6 @@
 // File edge of the scene module: reads the scene file, then the mesh files
 // its Inline urls name.
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -61,6 +62,13 @@ Result<std::pair<IndexedMesh, SkinnedAnimation>> loadAnimatedMesh(const std::str
   animation.skeleton = std::move(model->skeleton);
   animation.skin = std::move(model->skin);
   animation.palette = anim::compactSkin(animation.skin);
+  animation.motionBound = anim::sampledMaxDeviationFromBind(
+      animation.skeleton, animation.clip, model->mesh.positions, animation.skin,
+      SkinnedAnimation::kMotionSamples);
+  if (!std::isfinite(animation.motionBound)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  path + ": animation '" + clip + "' moves a vertex to a non-finite position");
+  }
   return std::make_pair(std::move(model->mesh), std::move(animation));
 }
 

@@ -60,6 +60,14 @@ Result<std::vector<SceneObject>> collectSceneObjects(const Scene& scene,
     object.contentSphere = shape->geometry.kind == GeometryKind::kPrimitive
                                ? primitiveReferenceSphere(shape->geometry.primitive)
                                : referenceSphere(**mesh);
+    if (const SkinnedAnimation* animation = shape->geometry.animation.get()) {
+      // The deformed mesh stays within motionBound of the stored one.
+      const auto reach = static_cast<float>(animation->motionBound);
+      object.contentSphere.radius += reach;
+      const glm::vec3 grow(reach * maxScale(object.objectToWorld));
+      object.worldBounds.extend(object.worldBounds.min - grow);
+      object.worldBounds.extend(object.worldBounds.max + grow);
+    }
     object.worldSphere = mapReferenceSphere(object.contentSphere, object.objectToWorld,
                                             maxScale(object.objectToWorld));
     objects.push_back(std::move(object));

@@ -143,6 +143,26 @@ SkinPalette compactSkin(const std::vector<VertexSkin>& skin);
 std::vector<glm::mat4> paletteMatricesAt(const Skeleton& skeleton, const AnimationClip& clip,
                                          const SkinPalette& palette, double seconds, ClipWrap wrap);
 
+// Largest distance of any vertex from its stored (bind) position over the
+// whole clip, sampled at `steps` + 1 evenly spaced times in [0, duration]
+// (steps >= 1): how far the deformed mesh reaches from the mesh as stored.
+// Measured, not proven, as sampledMaxDisplacement. +infinity when a deformed
+// position is not finite.
+double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip& clip,
+                                   const std::vector<glm::vec3>& positions,
+                                   const std::vector<VertexSkin>& skin, std::size_t steps);
+
+// The relative accuracy (Pasman & Jansen's a = L / error) a representation
+// keeps while its object moves (docs/animation.md, "Served"): credited
+// `restAccuracy` against the bind-pose reference length L, with every point
+// of the level and of the full mesh at most m from its bind position
+// (motionRatio = 2 m / L), the deformed level is within L / restAccuracy + 2m
+// of the deformed full mesh (a point of a triangle moves by a convex
+// combination of its corners' motions), and the reference sphere grown by m
+// has diameter L + 2m: a' = (1 + motionRatio) / (1 / restAccuracy +
+// motionRatio). restAccuracy > 0, motionRatio >= 0; 0 gives restAccuracy.
+double animatedRelativeAccuracy(double restAccuracy, double motionRatio);
+
 // Largest displacement of any vertex from its position at t0 over [t0, t1],
 // with the clip sampled every `step` seconds (and at t1): a measured motion
 // bound for the planned lifetime, not a proof (fast motion between samples

@@ -97,6 +97,11 @@ struct SkinnedAnimation {
   std::vector<anim::VertexSkin> skin;  // one per mesh vertex, skeleton bones
   anim::AnimationClip clip;            // the one the scene names, validated
   anim::SkinPalette palette;
+  // Largest distance of a vertex from its bind position over the clip
+  // (sampledMaxDeviationFromBind, kMotionSamples steps; mesh units, finite):
+  // the object's reach grows by it (scene_objects.h).
+  double motionBound = 0.0;
+  static constexpr std::size_t kMotionSamples = 128;
 };
 
 struct Geometry {

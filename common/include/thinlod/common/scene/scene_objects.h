@@ -16,6 +16,12 @@
 //   referenceSphere(fullMesh) otherwise. worldSphere is it mapped by
 //   objectToWorld (mapReferenceSphere with maxScale); it encloses the object
 //   and is the scheduler's leaf sphere, its diameter the world L.
+// - An animated object (Geometry::animation) moves within its clip's motion
+//   bound m of its stored (bind) mesh: its contentSphere is the reference
+//   sphere grown by m and its worldBounds by m (times maxScale), so both
+//   enclose it at every (sampled) pose. Relative accuracies measured against
+//   the bind mesh's sphere convert to this one by anim::animatedRelativeAccuracy
+//   (docs/animation.md, "Served").
 // - Pointers refer into the Scene, which must outlive the objects.
 // - Errors: a mesh-file Shape whose mesh was not resolved -> kNotFound naming
 //   the url; an invalid primitive -> kInvalidArgument.
