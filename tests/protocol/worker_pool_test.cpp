@@ -2,6 +2,8 @@
 // worker is lost, restarts or times out; first result wins.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <map>
 #include <zmq.hpp>
 
@@ -145,7 +147,13 @@ TEST(WorkerPool, ImpostorRequestsUseTheSameMachinery) {
     r.poll(*pool);
     worker.poll();
   };
-  ImpostorRequest request = std::get<ImpostorRequest>(seeds::seedMessages()[10].message);
+  // The first ImpostorRequest seed, found by type: seeds are added over time.
+  const std::vector<seeds::NamedMessage> all = seeds::seedMessages();
+  const auto seed = std::find_if(all.begin(), all.end(), [](const seeds::NamedMessage& m) {
+    return std::holds_alternative<ImpostorRequest>(m.message);
+  });
+  ASSERT_NE(seed, all.end());
+  ImpostorRequest request = std::get<ImpostorRequest>(seed->message);
   auto id = pool->submit(request);
   ASSERT_TRUE(id.ok());
   ASSERT_TRUE(pumpUntil(step, [&] { return !worker.impostor.empty(); }));
