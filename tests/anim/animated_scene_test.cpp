@@ -103,11 +103,11 @@ TEST(MotionBound, IsTheLargestDeviationFromBindAtTheSampledTimes) {
   std::vector<glm::vec3> out(figure.mesh.vertexCount());
   for (std::size_t i = 0; i <= steps; ++i) {
     const double t = figure.clip.duration * double(i) / double(steps);
-    anim::deform(figure.mesh.positions, figure.skin,
-                 anim::skinningMatrices(figure.skeleton, anim::samplePose(figure.skeleton,
-                                                                          figure.clip, t,
-                                                                          anim::ClipWrap::kClamp)),
-                 {}, out);
+    anim::deform(
+        figure.mesh.positions, figure.skin,
+        anim::skinningMatrices(figure.skeleton, anim::samplePose(figure.skeleton, figure.clip, t,
+                                                                 anim::ClipWrap::kClamp)),
+        {}, out);
     for (std::size_t v = 0; v < out.size(); ++v)
       direct = std::max(direct, double(glm::length(out[v] - figure.mesh.positions[v])));
   }
@@ -151,9 +151,8 @@ TEST(AnimatedInline, TheObjectsSphereAndBoundsEncloseEveryPose) {
                                                          anim::ClipWrap::kLoop)),
                  {}, out);
     for (const glm::vec3& p : out) {
-      worstExcess = std::max(
-          worstExcess,
-          double(glm::length(p - object.contentSphere.center) - object.contentSphere.radius));
+      worstExcess = std::max(worstExcess, double(glm::length(p - object.contentSphere.center) -
+                                                 object.contentSphere.radius));
       const glm::vec3 world(object.objectToWorld * glm::vec4(p, 1.0f));
       EXPECT_TRUE(glm::all(glm::greaterThanEqual(world, object.worldBounds.min - 1e-3f)) &&
                   glm::all(glm::lessThanEqual(world, object.worldBounds.max + 1e-3f)));

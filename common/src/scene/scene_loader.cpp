@@ -62,9 +62,9 @@ Result<std::pair<IndexedMesh, SkinnedAnimation>> loadAnimatedMesh(const std::str
   animation.skeleton = std::move(model->skeleton);
   animation.skin = std::move(model->skin);
   animation.palette = anim::compactSkin(animation.skin);
-  animation.motionBound = anim::sampledMaxDeviationFromBind(
-      animation.skeleton, animation.clip, model->mesh.positions, animation.skin,
-      SkinnedAnimation::kMotionSamples);
+  animation.motionBound =
+      anim::sampledMaxDeviationFromBind(animation.skeleton, animation.clip, model->mesh.positions,
+                                        animation.skin, SkinnedAnimation::kMotionSamples);
   if (!std::isfinite(animation.motionBound)) {
     return Status(ErrorCode::kInvalidArgument,
                   path + ": animation '" + clip + "' moves a vertex to a non-finite position");
