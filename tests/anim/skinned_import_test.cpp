@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -92,6 +93,46 @@ TEST(SkinnedImport, MissingEmptyAndInvalidFilesAreCleanErrors) {
     EXPECT_NE(model.status().message().find(invalid), std::string::npos)
         << "the error names the file: " << model.status().toString();
   }
+}
+
+// Assimp's SMD reader never returned on a file cut off inside a section
+// (fuzz finding 28: "version 1\nnodes\n", 16 bytes): the SMD pre-check
+// refuses it, and other cut or malformed lines, before Assimp runs. Formats
+// outside the tested list never reach Assimp.
+TEST(SkinnedImport, TruncatedOrMalformedSmdAndUntestedFormatsAreRefusedBeforeAssimp) {
+  const std::string valid =
+      "version 1\nnodes\n0 \"root\" -1\n1 \"arm\" 0\nend\nskeleton\ntime 0\n"
+      "0 0 0 0 0 0 0\n1 0 1 0 0 0 0\nend\ntriangles\nskin\n"
+      "0 0 0 0 0 0 1 0 0 1 0 1.0\n0 1 0 0 0 0 1 1 0 2 0 0.5 1 0.5\n1 0 2 0 0 0 1 0 1 1 1 1.0\n"
+      "end\n";
+  const std::string path = testing::TempDir() + "/precheck-skin.smd";
+  auto import = [&](const std::string& text) {
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
+    return importSkinnedModel(path);
+  };
+  const Result<SkinnedModel> whole = import(valid);
+  ASSERT_TRUE(whole.ok()) << whole.status().toString();
+  EXPECT_EQ(whole->mesh.triangleCount(), 1u);
+  // Every cut inside a section, the finding's among them.
+  for (const char* cut : {"nodes\n", "0 0 0 0 0 0 0\n", "skin\n", "0 0 0 0 0 0 1 0 0 1 0 1.0\n"}) {
+    const std::size_t at = valid.find(cut) + std::string(cut).size();
+    const Result<SkinnedModel> model = import(valid.substr(0, at));
+    EXPECT_EQ(model.status().code(), ErrorCode::kParseError) << "cut after " << cut;
+  }
+  for (const std::string& bad :
+       {valid.substr(0, 10) + "nodes\n0 \"root -1\nend\n",       // open quote
+        "version 2\n" + valid.substr(10),                         // version
+        std::string(valid).replace(valid.find("1 \"arm\" 0"), 9, "1 \"arm\" 5"),  // parent
+        std::string(valid).replace(valid.find("0 0 0 0 0 0 0\n"), 13, "0 0 0 nan 0 0 0"),
+        std::string(valid).replace(valid.find("1 0 2 0 0 0 1 0 1 1 1 1.0"), 25,
+                                   "1 0 2 0 0 0 1 0 1 1 7 1.0")}) {  // link to bone 7
+    const Result<SkinnedModel> model = import(bad);
+    EXPECT_EQ(model.status().code(), ErrorCode::kParseError) << bad;
+    EXPECT_NE(model.status().message().find(path), std::string::npos) << model.status().toString();
+  }
+  EXPECT_EQ(importSkinnedModel(testing::TempDir() + "/figure.md5mesh").status().code(),
+            ErrorCode::kUnsupported);
+  std::remove(path.c_str());
 }
 
 TEST(SkinnedImport, BoneThatNamesNoNodeIsRefused) {

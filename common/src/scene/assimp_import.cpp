@@ -609,6 +609,10 @@ Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
       Result<std::string> bytes = readFileBounded(path, size);
       if (!bytes.ok()) return bytes.status();
       THINLOD_RETURN_IF_ERROR(detail::precheckCollada(path, *bytes, limits));
+    } else if (ext == ".smd") {
+      Result<std::string> bytes = readFileBounded(path, size);
+      if (!bytes.ok()) return bytes.status();
+      THINLOD_RETURN_IF_ERROR(detail::precheckSmd(path, *bytes));
     }
     Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
     auto* io = new BoundedIOSystem(limits);
@@ -991,8 +995,20 @@ class SkinnedConverter {
 
 }  // namespace
 
+bool isSkinnedModelExtension(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".fbx" || ext == ".x" ||
+         ext == ".smd";
+}
+
 Result<SkinnedModel> importSkinnedModel(const std::string& path,
                                         const SkinnedImportLimits& limits) {
+  // Only the formats we have read and tested: every other Assimp reader
+  // (md5, bvh, ms3d, ...) would get untrusted bytes no check of ours saw.
+  if (!isSkinnedModelExtension(path)) {
+    return Status(ErrorCode::kUnsupported,
+                  path + ": not a skinned model format (.gltf .glb .dae .fbx .x .smd)");
+  }
   return readThroughAssimp<SkinnedModel>(
       path, limits.files, [&](const aiScene& ai, const std::optional<GltfDeclared>&) {
         return SkinnedConverter(path, ai, limits).run();

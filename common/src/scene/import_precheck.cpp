@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <utility>
+#include <vector>
 
 namespace thinlod::scene::detail {
 
@@ -260,6 +262,202 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     if (found != nodeById.end()) children[node].push_back(found->second);
   }
   return checkNodeGraph(path, children, roots, limits);
+}
+
+
+namespace {
+
+// One SMD line split into tokens: whitespace separated, a double-quoted
+// token (a node name) kept whole without its quotes; false when a quote is
+// not closed on the line.
+bool smdTokens(std::string_view line, std::vector<std::string_view>& tokens) {
+  tokens.clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (i >= line.size()) break;
+    if (line[i] == '"') {
+      const std::size_t close = line.find('"', i + 1);
+      if (close == std::string_view::npos) return false;
+      tokens.push_back(line.substr(i + 1, close - i - 1));
+      i = close + 1;
+      continue;
+    }
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    tokens.push_back(line.substr(start, i - start));
+  }
+  return true;
+}
+
+bool smdInteger(std::string_view token, long lo, long hi, long* out = nullptr) {
+  if (token.empty() || token.size() > 11) return false;
+  std::size_t i = token[0] == '-' ? 1 : 0;
+  if (i == token.size()) return false;
+  for (std::size_t k = i; k < token.size(); ++k) {
+    if (!std::isdigit(static_cast<unsigned char>(token[k]))) return false;
+  }
+  const long value = std::strtol(std::string(token).c_str(), nullptr, 10);
+  if (value < lo || value > hi) return false;
+  if (out != nullptr) *out = value;
+  return true;
+}
+
+// A plain decimal number (sign, digits, one point, an exponent) that is
+// finite: what Assimp's fast_atof reads the same way.
+bool smdNumber(std::string_view token) {
+  if (token.empty() || token.size() > 64) return false;
+  std::size_t i = 0;
+  if (token[i] == '-' || token[i] == '+') ++i;
+  bool digits = false;
+  while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+    ++i;
+    digits = true;
+  }
+  if (i < token.size() && token[i] == '.') {
+    ++i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+      ++i;
+      digits = true;
+    }
+  }
+  if (!digits) return false;
+  if (i < token.size() && (token[i] == 'e' || token[i] == 'E')) {
+    ++i;
+    if (i < token.size() && (token[i] == '-' || token[i] == '+')) ++i;
+    const std::size_t exponent = i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) ++i;
+    if (i == exponent || i - exponent > 3) return false;
+  }
+  if (i != token.size()) return false;
+  return std::isfinite(std::strtod(std::string(token).c_str(), nullptr));
+}
+
+}  // namespace
+
+Status precheckSmd(const std::string& path, std::string_view bytes) {
+  enum class Section { kNone, kNodes, kSkeleton, kTriangles, kVertexAnimation };
+  Section section = Section::kNone;
+  bool sawVersion = false;
+  long nodes = 0;
+  int triangleLine = 0;  // 0: the material line next, 1-3: a vertex line
+  std::size_t lineNumber = 0;
+  std::vector<std::string_view> tokens;
+  auto refuse = [&](const std::string& why) {
+    return Status(ErrorCode::kParseError,
+                  path + ": SMD line " + std::to_string(lineNumber) + ": " + why);
+  };
+  std::size_t pos = 0;
+  while (pos < bytes.size()) {
+    std::size_t end = bytes.find('\n', pos);
+    if (end == std::string_view::npos) end = bytes.size();
+    std::string_view line = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNumber;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.find_first_of(std::string_view("\0\r", 2)) != std::string_view::npos) {
+      return refuse("a NUL or a lone carriage return");
+    }
+    const std::size_t comment = line.find("//");
+    if (comment != std::string_view::npos) line = line.substr(0, comment);
+    if (!smdTokens(line, tokens)) return refuse("a quote is not closed");
+    if (tokens.empty()) continue;
+    if (!sawVersion) {
+      if (tokens.size() != 2 || tokens[0] != "version" || tokens[1] != "1") {
+        return refuse("the file must start with 'version 1'");
+      }
+      sawVersion = true;
+      continue;
+    }
+    if (section == Section::kNone) {
+      if (tokens.size() != 1) return refuse("a section name (nodes, skeleton, triangles) expected");
+      if (tokens[0] == "nodes") {
+        section = Section::kNodes;
+      } else if (tokens[0] == "skeleton") {
+        section = Section::kSkeleton;
+      } else if (tokens[0] == "triangles") {
+        section = Section::kTriangles;
+        triangleLine = 0;
+      } else if (tokens[0] == "vertexanimation") {
+        section = Section::kVertexAnimation;
+      } else {
+        return refuse("unknown section");
+      }
+      if (section != Section::kNodes && nodes == 0) return refuse("a section before the nodes");
+      continue;
+    }
+    if (tokens.size() == 1 && tokens[0] == "end" &&
+        !(section == Section::kTriangles && triangleLine != 0)) {
+      if (section == Section::kNodes && nodes == 0) return refuse("no nodes");
+      section = Section::kNone;
+      continue;
+    }
+    switch (section) {
+      case Section::kNodes: {
+        long id = 0;
+        long parent = 0;
+        if (tokens.size() != 3 || !smdInteger(tokens[0], 0, 65535, &id) || id != nodes ||
+            !smdInteger(tokens[2], -1, 65535, &parent) || parent >= id) {
+          return refuse("a node is 'id \"name\" parent', ids 0, 1, 2, ... and parents before them");
+        }
+        ++nodes;
+        break;
+      }
+      case Section::kSkeleton:
+      case Section::kVertexAnimation: {
+        if (tokens[0] == "time") {
+          if (tokens.size() != 2 || !smdInteger(tokens[1], 0, 1000000)) {
+            return refuse("'time' takes one frame number");
+          }
+          break;
+        }
+        const long limit = section == Section::kSkeleton ? nodes - 1 : 10000000;
+        const std::size_t values = section == Section::kSkeleton ? 7 : 7;
+        if (tokens.size() != values || !smdInteger(tokens[0], 0, limit)) {
+          return refuse("a key is 'bone x y z rx ry rz' with a known bone");
+        }
+        for (std::size_t k = 1; k < tokens.size(); ++k) {
+          if (!smdNumber(tokens[k])) return refuse("not a finite number");
+        }
+        break;
+      }
+      case Section::kTriangles: {
+        if (triangleLine == 0) {  // the material: any text
+          triangleLine = 1;
+          break;
+        }
+        long links = 0;
+        const bool shaped =
+            tokens.size() >= 9 && smdInteger(tokens[0], 0, nodes - 1) &&
+            (tokens.size() == 9 ||
+             (smdInteger(tokens[9], 0, 64, &links) &&
+              tokens.size() == 10 + 2 * static_cast<std::size_t>(links)));
+        if (!shaped) {
+          return refuse(
+              "a vertex is 'bone x y z nx ny nz u v [links (bone weight)...]' with known bones");
+        }
+        for (std::size_t k = 1; k < 9; ++k) {
+          if (!smdNumber(tokens[k])) return refuse("not a finite number");
+        }
+        for (long l = 0; l < links; ++l) {
+          const std::size_t at = 10 + 2 * static_cast<std::size_t>(l);
+          if (!smdInteger(tokens[at], 0, nodes - 1) || !smdNumber(tokens[at + 1])) {
+            return refuse("a link is 'bone weight' with a known bone");
+          }
+        }
+        triangleLine = triangleLine == 3 ? 0 : triangleLine + 1;
+        break;
+      }
+      case Section::kNone:
+        break;
+    }
+  }
+  if (!sawVersion) return Status(ErrorCode::kParseError, path + ": SMD: no 'version 1' line");
+  if (section != Section::kNone) {
+    return Status(ErrorCode::kParseError,
+                  path + ": SMD: a section is not closed by 'end' (the file is truncated)");
+  }
+  return Status();
 }
 
 }  // namespace thinlod::scene::detail

@@ -36,4 +36,14 @@ Status checkNodeGraph(const std::string& path,
 // instance_node) that checkNodeGraph refuses.
 Status precheckCollada(const std::string& path, std::string_view xml, const ImportLimits& limits);
 
+// Valve SMD (skinned imports): Assimp's reader loops without end when a
+// section is cut off before its 'end' (a 16-byte file "version 1\nnodes\n"
+// hung it, found by fuzz/imported_scene.cpp). Refuses anything but the
+// format's line grammar: 'version 1', then sections nodes / skeleton /
+// triangles / vertexanimation each closed by 'end'; nodes numbered 0, 1,
+// ... with earlier parents; keys and vertices with the token counts of
+// their lines, known bones and finite plain decimal numbers; triangles of a
+// material line and three vertex lines.
+Status precheckSmd(const std::string& path, std::string_view bytes);
+
 }  // namespace thinlod::scene::detail

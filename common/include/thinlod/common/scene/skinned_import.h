@@ -1,11 +1,11 @@
 // Skinned, animated models read through Assimp (glTF skins, Collada, FBX,
-// DirectX .x, Valve .smd, .md5mesh, ...) into the pure skinning types of
+// DirectX .x, Valve .smd; no other format) into the pure skinning types of
 // core/skinning.h (docs/animation.md).
 //
 // Contract:
 // - The same front door as importScene (scene_import.h; one function in
 //   assimp_import.cpp): every file opened is bounded by ImportLimits before
-//   it is read, glTF and Collada are pre-checked, no
+//   it is read, glTF, Collada and SMD are pre-checked, no
 //   Assimp type or exception crosses this interface, failures are a Status
 //   naming the file.
 // - Skeleton: every node of the file is a bone, parents first (restLocal =
@@ -55,6 +55,10 @@ struct SkinnedImportLimits {
   ImportLimits files;
   std::size_t maxKeys = 10'000'000;  // keys of all clips together
 };
+
+// True for the extensions importSkinnedModel takes (case-insensitive):
+// .gltf .glb .dae .fbx .x .smd; any other is kUnsupported.
+bool isSkinnedModelExtension(const std::string& path);
 
 Result<SkinnedModel> importSkinnedModel(const std::string& path,
                                         const SkinnedImportLimits& limits = {});
