@@ -2,7 +2,8 @@
 // mesh with its bone pose is drawn deformed by the vertex shader exactly as
 // the CPU-deformed mesh (anim::deform) is drawn; poses apply with their
 // batch, only to held skinned objects; without a pose (or with too few
-// bones) the object is not drawn. FrontendScene's checks of skins and poses.
+// bones) the object is not drawn; the reference renderer draws a skinned full
+// mesh at its pose the same way. FrontendScene's checks of skins and poses.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +12,7 @@
 #include "articulated_figure.h"
 #include "frontend_test_util.h"
 #include "thinlod/frontend/frontend_renderer.h"
+#include "thinlod/frontend/reference_renderer.h"
 
 namespace thinlod::frontend {
 namespace {
@@ -165,6 +167,40 @@ TEST_P(SkinnedFrontendTest, WithoutAPoseOrWithTooFewBonesNothingIsDrawn) {
   report = frame(image);
   EXPECT_EQ(renderer_->scene().bonePose(1), nullptr);
   EXPECT_EQ(report.skinnedObjects, 0u);
+}
+
+TEST_P(SkinnedFrontendTest, ReferenceDrawsTheSkinnedFullMeshAtItsPose) {
+  const anim::testing::ArticulatedFigure f = figure();
+  ReferenceRendererOptions options;
+  options.width = kSize;
+  options.height = kSize;
+  auto reference = ReferenceRenderer::create(*context_, options);
+  ASSERT_TRUE(reference.ok()) << reference.status().toString();
+  const BoneMatrices bones = poseAt(f, 0.7);
+  ReferenceObject skinned;
+  skinned.mesh = std::make_shared<const IndexedMesh>(f.mesh);
+  skinned.material.lit = false;
+  skinned.material.diffuse = glm::vec4(1.0f);
+  skinned.transform = kPlace;
+  skinned.skin = std::make_shared<const std::vector<anim::VertexSkin>>(f.skin);
+  skinned.bones = &bones;
+  RgbaImage onGpu;
+  ASSERT_TRUE((*reference)->render({skinned}, orthoCamera(), flatLighting(), onGpu).ok());
+  ReferenceObject plain = skinned;
+  auto deformed = std::make_shared<IndexedMesh>(f.mesh);
+  anim::deform(f.mesh.positions, f.skin, bones, {}, deformed->positions);
+  plain.mesh = deformed;
+  plain.skin = nullptr;
+  plain.bones = nullptr;
+  RgbaImage onCpu;
+  ASSERT_TRUE((*reference)->render({plain}, orthoCamera(), flatLighting(), onCpu).ok());
+  const int area = covered(onCpu);
+  EXPECT_GT(area, kSize * kSize / 50);
+  EXPECT_LE(differing(onGpu, onCpu), area / 100 + 2);
+  // A skin without bones draws nothing and says why.
+  skinned.bones = nullptr;
+  EXPECT_EQ((*reference)->render({skinned}, orthoCamera(), flatLighting(), onGpu).status().code(),
+            ErrorCode::kInvalidArgument);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, SkinnedFrontendTest,

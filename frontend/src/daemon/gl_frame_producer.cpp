@@ -40,6 +40,7 @@ Result<std::unique_ptr<GlFrameProducer>> GlFrameProducer::create(
       flat.material.diffuse = coverageColor(item.extent);
       flat.material.lit = false;
       flat.material.doubleSided = item.object.material.doubleSided;
+      flat.skin = item.object.skin;
       producer->coverageList_.push_back(std::move(flat));
     }
   }
@@ -118,6 +119,16 @@ Result<double> GlFrameProducer::renderReference(const Pose& pose,
                                                 std::vector<std::uint32_t>& covered) {
   Result<render::Camera> camera = cameraFromPose(pose, options_.width, options_.height);
   if (!camera.ok()) return camera.status();
+  // Animated objects at the pose's time (the backbone's clock: pose time).
+  referenceBones_.resize(reference_.size());
+  for (std::size_t i = 0; i < reference_.size(); ++i) {
+    const scene::SkinnedAnimation* animation = reference_[i].animation;
+    if (animation == nullptr) continue;
+    referenceBones_[i] = anim::paletteMatricesAt(
+        animation->skeleton, animation->clip, animation->palette, pose.time, anim::ClipWrap::kLoop);
+    reference_[i].object.bones = &referenceBones_[i];
+    if (i < coverageList_.size()) coverageList_[i].bones = &referenceBones_[i];
+  }
   drawList_.clear();
   for (const ReferenceItem& item : reference_) drawList_.push_back(item.object);
   const auto firstBlended =

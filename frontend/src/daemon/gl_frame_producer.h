@@ -74,6 +74,7 @@ class GlFrameProducer final : public FrameProducer {
   std::vector<ReferenceObject> drawList_;  // reused each measure()
   std::vector<ObjectExtent> extents_;
   std::vector<ReferenceObject> coverageList_;  // the reference in coverage colours, unlit
+  std::vector<std::vector<glm::mat4>> referenceBones_;  // per reference item: this frame's pose
   RgbaImage coverageFrame_;
   std::vector<std::uint32_t> covered_;
   ShownFrameLog kept_;

@@ -84,6 +84,12 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     item.object.material = material;
     item.object.texture = textureOf(object.shape->appearance.texturePath);
     item.object.transform = object.objectToWorld;
+    if (const auto& animation = object.shape->geometry.animation) {
+      item.animation = animation.get();
+      // The palette skin, kept alive by the scene's animation.
+      item.object.skin =
+          std::shared_ptr<const std::vector<anim::VertexSkin>>(animation, &animation->palette.skin);
+    }
     item.worldCentre = object.worldBounds.center();
     item.blended = material.alphaMode == render::AlphaMode::kBlend;
     item.extent = loaded.extents.size() - 1;

@@ -33,6 +33,10 @@ struct ReferenceItem {
   glm::vec3 worldCentre{0.0f};  // for back-to-front order of blended materials
   bool blended = false;
   std::size_t extent = 0;  // index into LoadedScene::extents (coverage colour)
+  // An animated object: its clip, played on the frame's pose time to give
+  // object.bones (GlFrameProducer), so the reference moves as the frontend's
+  // levels do. object.skin is its palette skin.
+  const scene::SkinnedAnimation* animation = nullptr;
 };
 
 struct LoadedScene {

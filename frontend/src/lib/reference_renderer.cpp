@@ -55,10 +55,12 @@ struct ReferenceRenderer::Impl {
     }
   }
 
-  Result<render::MeshHandle> meshFor(const std::shared_ptr<const IndexedMesh>& mesh) {
+  Result<render::MeshHandle> meshFor(const ReferenceObject& object) {
+    const std::shared_ptr<const IndexedMesh>& mesh = object.mesh;
     auto it = meshes.find(mesh.get());
     if (it != meshes.end()) return it->second.handle;
-    auto handle = renderer->uploadMesh(*mesh);
+    auto handle = object.skin != nullptr ? renderer->uploadSkinnedMesh(*mesh, *object.skin)
+                                         : renderer->uploadMesh(*mesh);
     if (!handle.ok()) return handle.status();
     meshes.emplace(mesh.get(), CacheEntry<IndexedMesh, render::MeshHandle>{mesh, *handle});
     return *handle;
@@ -120,6 +122,9 @@ Result<ReferenceReport> ReferenceRenderer::render(const std::vector<ReferenceObj
     if (object.texture != nullptr && (!object.texture->consistent() || object.texture->empty())) {
       return Status(ErrorCode::kInvalidArgument, what + ": texture is empty or inconsistent");
     }
+    if ((object.skin == nullptr) != (object.bones == nullptr)) {
+      return Status(ErrorCode::kInvalidArgument, what + ": a skin needs bones and bones a skin");
+    }
     if (impl.meshes.find(object.mesh.get()) == impl.meshes.end() ||
         impl.meshes.find(object.mesh.get())->second.source.expired()) {
       THINLOD_RETURN_IF_ERROR(object.mesh->validate(what + " mesh"));
@@ -129,12 +134,13 @@ Result<ReferenceReport> ReferenceRenderer::render(const std::vector<ReferenceObj
   impl.items.clear();
   impl.items.reserve(objects.size());
   for (const ReferenceObject& object : objects) {
-    auto mesh = impl.meshFor(object.mesh);
+    auto mesh = impl.meshFor(object);
     if (!mesh.ok()) return mesh.status();
     render::DrawItem item;
     item.mesh = *mesh;
     item.model = object.transform;
     item.material = object.material;
+    item.bones = object.bones;
     if (object.texture != nullptr) {
       auto texture = impl.textureFor(object.texture);
       if (!texture.ok()) return texture.status();

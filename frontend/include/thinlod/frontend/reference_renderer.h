@@ -10,6 +10,10 @@
 //   shared_ptr while the caller keeps it alive (a cache entry whose source has
 //   expired is freed at the next render). Material::texture must be empty: the
 //   texture, if any, comes from ReferenceObject::texture.
+// - A skinned object (docs/animation.md) carries its mesh's skin and this
+//   frame's bone matrices, both or neither; its mesh is uploaded skinned (the
+//   same mesh object is always drawn with its skin) and deformed by the
+//   vertex shader, as the frontend draws its levels.
 // - Blended materials are drawn after opaque ones in the given order (pass
 //   them back to front).
 // - Errors: invalid mesh/material/transform is kInvalidArgument naming the
@@ -24,6 +28,7 @@
 
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/rgba_image.h"
+#include "thinlod/common/core/skinning.h"
 #include "thinlod/common/core/status.h"
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/render/mesh_renderer.h"
@@ -36,6 +41,8 @@ struct ReferenceObject {
   render::Material material;
   glm::mat4 transform{1.0f};                 // object -> world
   std::shared_ptr<const RgbaImage> texture;  // optional
+  std::shared_ptr<const std::vector<anim::VertexSkin>> skin;  // optional, one per vertex
+  const std::vector<glm::mat4>* bones = nullptr;              // with `skin`: read in render()
 };
 
 struct ReferenceRendererOptions {
