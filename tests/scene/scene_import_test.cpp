@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 #include <vector>
@@ -479,6 +480,23 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
   expectWellFormed(*collada);
   EXPECT_EQ(distinctShapes(*collada).size(), 1u);
   EXPECT_EQ(instanceTriangles(*collada), 2u);
+
+  // Fuzz finding 29: a shown scene's url naming nothing made Assimp leak
+  // what it had built; the Collada pre-check refuses it first.
+  {
+    std::ifstream in(seeds + "instanced_triangle.dae");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = text.find("url=\"#scene\"");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, std::string("url=\"#scene\"").size(), "url=\"ec#sne\"");
+    const std::string path = testing::TempDir() + "/unresolved-scene.dae";
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
+    Result<Scene> r = importScene(path);
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError);
+    EXPECT_NE(r.status().message().find("names no <visual_scene>"), std::string::npos)
+        << r.status().toString();
+    fs::remove(path);
+  }
 
   Result<SkinnedModel> smd = importSkinnedModel(seeds + "two_bones.smd");
   ASSERT_TRUE(smd.ok()) << smd.status().toString();
