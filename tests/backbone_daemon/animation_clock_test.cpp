@@ -213,7 +213,8 @@ TEST(BackboneAnimationClock, PosesPassTheLinkShaperAndWaitWhenItIsEmpty) {
                     .ok());
     answer(core, fake, submitAll(core));
     const PoseOutcome outcome = core.finishPose();
-    if (outcome.posesDeferredByLink) {
+    if (outcome.posesDeferredByLink > 0) {
+      EXPECT_EQ(outcome.posesDeferredByLink, 1u);
       ++deferred;
       EXPECT_TRUE(outcome.update.bonePoses.empty());
       EXPECT_EQ(outcome.bonePoseBytes, 0u);

@@ -1255,19 +1255,18 @@ PoseOutcome BackboneCore::finishPose() {
     ++out.resyncRemoves;
   }
   out.frontendTriangles = mirror_.triangles();
-  std::vector<protocol::BonePose> poses = bonePosesAt(poseTimeNs_);
-  std::uint64_t poseBytes = 0;
-  for (const protocol::BonePose& pose : poses) {
-    poseBytes += static_cast<std::uint64_t>(kBonePoseOverheadBytes +
-                                            kBytesPerBoneMatrix * double(pose.matrices.size()));
-  }
-  if (!poses.empty() && shaper_ && !shaper_->trySend(poseBytes, now)) {
-    out.posesDeferredByLink = true;
-  } else if (!poses.empty()) {
-    if (shaper_) shapedBytes_ += poseBytes;
-    out.linkBytes += poseBytes;
-    out.bonePoseBytes = poseBytes;
-    out.update.bonePoses = std::move(poses);
+  // Each object's pose on its own: the ones the shaper has tokens for go.
+  for (protocol::BonePose& pose : bonePosesAt(poseTimeNs_)) {
+    const auto bytes = static_cast<std::uint64_t>(
+        kBonePoseOverheadBytes + kBytesPerBoneMatrix * double(pose.matrices.size()));
+    if (shaper_ && !shaper_->trySend(bytes, now)) {
+      ++out.posesDeferredByLink;
+      continue;
+    }
+    if (shaper_) shapedBytes_ += bytes;
+    out.linkBytes += bytes;
+    out.bonePoseBytes += bytes;
+    out.update.bonePoses.push_back(std::move(pose));
   }
   return out;
 }

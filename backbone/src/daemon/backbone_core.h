@@ -173,12 +173,12 @@ struct PoseOutcome {
   double frontendTriangles = 0.0;     // after the update is applied
   std::uint32_t expiredCopiesKept = 0;  // PlanStats::expiredCopiesKept of the final plan
   // Bytes of update.bonePoses (the held animated objects' poses at the
-  // pose's time, bonePosesAt), counted in linkBytes; with a link budget they
-  // pass the shaper after the operations, and a frame whose poses find no
-  // tokens goes without them (posesDeferredByLink: the frontend keeps the
-  // last pose it has).
+  // pose's time, bonePosesAt), counted in linkBytes; with a link budget each
+  // object's pose passes the shaper after the operations, and one that finds
+  // no tokens is left out of this frame (posesDeferredByLink counts them: the
+  // frontend keeps the last pose it has).
   std::uint64_t bonePoseBytes = 0;
-  bool posesDeferredByLink = false;
+  std::uint32_t posesDeferredByLink = 0;
 };
 
 class BackboneCore {
