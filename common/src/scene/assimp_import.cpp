@@ -132,6 +132,21 @@ std::uint32_t le32(const std::string& b, std::size_t at) {
          static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
 }
 
+// RFC 4648 base64 with padding: A-Z a-z 0-9 + /, '=' only as the last one or
+// two characters, length divisible by 4.
+bool isPlainBase64(std::string_view text) {
+  if (text.size() % 4 != 0) return false;
+  std::size_t padding = 0;
+  while (padding < 2 && padding < text.size() && text[text.size() - 1 - padding] == '=') ++padding;
+  for (std::size_t i = 0; i + padding < text.size(); ++i) {
+    const char c = text[i];
+    const bool alphabet = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
+                          (c >= '0' && c <= '9') || c == '+' || c == '/';
+    if (!alphabet) return false;
+  }
+  return true;
+}
+
 Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
                                   const ImportLimits& limits) {
   Result<std::string> bytes = readFileBounded(path, size);
@@ -187,6 +202,28 @@ Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
   }
   if (doc.is_discarded() || !doc.is_object()) {
     return Status(ErrorCode::kParseError, path + ": not valid glTF JSON");
+  }
+  // Embedded data (buffers' and images' "data:...;base64," uris): Assimp's
+  // base64 decoder leaked its output buffer when it met a character outside
+  // the alphabet (fuzz finding 30), so the text must be plain base64: the
+  // 64 characters, '=' only as the last one or two of a length divisible
+  // by 4.
+  for (const char* array : {"buffers", "images"}) {
+    const auto items = doc.find(array);
+    if (items == doc.end() || !items->is_array()) continue;
+    for (const nlohmann::json& item : *items) {
+      if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+      const std::string& uri = item["uri"].get_ref<const std::string&>();
+      if (uri.rfind("data:", 0) != 0) continue;
+      const std::size_t marker = uri.find(";base64,");
+      if (marker == std::string::npos) continue;  // not base64: Assimp refuses it itself
+      if (!isPlainBase64(std::string_view(uri).substr(marker + 8))) {
+        return Status(ErrorCode::kParseError,
+                      path + ": an embedded " + std::string(array) +
+                          " uri is not plain base64 (characters outside the alphabet, "
+                          "misplaced '=' or a length not divisible by 4)");
+      }
+    }
   }
   // The node graph: Assimp recurses over it without a depth limit (a chain
   // of 100 000 nodes overflowed the stack) and follows children indices as
