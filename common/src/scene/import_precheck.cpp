@@ -108,6 +108,35 @@ std::uint64_t number(std::string_view text, std::uint64_t fallback) {
   return value;
 }
 
+// Values a Collada transform element holds (0: not a transform).
+std::size_t transformValues(std::string_view name) {
+  if (name == "translate" || name == "scale") return 3;
+  if (name == "rotate") return 4;
+  if (name == "skew") return 7;
+  if (name == "lookat") return 9;
+  if (name == "matrix") return 16;
+  return 0;
+}
+
+// The whitespace-separated tokens of an element's text; false when one is
+// not a finite number.
+bool countNumbers(std::string_view text, std::uint64_t* count) {
+  *count = 0;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    if (i >= text.size()) break;
+    const std::size_t start = i;
+    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    const std::string token(text.substr(start, i - start));
+    char* end = nullptr;
+    const double value = std::strtod(token.c_str(), &end);
+    if (end != token.c_str() + token.size() || !std::isfinite(value)) return false;
+    ++*count;
+  }
+  return true;
+}
+
 bool isArrayElement(std::string_view name) {
   return name == "float_array" || name == "int_array" || name == "Name_array" ||
          name == "bool_array" || name == "IDREF_array";
@@ -235,6 +264,16 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
       std::string_view url = attribute(attributes, "url");
       if (!url.empty() && url.front() == '#') url.remove_prefix(1);
       instances.push_back({enclosing, url});
+    } else if (const std::size_t wanted = transformValues(name); wanted > 0) {
+      // Assimp's Collada reader threw on a transform with too few values
+      // and leaked the nodes it had built (fuzz finding 31).
+      const std::size_t textEnd = selfClosing ? i : std::min(xml.find('<', i), xml.size());
+      std::uint64_t values = 0;
+      if (!countNumbers(xml.substr(i, textEnd - i), &values) || values != wanted) {
+        return Status(ErrorCode::kParseError,
+                      path + ": <" + std::string(name) + "> at byte " + std::to_string(i) +
+                          " must hold " + std::to_string(wanted) + " finite numbers");
+      }
     } else if (isArrayElement(name)) {
       const std::string_view id = attribute(attributes, "id");
       if (!id.empty()) arrayCount[id] = number(attribute(attributes, "count"), 0);
