@@ -20,6 +20,7 @@
 #include <set>
 
 #include "import_precheck.h"
+#include "mesh/mesh_precheck.h"
 #include "thinlod/common/core/file_bytes.h"
 #include "thinlod/common/scene/scene_import.h"
 #include "thinlod/common/scene/skinned_import.h"
@@ -646,6 +647,16 @@ Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
       Result<std::string> bytes = readFileBounded(path, size);
       if (!bytes.ok()) return bytes.status();
       THINLOD_RETURN_IF_ERROR(detail::precheckCollada(path, *bytes, limits));
+    } else if (ext == ".obj") {
+      // The OBJ (+ MTL) route to Assimp: the mesh loader's OBJ pre-check
+      // first (numbers, face indices in range, line grammar). Assimp's OBJ
+      // reader leaked what it had built on a face naming a uv past the
+      // file's (fuzz finding 32).
+      Result<std::string> bytes = readFileBounded(path, size);
+      if (!bytes.ok()) return bytes.status();
+      Result<mesh_detail::PrecheckResult> checked =
+          mesh_detail::precheckMesh(*bytes, mesh_detail::MeshFormat::kObj, path, MeshLoadOptions{});
+      if (!checked.ok()) return checked.status();
     } else if (ext == ".smd") {
       Result<std::string> bytes = readFileBounded(path, size);
       if (!bytes.ok()) return bytes.status();
