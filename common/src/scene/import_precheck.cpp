@@ -137,6 +137,20 @@ bool countNumbers(std::string_view text, std::uint64_t* count) {
   return true;
 }
 
+// The instance elements whose url Assimp needs resolved to build geometry.
+// (Cameras, lights and effects it skips when their url names nothing: the
+// package's cube_emptyTags.dae has such a camera and loads.)
+bool isUrlInstance(std::string_view name) {
+  return name == "instance_geometry" || name == "instance_node" ||
+         name == "instance_controller" || name == "instance_visual_scene";
+}
+
+struct InstanceUrl {
+  std::string_view element;
+  std::string_view url;
+  std::size_t at;  // byte after the tag
+};
+
 bool isArrayElement(std::string_view name) {
   return name == "float_array" || name == "int_array" || name == "Name_array" ||
          name == "bool_array" || name == "IDREF_array";
@@ -170,6 +184,8 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
   std::vector<std::vector<std::uint32_t>> children;
   std::vector<std::uint32_t> roots;
   std::map<std::string_view, std::uint32_t> nodeById;
+  std::set<std::string_view> ids;            // every element's id
+  std::vector<InstanceUrl> instanceUrls;     // instance_* elements and their urls
   std::set<std::string_view> visualScenes;   // ids of <visual_scene>
   std::vector<std::string_view> shownScenes;  // <instance_visual_scene> urls
   std::vector<std::pair<std::uint32_t, std::string_view>> instances;  // node, target id
@@ -254,13 +270,17 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
         return Status(ErrorCode::kResourceExhausted,
                       path + ": more than " + std::to_string(limits.maxNodes) + " nodes");
       }
-    } else if (name == "visual_scene") {
+    }
+    if (const std::string_view id = attribute(attributes, "id"); !id.empty()) ids.insert(id);
+    if (name == "visual_scene") {
       visualScenes.insert(attribute(attributes, "id"));
     } else if (name == "instance_visual_scene") {
       std::string_view url = attribute(attributes, "url");
       if (!url.empty() && url.front() == '#') url.remove_prefix(1);
       shownScenes.push_back(url);
-    } else if (name == "instance_node" && enclosing != kNoNode) {
+    }
+    if (isUrlInstance(name)) instanceUrls.push_back({name, attribute(attributes, "url"), i});
+    if (name == "instance_node" && enclosing != kNoNode) {
       std::string_view url = attribute(attributes, "url");
       if (!url.empty() && url.front() == '#') url.remove_prefix(1);
       instances.push_back({enclosing, url});
@@ -305,8 +325,20 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
                         std::string(a.source) + "' of " + std::to_string(array->second));
     }
   }
-  // Assimp's Collada reader leaked the scene it had built when the shown
-  // scene's url named nothing (fuzz finding 29): refused here instead.
+  // Assimp's Collada reader leaked what it had built when an instance's url
+  // was missing (fuzz finding 33) or named nothing in the file (29, the
+  // shown scene's): every instance must name an element of the file.
+  for (const InstanceUrl& instance : instanceUrls) {
+    if (instance.url.size() < 2 || instance.url.front() != '#' ||
+        ids.count(instance.url.substr(1)) == 0) {
+      return Status(ErrorCode::kParseError,
+                    path + ": <" + std::string(instance.element) + "> at byte " +
+                        std::to_string(instance.at) + " has a url \"" +
+                        std::string(instance.url.substr(0, 64)) +
+                        "\" that names no element of the file (only \"#id\" urls are read)");
+    }
+  }
+  // The shown scene's url must name a visual scene, not just any element.
   for (const std::string_view shown : shownScenes) {
     if (visualScenes.count(shown) == 0) {
       return Status(ErrorCode::kParseError,
