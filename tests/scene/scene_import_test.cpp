@@ -327,6 +327,30 @@ TEST(SceneImport, PackageInvalidFilesAreRefusedCleanly) {
   }
 }
 
+// Fuzz finding 34: "fox ..." passed the OBJ pre-check (a statement it has no
+// use for) and Assimp took it for a face and read past its buffer. Only
+// v vt vn f o g s mtllib usemtl (and comments) reach Assimp.
+TEST(SceneImport, ObjStatementsOutsideTheReadListAreRefusedBeforeAssimp) {
+  std::ifstream in(dataPath("colored_quad.obj"));
+  const std::string quad((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string dir = testing::TempDir() + "/obj-statements";
+  fs::create_directories(dir);
+  fs::copy_file(dataPath("colored_quad.mtl"), dir + "/colored_quad.mtl",
+                fs::copy_options::overwrite_existing);
+  const std::string path = dir + "/quad.obj";
+  { std::ofstream(path, std::ios::binary | std::ios::trunc) << quad; }
+  Result<Scene> plain = importScene(path);
+  ASSERT_TRUE(plain.ok()) << plain.status().toString();  // mtllib, usemtl, vt, f: all read
+  for (const std::string& extra : {std::string("fox 1 2 3\n"), std::string("l 1 2\n"),
+                                   std::string("vp 0.5\n"), std::string("v 1 2 3\0\n", 9)}) {
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << quad << extra; }
+    Result<Scene> r = importScene(path);
+    ASSERT_FALSE(r.ok()) << extra;  // the NUL: the mesh pre-check's refusal comes first
+    EXPECT_NE(r.status().message().find(path), std::string::npos) << r.status().toString();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(SceneImport, ObjWithAnEmptyFaceLineIsRefusedBeforeAssimp) {
   // invalid/malformed2.obj "references a non-existent material", which
   // Assimp would replace by its default one, but it also has a face line
