@@ -534,6 +534,18 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
     EXPECT_EQ(u.status().code(), ErrorCode::kParseError);
     EXPECT_NE(u.status().message().find("<instance_geometry>"), std::string::npos)
         << u.status().toString();
+    // Fuzz finding 35: an index list with a comma (Assimp read indices in
+    // the billions and asked for 3 GB); a sign or a value of 2^31 alike.
+    for (const char* list : {"<p>, 1 2</p>", "<p>0 -1 2</p>", "<p>0 1 2147483648</p>"}) {
+      std::string mutated = text;
+      const std::string p = "<p>0 1 2</p>";
+      mutated.replace(mutated.find(p), p.size(), list);
+      { std::ofstream(path, std::ios::binary | std::ios::trunc) << mutated; }
+      Result<Scene> m = importScene(path);
+      EXPECT_EQ(m.status().code(), ErrorCode::kParseError) << list;
+      EXPECT_NE(m.status().message().find("must hold unsigned integers"), std::string::npos)
+          << m.status().toString();
+    }
     // Fuzz finding 31: a transform with too few values (Assimp threw and
     // leaked); too many, a word or a self-closed one are refused alike.
     const std::string translate = "<translate>2 0 0</translate>";

@@ -151,6 +151,29 @@ struct InstanceUrl {
   std::size_t at;  // byte after the tag
 };
 
+// A primitive's index lists (p, vcount, v, h).
+bool isIndexList(std::string_view name) {
+  return name == "p" || name == "vcount" || name == "v" || name == "h";
+}
+
+// Whitespace-separated decimal integers in [0, 2^31).
+bool allUnsignedIntegers(std::string_view text) {
+  std::size_t digits = 0;
+  std::uint64_t value = 0;
+  for (const char c : text) {
+    if (c >= '0' && c <= '9') {
+      value = value * 10 + static_cast<std::uint64_t>(c - '0');
+      if (++digits > 10 || value >= (std::uint64_t{1} << 31)) return false;
+    } else if (std::isspace(static_cast<unsigned char>(c))) {
+      digits = 0;
+      value = 0;
+    } else {
+      return false;
+    }
+  }
+  return true;
+}
+
 bool isArrayElement(std::string_view name) {
   return name == "float_array" || name == "int_array" || name == "Name_array" ||
          name == "bool_array" || name == "IDREF_array";
@@ -293,6 +316,16 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
         return Status(ErrorCode::kParseError,
                       path + ": <" + std::string(name) + "> at byte " + std::to_string(i) +
                           " must hold " + std::to_string(wanted) + " finite numbers");
+      }
+    } else if (isIndexList(name) && !selfClosing) {
+      // Assimp read a primitive's index list "<p>, 1 2</p>" as indices in
+      // the billions and asked for 3 GB (fuzz finding 35): index lists hold
+      // unsigned integers only.
+      const std::size_t textEnd = std::min(xml.find('<', i), xml.size());
+      if (!allUnsignedIntegers(xml.substr(i, textEnd - i))) {
+        return Status(ErrorCode::kParseError,
+                      path + ": <" + std::string(name) + "> at byte " + std::to_string(i) +
+                          " must hold unsigned integers (indices below 2^31) only");
       }
     } else if (isArrayElement(name)) {
       const std::string_view id = attribute(attributes, "id");
