@@ -573,6 +573,16 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
     const std::size_t at = text.find(";base64,");
     ASSERT_NE(at, std::string::npos);
     const std::string path = testing::TempDir() + "/bad-base64.gltf";
+    // Fuzz finding 36: a NUL byte ends the pre-check's JSON (nlohmann parsed
+    // "{}\0..." as {}) but not Assimp's, which leaked on what followed.
+    {
+      std::string withNul = text;
+      withNul.insert(1, std::string("\0", 1));
+      { std::ofstream(path, std::ios::binary | std::ios::trunc) << withNul; }
+      Result<Scene> n = importScene(path);
+      EXPECT_EQ(n.status().code(), ErrorCode::kParseError);
+      EXPECT_NE(n.status().message().find("NUL byte"), std::string::npos) << n.status().toString();
+    }
     for (const std::string& bad : {std::string("\xC2\xBE"), std::string("="), std::string("A")}) {
       std::string mutated = text;
       mutated.insert(at + 8 + 4, bad);  // inside the data: a foreign byte, early '=', length
