@@ -114,7 +114,7 @@ std::vector<NamedMessage> seedMessages() {
   mixed.operations.push_back(std::move(remove));
   out.push_back({"scene_update_mixed", mixed});
 
-  out.push_back({"scene_update_empty", SceneUpdate{18, 341, 12.5, {}, {}}});
+  out.push_back({"scene_update_empty", SceneUpdate{18, 341, 12.5, {}, {}, {}}});
 
   // Animated objects' bone poses (docs/protocol.md, "Bone poses"): a skinned
   // mesh added and two objects' poses, one of three bones, one of one.
