@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "backbone_core.h"
 #include "fake_simplifier.h"
 #include "thinlod/common/core/relative_accuracy.h"
@@ -26,8 +28,13 @@ const std::string kWusonDir = "/usr/share/assimp/models/X";
 Result<std::unique_ptr<BackboneCore>> animatedCore(CoreOptions options) {
   EXPECT_TRUE(std::filesystem::exists(kWusonDir + "/Testwuson.X"))
       << "deploy/setup installs the Debian package assimp-testmodels";
+  // One file per test and process: ctest runs this file's tests side by side,
+  // and a shared name let one test read another's half-written scene.
+  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::string path =
-      (std::filesystem::path(::testing::TempDir()) / "animation_clock.wrl").string();
+      (std::filesystem::path(::testing::TempDir()) /
+       ("animation_clock_" + std::string(info->name()) + "_" + std::to_string(::getpid()) + ".wrl"))
+          .string();
   std::ofstream(path) << "#VRML V2.0 utf8\n"
                          "Transform { scale 0.1 0.1 0.1 children [\n"
                          "  Inline { url \"Testwuson.X\" animation \"Wuson_Run\" } ] }\n"
