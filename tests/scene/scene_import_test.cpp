@@ -547,12 +547,18 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
           << m.status().toString();
     }
     // Fuzz finding 31: a transform with too few values (Assimp threw and
-    // leaked); too many, a word or a self-closed one are refused alike.
+    // leaked); too many, a word or a self-closed one are refused alike, and
+    // so are numbers that are not plain decimals (Assimp's fast_atof reads
+    // hex floats, "inf" and "nan" otherwise than strtod) or not finite.
     const std::string translate = "<translate>2 0 0</translate>";
     const std::size_t t = text.find(translate);
     ASSERT_NE(t, std::string::npos);
-    for (const char* bad : {"<translate>00 2 </translate>", "<translate>1 2 3 4</translate>",
-                            "<translate>1 two 3</translate>", "<translate/>"}) {
+    for (const char* bad :
+         {"<translate>00 2 </translate>", "<translate>1 2 3 4</translate>",
+          "<translate>1 two 3</translate>", "<translate/>", "<translate>0x1p3 0 0</translate>",
+          "<translate>inf 0 0</translate>", "<translate>0 nan 0</translate>",
+          "<translate>0 0 1e400</translate>", "<translate>1e1000 0 0</translate>",
+          "<translate>+-1 0 0</translate>", "<translate>1.2.3 0 0</translate>"}) {
       std::string mutated = text;
       mutated.replace(t, translate.size(), bad);
       { std::ofstream(path, std::ios::binary | std::ios::trunc) << mutated; }
@@ -560,6 +566,14 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
       EXPECT_EQ(m.status().code(), ErrorCode::kParseError) << bad;
       EXPECT_NE(m.status().message().find("must hold 3 finite numbers"), std::string::npos)
           << m.status().toString();
+    }
+    {
+      std::string mutated = text;
+      mutated.replace(t, translate.size(), "<translate>+2.0 -0.5E+1 .5</translate>");
+      { std::ofstream(path, std::ios::binary | std::ios::trunc) << mutated; }
+      Result<Scene> plain = importScene(path);
+      EXPECT_TRUE(plain.ok()) << "signs, a leading point and an exponent are plain decimals: "
+                              << plain.status().toString();
     }
     fs::remove(path);
   }

@@ -133,61 +133,14 @@ std::uint32_t le32(const std::string& b, std::size_t at) {
          static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
 }
 
-// Every line of an OBJ going to Assimp starts with a statement of the list
-// below (or is blank or a comment), and the file has no NUL byte.
-Status checkObjStatementsForAssimp(const std::string& path, std::string_view text) {
-  if (text.find('\0') != std::string_view::npos) {
-    return Status(ErrorCode::kParseError, path + ": a NUL byte in an OBJ file");
-  }
-  static const std::set<std::string_view> kStatements = {"v", "vt", "vn", "f", "o", "g", "s",
-                                                         "mtllib", "usemtl"};
-  std::size_t line = 0;
-  for (std::size_t at = 0; at <= text.size();) {
-    std::size_t end = text.find('\n', at);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view current = text.substr(at, end - at);
-    at = end + 1;
-    ++line;
-    const std::size_t first = current.find_first_not_of(" \t\r");
-    if (first == std::string_view::npos || current[first] == '#') continue;
-    const std::size_t tokenEnd = current.find_first_of(" \t\r", first);
-    const std::string_view statement = current.substr(
-        first, tokenEnd == std::string_view::npos ? std::string_view::npos : tokenEnd - first);
-    if (kStatements.count(statement) == 0) {
-      return Status(ErrorCode::kParseError,
-                    path + ":" + std::to_string(line) + ": OBJ statement '" +
-                        std::string(statement.substr(0, 32)) +
-                        "' is not read (v vt vn f o g s mtllib usemtl only)");
-    }
-  }
-  return Status();
-}
-
 // The longest media type a glTF data uri may name before ";base64,".
 constexpr std::size_t kMaxDataUriMediaTypeLength = 64;
 
-// RFC 4648 base64 with padding: A-Z a-z 0-9 + /, '=' only as the last one or
-// two characters, length divisible by 4.
-bool isPlainBase64(std::string_view text) {
-  if (text.size() % 4 != 0) return false;
-  std::size_t padding = 0;
-  while (padding < 2 && padding < text.size() && text[text.size() - 1 - padding] == '=') ++padding;
-  for (std::size_t i = 0; i + padding < text.size(); ++i) {
-    const char c = text[i];
-    const bool alphabet = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
-                          (c >= '0' && c <= '9') || c == '+' || c == '/';
-    if (!alphabet) return false;
-  }
-  return true;
-}
-
-Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
+Result<GltfDeclared> precheckGltf(const std::string& path, const std::string& bytes,
                                   const ImportLimits& limits) {
-  Result<std::string> bytes = readFileBounded(path, size);
-  if (!bytes.ok()) return bytes.status();
   std::string json;
   if (lowerExtension(path) == ".glb") {
-    const std::string& b = *bytes;
+    const std::string& b = bytes;
     if (b.size() < 20 || b.compare(0, 4, "glTF") != 0) {
       return Status(ErrorCode::kParseError, path + ": not a binary glTF (no 'glTF' header)");
     }
@@ -219,7 +172,7 @@ Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
       at += 8 + static_cast<std::size_t>(length);
     }
   } else {
-    json = std::move(*bytes);
+    json = bytes;
   }
   // A NUL byte ends the text for nlohmann's parser but not for Assimp's, so
   // the two read different documents ("{}\0..." passed, and Assimp leaked
@@ -266,7 +219,7 @@ Result<GltfDeclared> precheckGltf(const std::string& path, std::uint64_t size,
                           std::to_string(marker - 5) + " characters (at most " +
                           std::to_string(kMaxDataUriMediaTypeLength) + ")");
       }
-      if (!isPlainBase64(std::string_view(uri).substr(marker + 8))) {
+      if (!detail::isPlainBase64(std::string_view(uri).substr(marker + 8))) {
         return Status(ErrorCode::kParseError,
                       path + ": an embedded " + std::string(array) +
                           " uri is not plain base64 (characters outside the alphabet, "
@@ -685,36 +638,37 @@ Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
   try {
     std::optional<GltfDeclared> declared;
     const std::string ext = lowerExtension(path);
+    // The formats with a pre-check of ours are read once here; the others
+    // (.fbx, .x) reach Assimp through BoundedIOSystem's byte limits only.
+    const bool prechecked = ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".obj" ||
+                            ext == ".smd";
+    std::string bytes;
+    if (prechecked) {
+      Result<std::string> read = readFileBounded(path, size);
+      if (!read.ok()) return read.status();
+      bytes = std::move(*read);
+    }
     if (ext == ".gltf" || ext == ".glb") {
-      Result<GltfDeclared> checked = precheckGltf(path, size, limits);
+      Result<GltfDeclared> checked = precheckGltf(path, bytes, limits);
       if (!checked.ok()) return checked.status();
       declared = *checked;
     } else if (ext == ".dae") {
       // Assimp's Collada reader recurses over nodes and instance_node
       // references unchecked: a cycle or deep nesting crashed it.
-      Result<std::string> bytes = readFileBounded(path, size);
-      if (!bytes.ok()) return bytes.status();
-      THINLOD_RETURN_IF_ERROR(detail::precheckCollada(path, *bytes, limits));
+      THINLOD_RETURN_IF_ERROR(detail::precheckCollada(path, bytes, limits));
     } else if (ext == ".obj") {
       // The OBJ (+ MTL) route to Assimp: the mesh loader's OBJ pre-check
       // first (numbers, face indices in range, line grammar). Assimp's OBJ
       // reader leaked what it had built on a face naming a uv past the
       // file's (fuzz finding 32).
-      Result<std::string> bytes = readFileBounded(path, size);
-      if (!bytes.ok()) return bytes.status();
       Result<mesh_detail::PrecheckResult> checked =
-          mesh_detail::precheckMesh(*bytes, mesh_detail::MeshFormat::kObj, path, MeshLoadOptions{});
+          mesh_detail::precheckMesh(bytes, mesh_detail::MeshFormat::kObj, path, MeshLoadOptions{});
       if (!checked.ok()) return checked.status();
-      // The pre-check skips statements it has no use for; Assimp reads the
-      // original bytes and dispatches on a line's first characters, so
-      // "fox ..." was a face to it and its number parsing read past the
-      // buffer (fuzz finding 34, a heap overflow). Only the statements both
-      // understand the same way get through, and no NUL.
-      THINLOD_RETURN_IF_ERROR(checkObjStatementsForAssimp(path, *bytes));
+      // Then the statements both readers understand the same way, and no NUL
+      // (fuzz finding 34).
+      THINLOD_RETURN_IF_ERROR(detail::checkObjStatementsForAssimp(path, bytes));
     } else if (ext == ".smd") {
-      Result<std::string> bytes = readFileBounded(path, size);
-      if (!bytes.ok()) return bytes.status();
-      THINLOD_RETURN_IF_ERROR(detail::precheckSmd(path, *bytes));
+      THINLOD_RETURN_IF_ERROR(detail::precheckSmd(path, bytes));
     }
     Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
     auto* io = new BoundedIOSystem(limits);

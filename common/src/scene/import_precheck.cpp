@@ -118,8 +118,43 @@ std::size_t transformValues(std::string_view name) {
   return 0;
 }
 
+// The one number reader of the Assimp pre-checks: a plain decimal number
+// (sign, digits, one point, an exponent of at most 3 digits) that is finite,
+// the form Assimp's fast_atof reads as strtod does. Hex floats ("0x1p3"),
+// "inf" and "nan" are refused: fast_atof reads them otherwise (the class of
+// fuzz findings 6, 9, 19 and 26, where a pre-check and the library read
+// different numbers). Not mesh_detail::parseNumberToken: that one follows
+// OpenMesh's stream reader (from_chars, infinities kept for the caller).
+bool isPlainFiniteNumber(std::string_view token) {
+  if (token.empty() || token.size() > 64) return false;
+  std::size_t i = 0;
+  if (token[i] == '-' || token[i] == '+') ++i;
+  bool digits = false;
+  while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+    ++i;
+    digits = true;
+  }
+  if (i < token.size() && token[i] == '.') {
+    ++i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
+      ++i;
+      digits = true;
+    }
+  }
+  if (!digits) return false;
+  if (i < token.size() && (token[i] == 'e' || token[i] == 'E')) {
+    ++i;
+    if (i < token.size() && (token[i] == '-' || token[i] == '+')) ++i;
+    const std::size_t exponent = i;
+    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) ++i;
+    if (i == exponent || i - exponent > 3) return false;
+  }
+  if (i != token.size()) return false;
+  return std::isfinite(std::strtod(std::string(token).c_str(), nullptr));
+}
+
 // The whitespace-separated tokens of an element's text; false when one is
-// not a finite number.
+// not a plain finite number.
 bool countNumbers(std::string_view text, std::uint64_t* count) {
   *count = 0;
   std::size_t i = 0;
@@ -128,13 +163,24 @@ bool countNumbers(std::string_view text, std::uint64_t* count) {
     if (i >= text.size()) break;
     const std::size_t start = i;
     while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-    const std::string token(text.substr(start, i - start));
-    char* end = nullptr;
-    const double value = std::strtod(token.c_str(), &end);
-    if (end != token.c_str() + token.size() || !std::isfinite(value)) return false;
+    if (!isPlainFiniteNumber(text.substr(start, i - start))) return false;
     ++*count;
   }
   return true;
+}
+
+// Calls visit(line, number) for every line of text (split at '\n', the
+// '\n' dropped, numbered from 1) until it returns an error.
+template <typename Visit>
+Status forEachLine(std::string_view text, Visit visit) {
+  std::size_t number = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    THINLOD_RETURN_IF_ERROR(visit(text.substr(at, end - at), ++number));
+    at = end + 1;
+  }
+  return Status();
 }
 
 // The instance elements whose url Assimp needs resolved to build geometry.
@@ -147,9 +193,12 @@ bool isUrlInstance(std::string_view name) {
 
 struct InstanceUrl {
   std::string_view element;
-  std::string_view url;
-  std::size_t at;  // byte after the tag
+  std::string_view url;    // as written: "#id" is the only form read
+  std::size_t at;          // byte after the tag
+  std::uint32_t enclosing;  // the <node> it sits in, or kNoNode
 };
+
+constexpr std::uint32_t kNoNode = 0xffffffffu;
 
 // A primitive's index lists (p, vcount, v, h).
 bool isIndexList(std::string_view name) {
@@ -202,7 +251,6 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     std::string_view name;
     std::uint32_t node;  // index of the enclosing <node> (this one if a node), or kNoNode
   };
-  constexpr std::uint32_t kNoNode = 0xffffffffu;
   std::vector<Open> open;
   std::vector<std::vector<std::uint32_t>> children;
   std::vector<std::uint32_t> roots;
@@ -210,8 +258,6 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
   std::set<std::string_view> ids;            // every element's id
   std::vector<InstanceUrl> instanceUrls;     // instance_* elements and their urls
   std::set<std::string_view> visualScenes;   // ids of <visual_scene>
-  std::vector<std::string_view> shownScenes;  // <instance_visual_scene> urls
-  std::vector<std::pair<std::uint32_t, std::string_view>> instances;  // node, target id
   std::map<std::string_view, std::uint64_t> arrayCount;
   struct Accessor {
     std::string_view source;
@@ -295,18 +341,9 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
       }
     }
     if (const std::string_view id = attribute(attributes, "id"); !id.empty()) ids.insert(id);
-    if (name == "visual_scene") {
-      visualScenes.insert(attribute(attributes, "id"));
-    } else if (name == "instance_visual_scene") {
-      std::string_view url = attribute(attributes, "url");
-      if (!url.empty() && url.front() == '#') url.remove_prefix(1);
-      shownScenes.push_back(url);
-    }
-    if (isUrlInstance(name)) instanceUrls.push_back({name, attribute(attributes, "url"), i});
-    if (name == "instance_node" && enclosing != kNoNode) {
-      std::string_view url = attribute(attributes, "url");
-      if (!url.empty() && url.front() == '#') url.remove_prefix(1);
-      instances.push_back({enclosing, url});
+    if (name == "visual_scene") visualScenes.insert(attribute(attributes, "id"));
+    if (isUrlInstance(name)) {
+      instanceUrls.push_back({name, attribute(attributes, "url"), i, enclosing});
     } else if (const std::size_t wanted = transformValues(name); wanted > 0) {
       // Assimp's Collada reader threw on a transform with too few values
       // and leaked the nodes it had built (fuzz finding 31).
@@ -360,28 +397,27 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
   }
   // Assimp's Collada reader leaked what it had built when an instance's url
   // was missing (fuzz finding 33) or named nothing in the file (29, the
-  // shown scene's): every instance must name an element of the file.
+  // shown scene's): every instance must name an element of the file, the
+  // shown scene a visual scene. instance_node adds its target to the
+  // enclosing node's children for the graph check.
   for (const InstanceUrl& instance : instanceUrls) {
-    if (instance.url.size() < 2 || instance.url.front() != '#' ||
-        ids.count(instance.url.substr(1)) == 0) {
+    const std::string_view target = instance.url.substr(std::min<std::size_t>(1, instance.url.size()));
+    if (instance.url.size() < 2 || instance.url.front() != '#' || ids.count(target) == 0) {
       return Status(ErrorCode::kParseError,
                     path + ": <" + std::string(instance.element) + "> at byte " +
                         std::to_string(instance.at) + " has a url \"" +
                         std::string(instance.url.substr(0, 64)) +
                         "\" that names no element of the file (only \"#id\" urls are read)");
     }
-  }
-  // The shown scene's url must name a visual scene, not just any element.
-  for (const std::string_view shown : shownScenes) {
-    if (visualScenes.count(shown) == 0) {
+    if (instance.element == "instance_visual_scene" && visualScenes.count(target) == 0) {
       return Status(ErrorCode::kParseError,
-                    path + ": <instance_visual_scene url=\"#" + std::string(shown.substr(0, 64)) +
+                    path + ": <instance_visual_scene url=\"#" + std::string(target.substr(0, 64)) +
                         "\"> names no <visual_scene> of the file");
     }
-  }
-  for (const auto& [node, target] : instances) {
-    const auto found = nodeById.find(target);
-    if (found != nodeById.end()) children[node].push_back(found->second);
+    if (instance.element == "instance_node" && instance.enclosing != kNoNode) {
+      const auto found = nodeById.find(target);
+      if (found != nodeById.end()) children[instance.enclosing].push_back(found->second);
+    }
   }
   return checkNodeGraph(path, children, roots, limits);
 }
@@ -425,35 +461,6 @@ bool smdInteger(std::string_view token, long lo, long hi, long* out = nullptr) {
   return true;
 }
 
-// A plain decimal number (sign, digits, one point, an exponent) that is
-// finite: what Assimp's fast_atof reads the same way.
-bool smdNumber(std::string_view token) {
-  if (token.empty() || token.size() > 64) return false;
-  std::size_t i = 0;
-  if (token[i] == '-' || token[i] == '+') ++i;
-  bool digits = false;
-  while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
-    ++i;
-    digits = true;
-  }
-  if (i < token.size() && token[i] == '.') {
-    ++i;
-    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
-      ++i;
-      digits = true;
-    }
-  }
-  if (!digits) return false;
-  if (i < token.size() && (token[i] == 'e' || token[i] == 'E')) {
-    ++i;
-    if (i < token.size() && (token[i] == '-' || token[i] == '+')) ++i;
-    const std::size_t exponent = i;
-    while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) ++i;
-    if (i == exponent || i - exponent > 3) return false;
-  }
-  if (i != token.size()) return false;
-  return std::isfinite(std::strtod(std::string(token).c_str(), nullptr));
-}
 
 }  // namespace
 
@@ -463,19 +470,12 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
   bool sawVersion = false;
   long nodes = 0;
   int triangleLine = 0;  // 0: the material line next, 1-3: a vertex line
-  std::size_t lineNumber = 0;
   std::vector<std::string_view> tokens;
-  auto refuse = [&](const std::string& why) {
-    return Status(ErrorCode::kParseError,
-                  path + ": SMD line " + std::to_string(lineNumber) + ": " + why);
-  };
-  std::size_t pos = 0;
-  while (pos < bytes.size()) {
-    std::size_t end = bytes.find('\n', pos);
-    if (end == std::string_view::npos) end = bytes.size();
-    std::string_view line = bytes.substr(pos, end - pos);
-    pos = end + 1;
-    ++lineNumber;
+  THINLOD_RETURN_IF_ERROR(forEachLine(bytes, [&](std::string_view line, std::size_t lineNumber) {
+    auto refuse = [&](const std::string& why) {
+      return Status(ErrorCode::kParseError,
+                    path + ": SMD line " + std::to_string(lineNumber) + ": " + why);
+    };
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.find_first_of(std::string_view("\0\r", 2)) != std::string_view::npos) {
       return refuse("a NUL or a lone carriage return");
@@ -483,13 +483,13 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
     const std::size_t comment = line.find("//");
     if (comment != std::string_view::npos) line = line.substr(0, comment);
     if (!smdTokens(line, tokens)) return refuse("a quote is not closed");
-    if (tokens.empty()) continue;
+    if (tokens.empty()) return Status();
     if (!sawVersion) {
       if (tokens.size() != 2 || tokens[0] != "version" || tokens[1] != "1") {
         return refuse("the file must start with 'version 1'");
       }
       sawVersion = true;
-      continue;
+      return Status();
     }
     if (section == Section::kNone) {
       if (tokens.size() != 1) return refuse("a section name (nodes, skeleton, triangles) expected");
@@ -506,13 +506,13 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
         return refuse("unknown section");
       }
       if (section != Section::kNodes && nodes == 0) return refuse("a section before the nodes");
-      continue;
+      return Status();
     }
     if (tokens.size() == 1 && tokens[0] == "end" &&
         !(section == Section::kTriangles && triangleLine != 0)) {
       if (section == Section::kNodes && nodes == 0) return refuse("no nodes");
       section = Section::kNone;
-      continue;
+      return Status();
     }
     switch (section) {
       case Section::kNodes: {
@@ -534,12 +534,11 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
           break;
         }
         const long limit = section == Section::kSkeleton ? nodes - 1 : 10000000;
-        const std::size_t values = section == Section::kSkeleton ? 7 : 7;
-        if (tokens.size() != values || !smdInteger(tokens[0], 0, limit)) {
+        if (tokens.size() != 7 || !smdInteger(tokens[0], 0, limit)) {
           return refuse("a key is 'bone x y z rx ry rz' with a known bone");
         }
         for (std::size_t k = 1; k < tokens.size(); ++k) {
-          if (!smdNumber(tokens[k])) return refuse("not a finite number");
+          if (!isPlainFiniteNumber(tokens[k])) return refuse("not a finite number");
         }
         break;
       }
@@ -559,11 +558,11 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
               "a vertex is 'bone x y z nx ny nz u v [links (bone weight)...]' with known bones");
         }
         for (std::size_t k = 1; k < 9; ++k) {
-          if (!smdNumber(tokens[k])) return refuse("not a finite number");
+          if (!isPlainFiniteNumber(tokens[k])) return refuse("not a finite number");
         }
         for (long l = 0; l < links; ++l) {
           const std::size_t at = 10 + 2 * static_cast<std::size_t>(l);
-          if (!smdInteger(tokens[at], 0, nodes - 1) || !smdNumber(tokens[at + 1])) {
+          if (!smdInteger(tokens[at], 0, nodes - 1) || !isPlainFiniteNumber(tokens[at + 1])) {
             return refuse("a link is 'bone weight' with a known bone");
           }
         }
@@ -573,13 +572,49 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
       case Section::kNone:
         break;
     }
-  }
+    return Status();
+  }));
   if (!sawVersion) return Status(ErrorCode::kParseError, path + ": SMD: no 'version 1' line");
   if (section != Section::kNone) {
     return Status(ErrorCode::kParseError,
                   path + ": SMD: a section is not closed by 'end' (the file is truncated)");
   }
   return Status();
+}
+
+Status checkObjStatementsForAssimp(const std::string& path, std::string_view text) {
+  if (text.find('\0') != std::string_view::npos) {
+    return Status(ErrorCode::kParseError, path + ": a NUL byte in an OBJ file");
+  }
+  static const std::set<std::string_view> kStatements = {"v", "vt", "vn", "f", "o", "g", "s",
+                                                         "mtllib", "usemtl"};
+  return forEachLine(text, [&](std::string_view line, std::size_t number) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[first] == '#') return Status();
+    const std::size_t tokenEnd = line.find_first_of(" \t\r", first);
+    const std::string_view statement = line.substr(
+        first, tokenEnd == std::string_view::npos ? std::string_view::npos : tokenEnd - first);
+    if (kStatements.count(statement) == 0) {
+      return Status(ErrorCode::kParseError,
+                    path + ":" + std::to_string(number) + ": OBJ statement '" +
+                        std::string(statement.substr(0, 32)) +
+                        "' is not read (v vt vn f o g s mtllib usemtl only)");
+    }
+    return Status();
+  });
+}
+
+bool isPlainBase64(std::string_view text) {
+  if (text.size() % 4 != 0) return false;
+  std::size_t padding = 0;
+  while (padding < 2 && padding < text.size() && text[text.size() - 1 - padding] == '=') ++padding;
+  for (std::size_t i = 0; i + padding < text.size(); ++i) {
+    const char c = text[i];
+    const bool alphabet = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
+                          (c >= '0' && c <= '9') || c == '+' || c == '/';
+    if (!alphabet) return false;
+  }
+  return true;
 }
 
 }  // namespace thinlod::scene::detail

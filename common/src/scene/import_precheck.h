@@ -32,8 +32,12 @@ Status checkNodeGraph(const std::string& path,
 // before Assimp parses it. Refuses unterminated markup and a file whose
 // elements are left open (truncated), element nesting deeper than
 // limits.maxDepth + 64, an accessor reading past the array it names
-// (count * stride > the array's count), and node graphs (nesting plus
-// instance_node) that checkNodeGraph refuses.
+// (count * stride > the array's count), a transform without exactly its
+// count of plain finite decimal numbers, an index list (p, vcount, v, h)
+// with anything but unsigned integers below 2^31, an instance_geometry /
+// _node / _controller / _visual_scene whose url is not "#id" of an element
+// of the file (the shown scene's of a visual_scene), and node graphs
+// (nesting plus instance_node) that checkNodeGraph refuses.
 Status precheckCollada(const std::string& path, std::string_view xml, const ImportLimits& limits);
 
 // Valve SMD (skinned imports): Assimp's reader loops without end when a
@@ -45,5 +49,17 @@ Status precheckCollada(const std::string& path, std::string_view xml, const Impo
 // their lines, known bones and finite plain decimal numbers; triangles of a
 // material line and three vertex lines.
 Status precheckSmd(const std::string& path, std::string_view bytes);
+
+// OBJ on the route to Assimp (after the mesh loader's OBJ pre-check): every
+// line is blank, a comment or one of v vt vn f o g s mtllib usemtl, and
+// there is no NUL byte. Assimp dispatches on a line's first characters, so
+// a statement the mesh pre-check skips ("fox ...") was a face to it and its
+// number parsing read past the buffer (fuzz finding 34).
+Status checkObjStatementsForAssimp(const std::string& path, std::string_view text);
+
+// RFC 4648 base64 with padding: A-Z a-z 0-9 + /, '=' only as the last one or
+// two characters, a length divisible by 4. Assimp's decoder leaked its
+// output on a character outside the alphabet (fuzz finding 30).
+bool isPlainBase64(std::string_view text);
 
 }  // namespace thinlod::scene::detail
