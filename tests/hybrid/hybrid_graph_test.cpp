@@ -350,7 +350,9 @@ TEST(HybridMeasuredLevels, RungsAreStepsWithTheirCutsMeasuredError) {
   HybridCut incremental(*g);  // adapted rung to rung, as measureHybridLevels does
   for (std::size_t i = 0; i < levels->size(); ++i) {
     const HybridMeasuredLevel& level = (*levels)[i];
-    if (i > 0) EXPECT_GT(level.step.units, (*levels)[i - 1].step.units);
+    if (i > 0) {
+      EXPECT_GT(level.step.units, (*levels)[i - 1].step.units);
+    }
     HybridCut fresh(*g);
     fresh.adaptToError(level.step.error);
     incremental.adaptToError(level.step.error);
