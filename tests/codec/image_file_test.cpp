@@ -175,7 +175,7 @@ TEST(ImageFile, GreyAndGreyAlphaBecomeRgba) {
 // rgb16_5x3.png (written by hand, 16 bits per channel): channel c of pixel
 // (x, y) holds 257 k + 10 (k = (40x + 17y + 60c) mod 256; 65535 for k = 255),
 // so its 8-bit value is k. Read in the file's own type and converted by
-// readAsUint8 (not by ImageInput::read_image's 64 MB conversion buffer).
+// readAsRgba8 (not by ImageInput::read_image's 64 MB conversion buffer).
 TEST(ImageFile, SixteenBitPngBecomesEightBitRgba) {
   const std::vector<std::uint8_t> bytes = seedFile("rgb16_5x3.png");
   ASSERT_FALSE(bytes.empty());

@@ -247,33 +247,16 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::uint8_t* data, st
   return openWithProxy(formatFileName(codec), proxy);
 }
 
-// RGBA8 from an image's pixels (1 grey, 2 grey + alpha, 3 RGB, 4+ RGBA).
-void expandToRgba(const std::vector<std::uint8_t>& in, int channels, RgbaImage& out) {
-  const std::size_t pixels = out.pixels.size() / 4;
-  for (std::size_t p = 0; p < pixels; ++p) {
-    const std::uint8_t* src = in.data() + p * static_cast<std::size_t>(channels);
-    std::uint8_t* dst = out.pixels.data() + 4 * p;
-    if (channels <= 2) {
-      dst[0] = dst[1] = dst[2] = src[0];
-      dst[3] = channels == 2 ? src[1] : 255;
-    } else {
-      dst[0] = src[0];
-      dst[1] = src[1];
-      dst[2] = src[2];
-      dst[3] = channels >= 4 ? src[3] : 255;
-    }
-  }
-}
-
-// The pixels of an opened `input` as 8-bit values of its first `channels`
-// channels, row-major into `dest` (width * height * channels bytes; the
-// caller checked the dimensions against its limits). Read in the file's own
-// type, a band of rows at a time, and converted here: ImageInput::read_image
-// asked for a conversion (a 16-bit PNG to UINT8, or a channel subset)
-// allocates a buffer of about 64 MB whatever the image's size (OpenImageIO
-// 2.4's chunk is 2^26 bytes of rows, not clamped to the height), which made
-// every such file, even 1x1, cost a 64 MB allocation.
-Status readAsUint8(OIIO::ImageInput& input, int channels, std::uint8_t* dest) {
+// The pixels of an opened `input` as RGBA8, row-major into `dest` (width *
+// height * 4 bytes; the caller checked the dimensions against its limits):
+// 1 channel is grey, 2 grey + alpha, 3 RGB (alpha 255), 4 or more RGBA (the
+// rest dropped). Read in the file's own type, a band of rows at a time, and
+// converted here: ImageInput::read_image asked for a conversion (a 16-bit
+// PNG to UINT8, or a channel subset) allocates a buffer of about 64 MB
+// whatever the image's size (OpenImageIO 2.4's chunk is 2^26 bytes of rows,
+// not clamped to the height), which made every such file, even 1x1, cost a
+// 64 MB allocation.
+Status readAsRgba8(OIIO::ImageInput& input, std::uint8_t* dest) {
   const OIIO::ImageSpec& spec = input.spec();
   if (!spec.channelformats.empty()) {
     return textureError(ErrorCode::kUnsupported, "per-channel pixel formats");
@@ -306,9 +289,17 @@ Status readAsUint8(OIIO::ImageInput& input, int channels, std::uint8_t* dest) {
       bytes = converted.data();
     }
     const std::size_t pixels = std::size_t(spec.width) * std::size_t(rows);
-    for (std::size_t p = 0; p < pixels; ++p) {
-      std::copy_n(bytes + p * std::size_t(fileChannels), channels, dest);
-      dest += channels;
+    for (std::size_t p = 0; p < pixels; ++p, dest += 4) {
+      const std::uint8_t* src = bytes + p * std::size_t(fileChannels);
+      if (fileChannels <= 2) {
+        dest[0] = dest[1] = dest[2] = src[0];
+        dest[3] = fileChannels == 2 ? src[1] : 255;
+      } else {
+        dest[0] = src[0];
+        dest[1] = src[1];
+        dest[2] = src[2];
+        dest[3] = fileChannels >= 4 ? src[3] : 255;
+      }
     }
   }
   return Status();
@@ -332,11 +323,7 @@ Status decodeImage(const std::uint8_t* payload, std::size_t size, TextureCodec c
                             ", header says " + std::to_string(out.width) + "x" +
                             std::to_string(out.height) + "x" + std::to_string(wantChannels));
   }
-  if (wantChannels == 4) return readAsUint8(input, 4, out.pixels.data());
-  std::vector<std::uint8_t> rgb(out.pixels.size() / 4 * 3);
-  THINLOD_RETURN_IF_ERROR(readAsUint8(input, 3, rgb.data()));
-  expandToRgba(rgb, 3, out);
-  return Status();
+  return readAsRgba8(input, out.pixels.data());
 }
 
 double psnrRgb(const RgbaImage& a, const RgbaImage& b) {
@@ -483,11 +470,7 @@ Result<RgbaImage> decodeImageFile(const std::uint8_t* data, std::size_t size,
     out.width = spec.width;
     out.height = spec.height;
     out.pixels.assign(static_cast<std::size_t>(bytes), 0);
-    const int channels = std::min(spec.nchannels, 4);
-    std::vector<std::uint8_t> raw(static_cast<std::size_t>(bytes / 4) *
-                                  static_cast<std::size_t>(channels));
-    THINLOD_RETURN_IF_ERROR(readAsUint8(*input, channels, raw.data()));
-    expandToRgba(raw, channels, out);
+    THINLOD_RETURN_IF_ERROR(readAsRgba8(*input, out.pixels.data()));
     return out;
   } catch (const std::bad_alloc&) {
     return textureError(ErrorCode::kResourceExhausted, "out of memory decoding the image");
