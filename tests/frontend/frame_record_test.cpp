@@ -14,6 +14,8 @@
 #include <random>
 #include <sstream>
 
+#include "frontend_test_util.h"
+
 namespace thinlod::frontend {
 namespace {
 
@@ -62,13 +64,23 @@ TEST(FrameRecord, HeaderHasTheRequiredColumnsInOrder) {
             "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
             "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,"
             "wait_ms,updates_received,updates_rejected,lockstep_timeout,shown_at_ms,"
-            "visible_objects,missing_objects,blank,skinned_objects,deformed_vertices\n");
+            "visible_objects,missing_objects,blank,skinned_objects,deformed_vertices,"
+            "pose_bytes\n");
 }
 
 TEST(FrameRecord, RowFormatsEveryColumn) {
   EXPECT_EQ(formatFrameCsvRow(sampleRecord()),
             "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,31.5000,3,2,524288,"
-            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0\n");
+            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0,0\n");
+}
+
+TEST(FrameRecord, SkinnedColumnsComeLastAfterTheOlderOnes) {
+  FrameRecord r = sampleRecord();
+  r.skinnedObjects = 3;
+  r.deformedVertices = 4453;
+  r.poseBytes = 3 * 37 * 48;
+  const std::string row = formatFrameCsvRow(r);
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,3,4453,5328\n");
 }
 
 TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
@@ -76,7 +88,7 @@ TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
   r.frame = 1;
   r.quality.snrDb = kInf;
   r.quality.psnrDb = kInf;
-  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0\n");
+  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0,0\n");
   r.quality.snrDb = -kInf;
   EXPECT_NE(formatFrameCsvRow(r).find(",-inf,"), std::string::npos);
 }
@@ -452,6 +464,66 @@ TEST(FrameLog, ALongDeferredRunSpillsPendingRecordsInsteadOfHoldingThem) {
   const ReplaySummary s = (*log)->summary().summarize();
   EXPECT_EQ(s.frames, kFrames);
   EXPECT_EQ(s.snrFrames, kFrames / 10);
+}
+
+// A scene holding what `batch` brings (uploaded and committed at once).
+void hold(FrontendScene& scene, SceneBatch batch) {
+  ASSERT_TRUE(scene.enqueue(std::move(batch)).ok());
+  for (const PendingUpload& upload : scene.planUploads(~std::size_t{0}))
+    ASSERT_TRUE(scene.markUploaded(upload.key).ok());
+  scene.commitReady();
+}
+
+TEST(ObjectCsv, HeaderNamesThePerObjectColumns) {
+  EXPECT_EQ(objectCsvHeader(), "frame,time_s,object,kind,triangles,vertices,skinned,posed,x,y,z\n");
+}
+
+TEST(ObjectCsv, AnEmptySceneHasNoRows) {
+  EXPECT_EQ(formatObjectCsvRows(0, 0.0, FrontendScene()), "");
+}
+
+TEST(ObjectCsv, OneRowPerHeldObjectInIdOrderWithSkinAndPose) {
+  using testing::addOp;
+  using testing::quadMesh;
+  using testing::sphereMesh;
+  FrontendScene scene;
+  SceneBatch batch;
+  batch.plan = 1;
+  const glm::mat4 at = glm::translate(glm::mat4(1.0f), glm::vec3(-3.0f, 0.0f, 0.5f));
+  // Object 9: a skinned quad with its pose; object 4: a plain sphere; object 6:
+  // a skinned quad whose pose has not come.
+  SceneOperation skinned =
+      addOp(9, RepresentationKind::kMesh, quadMesh(0, 0, 1, 1, 0), nullptr, at);
+  skinned.representation.skin =
+      std::make_shared<const std::vector<anim::VertexSkin>>(4, anim::VertexSkin{0, 0, 0.0f});
+  SceneOperation unposed = skinned;
+  unposed.id = 6;
+  unposed.representation.transform = glm::mat4(1.0f);
+  const std::shared_ptr<const IndexedMesh> sphere = sphereMesh(1.0f, 8, 4);
+  batch.operations = {skinned, addOp(4, RepresentationKind::kMesh, sphere, nullptr), unposed};
+  batch.bonePoses = {{9, BoneMatrices(1, glm::mat4(1.0f))}};
+  hold(scene, std::move(batch));
+  ASSERT_EQ(scene.objects().size(), 3u);
+  const std::string mesh = representationKindName(RepresentationKind::kMesh);
+  const std::string sphereRow = "4," + mesh + "," + std::to_string(sphere->triangleCount()) + "," +
+                                std::to_string(sphere->vertexCount()) + ",0,0,0,0,0\n";
+  EXPECT_EQ(formatObjectCsvRows(17, 1.7, scene), "17,1.700000," + sphereRow + "17,1.700000,6," +
+                                                     mesh + ",2,4,1,0,0,0,0\n" + "17,1.700000,9," +
+                                                     mesh + ",2,4,1,1,-3,0,0.5\n");
+}
+
+TEST(ObjectCsv, AnImpostorRowNamesItsKind) {
+  using testing::addOp;
+  using testing::solidImage;
+  FrontendScene scene;
+  SceneBatch batch;
+  batch.operations = {
+      addOp(2, RepresentationKind::kSimpleImpostor, nullptr, solidImage(2, 2, 9, 9, 9, 255))};
+  hold(scene, std::move(batch));
+  // Without a mesh it holds the unit quad: 2 triangles, 4 vertices.
+  EXPECT_EQ(formatObjectCsvRows(0, 0.0, scene),
+            std::string("0,0.000000,2,") +
+                representationKindName(RepresentationKind::kSimpleImpostor) + ",2,4,0,0,0,0,0\n");
 }
 
 }  // namespace

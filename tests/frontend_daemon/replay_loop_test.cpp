@@ -380,6 +380,32 @@ TEST_F(ReplayLoopTest, LiveModeAppliesALateAnswerWhenItArrivesWithItsTrueLatency
   EXPECT_EQ(result.records[3].linkBytes, 0u);
 }
 
+TEST_F(ReplayLoopTest, PoseBytesCountTheBonePosesOfTheUpdatesReceivedInTheFrame) {
+  options.rate = 10.0;  // one frame every 100 ms
+  // Pose 0's answer brings a sphere and no pose; poses 1 and 2 are answered
+  // with two objects' poses (3 and 5 matrices), pose 2's 30 ms late (while
+  // frame 3 waits for its slot), so frame 2 receives nothing and frame 3 it.
+  link.responder = [](const protocol::ViewerPose& pose) {
+    std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
+    protocol::SceneUpdate update = sphereUpdate(pose.sequence + 1, pose.sequence, 1, 5.0);
+    if (pose.sequence > 0) {
+      update.operations.clear();
+      update.bonePoses = {{1, std::vector<glm::mat4>(3, glm::mat4(1.0f))},
+                          {2, std::vector<glm::mat4>(5, glm::mat4(1.0f))}};
+    }
+    if (pose.sequence < 3) reply = std::make_pair(pose.sequence == 2 ? 30 * kMs : 0, update);
+    return reply;
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2, 0.3}));
+  ASSERT_EQ(result.records.size(), 4u);
+  EXPECT_EQ(result.records[0].poseBytes, 0u);
+  EXPECT_EQ(result.records[1].poseBytes, 8u * 48u);
+  EXPECT_EQ(result.records[2].poseBytes, 0u);
+  EXPECT_EQ(result.records[3].poseBytes, 8u * 48u);
+  // They are part of link_bytes (the fake link counts 1000 bytes of framing an update).
+  EXPECT_EQ(result.records[1].linkBytes, 1000u + 8u * 48u);
+}
+
 TEST_F(ReplayLoopTest, ATraceGivesWaitsNoDescriptorToWakeOn) {
   options.rate = 10.0;
   run(traceAt({0.0, 0.1, 0.2}));

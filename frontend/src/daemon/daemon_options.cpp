@@ -38,6 +38,9 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
                     "representation bytes uploaded to the GPU per frame; 0 = unbounded");
   runtime.addOption("csv", &o->csvPath, "per-frame CSV output (empty: none)");
   runtime.addOption("summary-json", &o->summaryJsonPath, "run summary JSON output (empty: none)");
+  runtime.addOption("objects-csv", &o->objectsCsvPath,
+                    "per-object CSV output: a row per held object per frame (kind, triangles, "
+                    "vertices, skinned, posed, position; empty: none)");
   runtime.addOption("frames-dir", &o->framesDir,
                     "directory for frame_NNNN.png / reference_NNNN.png dumps (empty: none)");
   runtime.addOption("dump-every", &o->dumpEvery, "dump every Nth frame (with --frames-dir)");

@@ -42,6 +42,7 @@ struct DaemonOptions {
   std::string tracePath;
   std::string poseStreamPath;  // "-" = stdin
   std::string csvPath;
+  std::string objectsCsvPath;
   std::string summaryJsonPath;
   std::string framesDir;
   int dumpEvery = 10;

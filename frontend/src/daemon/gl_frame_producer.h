@@ -56,6 +56,8 @@ class GlFrameProducer final : public FrameProducer {
   std::size_t keptBytes() const { return std::max(kept_.bytes(), keptPeakBytes_); }
 
   const RgbaImage& frame() const { return frame_; }
+  // What the frontend holds (and drew in the last renderFrame).
+  const FrontendScene& scene() const { return renderer_->scene(); }
   const RgbaImage& referenceFrame() const { return referenceFrame_; }
   // "egl, llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string describe() const;
@@ -73,7 +75,7 @@ class GlFrameProducer final : public FrameProducer {
   std::vector<ReferenceItem> reference_;
   std::vector<ReferenceObject> drawList_;  // reused each measure()
   std::vector<ObjectExtent> extents_;
-  std::vector<ReferenceObject> coverageList_;  // the reference in coverage colours, unlit
+  std::vector<ReferenceObject> coverageList_;           // the reference in coverage colours, unlit
   std::vector<std::vector<glm::mat4>> referenceBones_;  // per reference item: this frame's pose
   RgbaImage coverageFrame_;
   std::vector<std::uint32_t> covered_;

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -70,10 +71,12 @@ constexpr int kPoseStreamRestartAfter = 10;
 // Logs, frames.csv with the summary (FrameLog) and the PNG dumps, frame by frame.
 class DaemonObserver final : public ReplayObserver {
  public:
-  DaemonObserver(FrameLog& log, const GlFrameProducer& producer, const DaemonOptions& options)
-      : log_(log), producer_(producer), options_(options) {}
+  DaemonObserver(FrameLog& log, const GlFrameProducer& producer, const DaemonOptions& options,
+                 std::FILE* objectsCsv)
+      : log_(log), producer_(producer), options_(options), objectsCsv_(objectsCsv) {}
 
   void onFrame(const FrameRecord& record, bool scorePending) override {
+    writeObjectRows(record);
     spdlog::debug(
         "event=frame frame={} polygons={} link_bytes={} snr_db={:.2f} render_ms={:.2f} "
         "reference_ms={:.2f} pose_to_frame_ms={:.2f} update_latency_ms={:.2f} plan={}",
@@ -93,6 +96,8 @@ class DaemonObserver final : public ReplayObserver {
     report(log_.add(record));
     if (!options_.framesDir.empty() && record.frame % options_.dumpEvery == 0) dump(record.frame);
   }
+
+  bool objectsFailed() const { return objectsFailed_; }
 
   void onFramesScored(const std::vector<FrameScore>& scores) override {
     report(log_.applyScores(scores));
@@ -129,6 +134,20 @@ class DaemonObserver final : public ReplayObserver {
     spdlog::error("event=csv_failed error=\"{}\"", status.toString());
   }
 
+  // objects.csv: what the scene holds right after the frame drawn (the next
+  // batches commit in the next renderFrame). Needs no score, so also in
+  // deferred mode the rows go out now.
+  void writeObjectRows(const FrameRecord& record) {
+    if (objectsCsv_ == nullptr || objectsFailed_) return;
+    const std::string rows = formatObjectCsvRows(record.frame, record.timeS, producer_.scene());
+    if (std::fwrite(rows.data(), 1, rows.size(), objectsCsv_) != rows.size() ||
+        std::fflush(objectsCsv_) != 0) {
+      objectsFailed_ = true;
+      spdlog::error("event=objects_csv_failed path={} frame={}", options_.objectsCsvPath,
+                    record.frame);
+    }
+  }
+
   void dump(std::uint64_t frame) {
     Status written = writePng(dumpPath(options_.framesDir, "frame", frame), producer_.frame());
     if (written.ok() && !options_.noReference) {
@@ -145,6 +164,8 @@ class DaemonObserver final : public ReplayObserver {
   FrameLog& log_;
   const GlFrameProducer& producer_;
   const DaemonOptions& options_;
+  std::FILE* objectsCsv_;
+  bool objectsFailed_ = false;
   bool reported_ = false;
 };
 
@@ -253,6 +274,18 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
     spdlog::error("event=csv_failed error=\"{}\"", log.status().toString());
     return 1;
   }
+  // objects.csv (--objects-csv): closed at exit by the unique_ptr.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> objectsCsv(nullptr, &std::fclose);
+  if (!options.objectsCsvPath.empty()) {
+    objectsCsv.reset(std::fopen(options.objectsCsvPath.c_str(), "wb"));
+    const std::string header = objectCsvHeader();
+    if (!objectsCsv ||
+        std::fwrite(header.data(), 1, header.size(), objectsCsv.get()) != header.size()) {
+      spdlog::error("event=objects_csv_failed path={} error=\"cannot create\"",
+                    options.objectsCsvPath);
+      return 1;
+    }
+  }
   if (!options.framesDir.empty()) {
     std::error_code error;
     std::filesystem::create_directories(options.framesDir, error);
@@ -296,7 +329,7 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
   SharedTextureCache sharedTextures;
   replay.conversion.sharedTextures = &sharedTextures;
 
-  DaemonObserver observer(**log, **producer, options);
+  DaemonObserver observer(**log, **producer, options, objectsCsv.get());
   (*producer)->setScoredSink(
       [&observer](std::uint64_t frame) { observer.onKeptFrameScored(frame); });
   ReplayResult result = runReplay(*source, replay, clock, **link, **producer, observer, stop);
@@ -324,6 +357,11 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
   if (!result.status.ok()) {
     info.error = result.status.toString();
     spdlog::error("event=replay_failed frame={} error=\"{}\"", result.frames, info.error);
+    exitCode = 1;
+  }
+  if (observer.objectsFailed() || (objectsCsv && std::fclose(objectsCsv.release()) != 0)) {
+    spdlog::error("event=objects_csv_failed path={} error=\"cannot write\"",
+                  options.objectsCsvPath);
     exitCode = 1;
   }
   const Status closed = (*log)->close();

@@ -13,6 +13,8 @@ namespace {
 
 constexpr double kNsPerMs = 1e6;
 constexpr double kNsPerS = 1e9;
+// A bone matrix on the wire: three rows of four floats (payloadBytes counts the same).
+constexpr std::uint64_t kWireBytesPerBoneMatrix = 48;
 
 // An update handed to the renderer, not yet visible.
 struct SubmittedUpdate {
@@ -190,6 +192,8 @@ class Replay {
     for (protocol::SceneUpdate& update : updates) {
       ++result_.updatesReceived;
       ++record_.updatesReceived;
+      for (const protocol::BonePose& pose : update.bonePoses)
+        record_.poseBytes += kWireBytesPerBoneMatrix * pose.matrices.size();
       notePlanGap(update.plan);
       if (update.frame < answered_.size()) answered_[update.frame] = true;
       Result<SceneBatch> batch = convertUpdate(update, options_.conversion);

@@ -56,7 +56,9 @@
 //   clock time when the frame was read back minus clock time when the pose
 //   that the newest visible update answered (SceneUpdate.frame) was sent;
 //   NaN on other frames or when that pose was not sent by this process.
-// - link_bytes: link.bytesReceived() since the previous frame.
+// - link_bytes: link.bytesReceived() since the previous frame; pose_bytes: the
+//   bone poses of the updates received since then, 48 bytes a matrix (also
+//   those of updates then rejected: they crossed the link).
 // - Errors: a failed render or measurement ends the replay; the frames so
 //   far have been handed on and the Status is in ReplayResult::status.
 // - Single-threaded; the interfaces are called from the caller's thread.

@@ -72,7 +72,7 @@ std::string frameCsvHeader() {
   return "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
          "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,wait_ms,"
          "updates_received,updates_rejected,lockstep_timeout,shown_at_ms,visible_objects,"
-         "missing_objects,blank,skinned_objects,deformed_vertices\n";
+         "missing_objects,blank,skinned_objects,deformed_vertices,pose_bytes\n";
 }
 
 std::string formatFrameCsvRow(const FrameRecord& r) {
@@ -102,8 +102,32 @@ std::string formatFrameCsvRow(const FrameRecord& r) {
   row += ',' + formatCount(r.quality.blank);
   row += ',' + std::to_string(r.skinnedObjects);
   row += ',' + std::to_string(r.deformedVertices);
+  row += ',' + std::to_string(r.poseBytes);
   row += '\n';
   return row;
+}
+
+std::string objectCsvHeader() {
+  return "frame,time_s,object,kind,triangles,vertices,skinned,posed,x,y,z\n";
+}
+
+std::string formatObjectCsvRows(std::uint64_t frame, double timeS, const FrontendScene& scene) {
+  std::string rows;
+  const std::string prefix = std::to_string(frame) + ',' + formatNumber(timeS, "%.6f") + ',';
+  for (const auto& [id, object] : scene.objects()) {
+    const Representation& rep = object.representation;
+    const bool skinned = rep.skin != nullptr;
+    rows += prefix + std::to_string(id);
+    rows += ',';
+    rows += representationKindName(rep.kind);
+    rows += ',' + std::to_string(object.triangleCount);
+    rows += ',' + std::to_string(rep.mesh ? rep.mesh->vertexCount() : 0);
+    rows += skinned ? ",1" : ",0";
+    rows += skinned && scene.bonePose(id) != nullptr ? ",1" : ",0";
+    for (int k = 0; k < 3; ++k) rows += ',' + formatNumber(rep.transform[3][k], "%.6g");
+    rows += '\n';
+  }
+  return rows;
 }
 
 Percentiles percentiles(std::vector<double> values) {

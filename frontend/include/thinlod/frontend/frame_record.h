@@ -28,6 +28,9 @@
 // - formatFrameCsvRow / frameCsvHeader / summaryJson / percentiles are pure and
 //   thread-safe. FrameSummary and FrameLog are not thread-safe; FrameLog's I/O
 //   failures are kIoError naming the path (the first one sticks).
+// - Per object (objects.csv, thinlod-frontend --objects-csv): formatObjectCsvRows
+//   gives one row per object the scene holds, in id order, for the frame just
+//   drawn (pure; the scene is only read).
 #pragma once
 
 #include <cstddef>
@@ -41,6 +44,7 @@
 #include <vector>
 
 #include "thinlod/common/core/status.h"
+#include "thinlod/frontend/frontend_scene.h"
 
 namespace thinlod::frontend {
 
@@ -88,7 +92,11 @@ struct FrameRecord {
   // shader deformed (FrameReport; docs/animation.md).
   std::size_t skinnedObjects = 0;
   std::size_t deformedVertices = 0;
-  FrameQuality quality;         // snr_db, psnr_db, reference_ms, visible/missing, blank
+  // Bone-pose bytes of the updates received since the previous frame (48 a
+  // matrix, as payloadBytes counts them): the part of link_bytes that is
+  // poses rather than geometry, textures or framing.
+  std::uint64_t poseBytes = 0;
+  FrameQuality quality;  // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
 // FrameLog spills pending records as raw bytes.
 static_assert(std::is_trivially_copyable_v<FrameRecord>);
@@ -97,10 +105,20 @@ static_assert(std::is_trivially_copyable_v<FrameRecord>);
 //  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,
 //  reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,
 //  shown_at_ms,visible_objects,missing_objects,blank,skinned_objects,
-//  deformed_vertices\n"
+//  deformed_vertices,pose_bytes\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);
+
+// "frame,time_s,object,kind,triangles,vertices,skinned,posed,x,y,z\n": per
+// held object, its representation's kind (representationKindName), triangles
+// and mesh vertices; skinned 1 when it carries a skin, posed 1 when the scene
+// also holds a bone pose for it (then the renderer deforms its `vertices`,
+// unless the pose has fewer bones than the skin names); x, y, z the
+// translation of its object -> world transform (which object it is).
+std::string objectCsvHeader();
+// The rows of every object `scene` holds, ascending by id ("" when none).
+std::string formatObjectCsvRows(std::uint64_t frame, double timeS, const FrontendScene& scene);
 
 struct Percentiles {
   std::size_t count = 0;  // finite values used
