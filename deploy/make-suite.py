@@ -23,6 +23,12 @@
                        Inline'd with their ImageTexture; the case runs with --models-dir
                        /usr/share/assimp/models (suite.json "models").
   textured-walk.trace  a walk past the two rows at 0.8 m/s, 10 s.
+  aerobic-class.wrl    the ASLOD paper's "aerobic class" (issue 18): three skinned, animated
+                       Testwuson.X figures of assimp-testmodels 3 m apart, the outer two playing
+                       Wuson_Run, the middle one Wuson_Walk (the backbone plays every clip on
+                       pose time: no phase offsets); --models-dir /usr/share/assimp/models/X.
+  aerobic-class.trace  120 poses 0.1 s apart on an arc around the class, closing in on the
+                       middle figure and turning from the left figure to the right one.
 
 Model sizes are read from the model files in --models-dir (default ../shared/models), so the
 scale factors written into the scenes are exact; the scenes name the models by file name only
@@ -394,6 +400,52 @@ def write_textured(path):
     return 12
 
 
+AEROBIC_FIGURES = ((-3.0, 0.0, 0.35, "Wuson_Run"), (0.0, -1.0, 0.0, "Wuson_Walk"),
+                   (3.0, 0.0, -0.35, "Wuson_Run"))  # x, z, yaw (rad), clip
+
+
+def write_aerobic(path):
+    """Three animated, skinned Testwuson.X figures in a row (ASLOD's aerobic class)."""
+    lines = ["#VRML V2.0 utf8",
+             "# ASLOD aerobic class (made by deploy/make-suite.py; do not edit by hand): three",
+             "# skinned, animated Testwuson.X figures (assimp-testmodels), --models-dir",
+             "# /usr/share/assimp/models/X; docs/results/aslod.md.",
+             'Viewpoint { description "front" position 0 1.4 7 fieldOfView 0.9 }',
+             "DirectionalLight { direction 0.3 -1 -0.6 intensity 0.9 ambientIntensity 0.3 }"]
+    for x, z, yaw, clip in AEROBIC_FIGURES:
+        lines.append(f"Transform {{ translation {fmt(x, 0, z)} rotation 0 1 0 {yaw:g} children [\n"
+                     f"  Inline {{ url \"Testwuson.X\" animation \"{clip}\" }} ] }}")
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return len(AEROBIC_FIGURES)
+
+
+def aerobic_walk(frames=120, dt=0.1):
+    """An arc around the class centre (0, 0, -0.3): from 50 degrees left of its front to 50
+    degrees right, the radius closing from 7 m to 3.5 m at the middle and opening again; the
+    look-at target slides from the left figure through the middle to the right one."""
+    centre = (0.0, 0.0, -0.3)
+    poses = []
+    for k in range(frames):
+        u = k / (frames - 1)
+        theta = math.radians(-50 + 100 * smoothstep(u))
+        radius = 7.0 - 3.5 * math.sin(math.pi * u)
+        eye = (centre[0] + radius * math.sin(theta), 1.5, centre[2] + radius * math.cos(theta))
+        target = (-3.0 + 6.0 * smoothstep(u), 0.8, centre[2])
+        poses.append((round(k * dt, 6), eye, target))
+    return poses
+
+
+def max_angular_speed(poses):
+    """Largest turn of the view direction between two poses, rad/s."""
+    def direction(p):
+        d = [b - a for a, b in zip(p[1], p[2])]
+        n = math.sqrt(sum(c * c for c in d))
+        return [c / n for c in d]
+    return max(math.acos(max(-1.0, min(1.0, sum(x * y for x, y in zip(direction(a), direction(b))))))
+               / (b[0] - a[0]) for a, b in zip(poses, poses[1:]))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models-dir", default=os.path.join(HERE, "..", "..", "shared", "models"))
@@ -464,11 +516,18 @@ def main():
                 f"walk between the textured rows at 0.8 m/s, {len(textured_walk)} poses",
                 textured_walk, 60)
 
+    figures = write_aerobic(os.path.join(args.out, "aerobic-class.wrl"))
+    aerobic = aerobic_walk()
+    write_trace(os.path.join(args.out, "aerobic-class.trace"),
+                f"an arc around the aerobic class, {len(aerobic)} poses 0.1 s apart (max "
+                f"{max_speed(aerobic):.2f} m/s, {max_angular_speed(aerobic):.2f} rad/s)", aerobic, 60)
+
     print(f"make-suite: textured {textured} objects; gallery {objects} objects, city {instances} instances, parts field "
           f"{parts} instances (parts-fly {len(fly)} poses, {max_speed(fly):.2f} m/s); traces: "
           f"paper-walk {len(walk)} ({max_speed(walk):.2f} m/s), gallery-tour {len(tour)} "
           f"({max_speed(tour):.2f} m/s), gallery-fast {len(fast)} ({max_speed(fast):.2f} m/s), "
-          f"city-walk {len(city)} ({max_speed(city):.2f} m/s)")
+          f"city-walk {len(city)} ({max_speed(city):.2f} m/s), aerobic-class {figures} figures, "
+          f"{len(aerobic)} poses ({max_speed(aerobic):.2f} m/s, {max_angular_speed(aerobic):.2f} rad/s)")
 
 
 if __name__ == "__main__":
