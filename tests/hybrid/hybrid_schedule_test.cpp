@@ -121,7 +121,7 @@ struct RunResult {
   double lastPlanAccuracy = 0.0;
 };
 
-RunResult runRow(double budget, double kappa) {
+RunResult runRow(double budget, double kappa, const std::string& scheduler = "accuracy-curve") {
   RunResult out;
   const std::string path = writeScene();
   scene::SceneLoadOptions load;
@@ -134,6 +134,7 @@ RunResult runRow(double budget, double kappa) {
   options.simpleImpostorRadii = 0.0;
   options.meshedImpostorRadii = 0.0;
   options.hybridKappa = kappa;
+  options.scheduler = scheduler;
   Result<std::unique_ptr<BackboneCore>> created =
       BackboneCore::create(std::move(loaded).value(), path, options);
   EXPECT_TRUE(created.ok()) << created.status().toString();
@@ -211,6 +212,34 @@ TEST(HybridSchedule, CoarseBudgetOnTheMultiManifoldRowPicksHybridsWithinTheBudge
   EXPECT_LE(meshes.maxHeldUnits, kBudget + 1e-6);
   EXPECT_GT(hybrid.lastPlanAccuracy, meshes.lastPlanAccuracy);
 }
+
+// Every other method of the catalogue that takes a polygon budget sees the
+// hybrid option among an object's candidates (it is one more option with its
+// curve) and holds the same budget in primitive units. Whether it chooses
+// hybrids is its own judgement; at this budget each of them does.
+class HybridScheduleEveryMethod : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(HybridScheduleEveryMethod, HoldsTheBudgetInPrimitiveUnitsAndChoosesHybrids) {
+  constexpr double kBudget = 2000.0;
+  const RunResult run = runRow(kBudget, kKappa, GetParam());
+  std::printf("%s: %zu hybrids, %zu meshes shown, max units %.1f (held %.1f)\n", GetParam(),
+              run.hybridsShown, run.meshesShown, run.maxFrontendUnits, run.maxHeldUnits);
+  EXPECT_LE(run.maxFrontendUnits, kBudget + 1e-6);
+  EXPECT_LE(run.maxHeldUnits, kBudget + 1e-6);
+  EXPECT_GT(run.hybridsShown + run.meshesShown, 0u) << "nothing shown";
+  EXPECT_GT(run.hybridsShown, 0u) << GetParam() << " chose no hybrid";
+}
+
+INSTANTIATE_TEST_SUITE_P(Catalogue, HybridScheduleEveryMethod,
+                         ::testing::Values("greedy-fs93", "aslod", "span-of-level-changed",
+                                           "active-set"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           std::string name = info.param;
+                           for (char& c : name) {
+                             if (c == '-') c = '_';
+                           }
+                           return name;
+                         });
 
 }  // namespace
 }  // namespace thinlod
