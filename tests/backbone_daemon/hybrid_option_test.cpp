@@ -4,10 +4,15 @@
 // polygon budget.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "backbone_core.h"
 #include "fake_simplifier.h"
+#include "thinlod/common/scene/scene_parser.h"
 
 namespace thinlod::backbone_daemon {
 namespace {
@@ -105,6 +110,47 @@ TEST(BackboneCoreHybrid, MeshObjectsGetAHybridOptionWithItsOwnCurve) {
     if (option.kind != OptionKind::kHybrid) continue;
     EXPECT_LT(option.relativeTriangles.minAccuracy(), option.relativeTriangles.maxAccuracy());
   }
+}
+
+// Hybrids carry no uvs: a textured mesh object is offered none (its hybrid
+// would drop the texture while credited like a textured copy).
+TEST(BackboneCoreHybrid, TexturedMeshObjectsGetNoHybrid) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
+                                    ("hybrid-textured-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file("/usr/share/assimp/models/glTF2/BoxTextured-glTF/CesiumLogoFlat.png",
+                             dir / "logo.png");
+  const std::string tetrahedron =
+      "geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0, 0 0 1 ] } "
+      "coordIndex [ 0 2 1 -1 0 1 3 -1 0 3 2 -1 1 2 3 -1 ] "
+      "texCoord TextureCoordinate { point [ 0 0, 1 0, 0 1, 1 1 ] } }";
+  std::ofstream(dir / "scene.wrl")
+      << "#VRML V2.0 utf8\n"
+      << "Shape { appearance Appearance { texture ImageTexture { url \"logo.png\" } } "
+      << tetrahedron << " }\n"
+      << "Transform { translation 3 0 0 children Shape { " << tetrahedron << " } }\n";
+  const std::string path = (dir / "scene.wrl").string();
+  Result<scene::Scene> loaded = scene::loadSceneFile(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().toString();
+  CoreOptions options = polygonBudget(300);
+  options.hybridKappa = kKappa;
+  auto created = BackboneCore::create(std::move(loaded).value(), path, options);
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  const BackboneCore& core = **created;
+  ASSERT_EQ(core.sceneObjects().size(), 2u);
+  ASSERT_FALSE(core.sceneObjects()[0].shape->appearance.texturePath.empty());
+  ASSERT_FALSE(core.sceneObjects()[0].fullMesh->uvs.empty());
+  const backbone::SchedulingScene& scene = core.schedulingScene();
+  std::vector<std::size_t> hybridsPerObject(scene.objects.size(), 0);
+  for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+    for (std::uint32_t o = 0; o < scene.objects[k].optionCount; ++o) {
+      hybridsPerObject[k] += scene.options[scene.objects[k].firstOption + o].kind == OptionKind::kHybrid;
+    }
+  }
+  EXPECT_EQ(hybridsPerObject, (std::vector<std::size_t>{0, 1}))
+      << "the textured tetrahedron none, the plain one its hybrid";
+  std::filesystem::remove_all(dir);
 }
 
 TEST(BackboneCoreHybrid, AMeshAnswerToAHybridRequestIsRefused) {

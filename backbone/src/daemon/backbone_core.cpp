@@ -349,8 +349,16 @@ Status BackboneCore::initialize() {
     }
 
     // Hybrid (behind CoreOptions::hybridKappa): like the simplified mesh, in
-    // primitive units, exact full mesh until its own curve arrives.
-    if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered && !animated) {
+    // primitive units, exact full mesh until its own curve arrives. Not for
+    // a textured object: hybrids carry no uvs (docs/hybrid.md) and their
+    // curve credits geometry only, so a hybrid would drop the texture while
+    // claiming the accuracy of a textured copy.
+    const bool textured = record.object != nullptr && record.object->shape != nullptr &&
+                          record.object->fullMesh != nullptr &&
+                          !record.object->fullMesh->uvs.empty() &&
+                          !record.object->shape->appearance.texturePath.empty();
+    if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered && !animated &&
+        !textured) {
       OptionState state;
       state.object = k;
       state.wireKind = protocol::RepresentationKind::kHybrid;
