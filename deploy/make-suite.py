@@ -27,8 +27,9 @@
                        Testwuson.X figures of assimp-testmodels 3 m apart, the outer two playing
                        Wuson_Run, the middle one Wuson_Walk (the backbone plays every clip on
                        pose time: no phase offsets); --models-dir /usr/share/assimp/models/X.
-  aerobic-class.trace  120 poses 0.1 s apart on an arc around the class, closing in on the
-                       middle figure and turning from the left figure to the right one.
+  aerobic-class.trace  120 poses 0.1 s apart: a walk at 0.8 m/s into the class, close to the
+                       left figure (the right one leaves the view), then a turn of about 110
+                       degrees to the right figure while walking towards it.
 
 Model sizes are read from the model files in --models-dir (default ../shared/models), so the
 scale factors written into the scenes are exact; the scenes name the models by file name only
@@ -421,19 +422,21 @@ def write_aerobic(path):
 
 
 def aerobic_walk(frames=120, dt=0.1):
-    """An arc around the class centre (0, 0, -0.3): from 50 degrees left of its front to 50
-    degrees right, the radius closing from 7 m to 3.5 m at the middle and opening again; the
-    look-at target slides from the left figure through the middle to the right one."""
-    centre = (0.0, 0.0, -0.3)
-    poses = []
-    for k in range(frames):
-        u = k / (frames - 1)
-        theta = math.radians(-50 + 100 * smoothstep(u))
-        radius = 7.0 - 3.5 * math.sin(math.pi * u)
-        eye = (centre[0] + radius * math.sin(theta), 1.5, centre[2] + radius * math.cos(theta))
-        target = (-3.0 + 6.0 * smoothstep(u), 0.8, centre[2])
-        poses.append((round(k * dt, 6), eye, target))
-    return poses
+    """A walk at 0.8 m/s from 7.5 m in front of the class to 2.7 m from the left figure (the
+    right one leaves the view), then a turn of about 110 degrees to the right figure while
+    walking towards it; look-at targets blend with smoothstep: the class centre, the left figure
+    (3.0-5.5 s), the right figure (8.0-10.5 s)."""
+    points = [(0.0, 1.5, 7.5), (-2.0, 1.5, 3.0), (-1.0, 1.5, 1.8), (2.0, 1.5, 2.5)]
+    keys = [(3.0, 2.5, (-3.0, 0.8, 0.0)), (8.0, 2.5, (3.0, 0.8, 0.0))]
+
+    def target(t, p, d):
+        value = (0.0, 0.8, -0.3)
+        for start, duration, goal in keys:
+            if t >= start:
+                u = smoothstep((t - start) / duration)
+                value = tuple(a + (b - a) * u for a, b in zip(value, goal))
+        return value
+    return along(points, 0.8, dt, target)[:frames]
 
 
 def max_angular_speed(poses):
@@ -519,7 +522,7 @@ def main():
     figures = write_aerobic(os.path.join(args.out, "aerobic-class.wrl"))
     aerobic = aerobic_walk()
     write_trace(os.path.join(args.out, "aerobic-class.trace"),
-                f"an arc around the aerobic class, {len(aerobic)} poses 0.1 s apart (max "
+                f"a walk into the aerobic class, {len(aerobic)} poses 0.1 s apart (max "
                 f"{max_speed(aerobic):.2f} m/s, {max_angular_speed(aerobic):.2f} rad/s)", aerobic, 60)
 
     print(f"make-suite: textured {textured} objects; gallery {objects} objects, city {instances} instances, parts field "
