@@ -587,5 +587,49 @@ TEST(RegionCurves, NearRegionsGetMoreTrianglesAtOneAbsoluteAccuracy) {
   EXPECT_TRUE(strictlyMore);
 }
 
+TEST(RegionCurves, ARegionThatCollapsesToNothingStillHasACurve) {
+  // Under the paper's border rule a region can end up owning no triangle
+  // (its neighbours' border triangles cover it). Its curve used to start at
+  // 1 triangle, extract an empty mesh and fail (kInternal); it starts at the
+  // fewest owned triangles above zero now.
+  const int n = 41, cells = 6;
+  IndexedMesh grid;
+  std::vector<std::uint32_t> labels;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const float x = static_cast<float>(i) / (n - 1), y = static_cast<float>(j) / (n - 1);
+      grid.positions.push_back({x, y, 0.05f * std::sin(9.0f * x) * std::cos(7.0f * y)});
+      labels.push_back(static_cast<std::uint32_t>(std::min(cells - 1, j * cells / (n - 1)) * cells +
+                                                  std::min(cells - 1, i * cells / (n - 1))));
+    }
+  }
+  for (int j = 0; j + 1 < n; ++j) {
+    for (int i = 0; i + 1 < n; ++i) {
+      const std::uint32_t a = static_cast<std::uint32_t>(j * n + i), b = a + 1, c = a + n,
+                          d = c + 1;
+      grid.indices.insert(grid.indices.end(), {a, b, d, a, d, c});
+    }
+  }
+  RegionBuildOptions build;
+  build.borderRule = BorderRule::kPaperUnchecked;
+  Result<RegionMesh> regions = RegionMesh::build(grid, labels, cells * cells, build);
+  ASSERT_TRUE(regions.ok()) << regions.status().toString();
+  MeshCurveOptions options;
+  options.levels = 4;
+  options.measureEncodedBytes = false;
+  options.error.samplesPerMesh = 1000;
+  int empty = 0;
+  for (std::size_t r = 0; r < regions->regionCount(); ++r) {
+    if (regions->minTriangles(r) != 0) continue;
+    ++empty;
+    Result<MeshCurves> curves = measureRegionCurves(*regions, r, options);
+    ASSERT_TRUE(curves.ok()) << "region " << r << ": " << curves.status().toString();
+    ASSERT_FALSE(curves->levels.empty());
+    EXPECT_GT(curves->levels.front().triangles, 0u) << "region " << r;
+    EXPECT_EQ(curves->levels.back().triangles, regions->maxTriangles(r)) << "region " << r;
+  }
+  EXPECT_GT(empty, 0);  // the case occurs on this grid
+}
+
 }  // namespace
 }  // namespace thinlod::simplifier

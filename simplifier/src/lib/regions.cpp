@@ -464,8 +464,15 @@ Result<MeshCurves> measureRegionCurves(const RegionMesh& regions, std::size_t r,
                   "regions: region " + std::to_string(r) + " owns no triangle (no curve)");
   }
   const IndexedMesh original = regions.extractRegion(r, regions.maxTriangles(r));
+  // The ladder starts at the region's fewest owned triangles above zero. A
+  // region can collapse to owning none (kPaperUnchecked: its neighbours'
+  // border triangles cover it); a ladder from 1 then extracted an empty mesh
+  // and the measurement failed. triangleCountAt(t) is 0 exactly while no
+  // state owns 1..t triangles, so the first t with a count is that count.
+  std::size_t lowest = std::max<std::size_t>(1, regions.minTriangles(r));
+  while (lowest < regions.maxTriangles(r) && regions.triangleCountAt(r, lowest) == 0) ++lowest;
   return measureMeshCurves(
-      original, std::max<std::size_t>(1, regions.minTriangles(r)), regions.maxTriangles(r),
+      original, lowest, regions.maxTriangles(r),
       [&regions, r](std::size_t n) { return regions.extractRegion(r, n); }, options);
 }
 
