@@ -235,5 +235,58 @@ TEST(BackboneAnimationClock, PosesPassTheLinkShaperAndWaitWhenItIsEmpty) {
   EXPECT_LE(double(core.shapedLinkBytes()), rate * 0.1 * step + burst + 8192.0);
 }
 
+// The scheduler plans geometry with the link rate the poses leave: the
+// reserve is the held figure's pose bytes at the pose rate, at most half the
+// link, and nothing before the figure is held or without a link budget.
+TEST(BackboneAnimationClock, PosesTakeTheirShareOfTheLinkBudgetBeforeGeometry) {
+  for (const double rate : {60000.0, 10000.0}) {
+    CoreOptions options = polygonBudget(5000);
+    options.budget.maxLinkBytesPerSecond = rate;
+    options.linkBurstBytes = 200000.0;
+    auto created = animatedCore(options);
+    ASSERT_TRUE(created.ok()) << created.status().toString();
+    BackboneCore& core = **created;
+    FakeSimplifier fake(core);
+    answer(core, fake, submitAll(core));
+    EXPECT_EQ(core.poseLinkReserve(), 0.0) << "no pose seen yet";
+    int step = 0;
+    ASSERT_TRUE(sendFigure(core, fake, step));
+    const double poseBytes =
+        kBonePoseOverheadBytes + kBytesPerBoneMatrix * double(wuson(core).palette.bones.size());
+    // Poses every 0.1 s of pose time (sendFigure's and the loop's spacing),
+    // known from the second pose on.
+    const double expected = std::min(poseBytes / 0.1, 0.5 * rate);
+    for (int i = 0; i < 5; ++i, ++step) {
+      ASSERT_TRUE(core.beginPose(poseAt(step, 0.1 * step, glm::vec3(0.3f, 0.3f, 2.0f),
+                                        glm::vec3(0.0f, 0.2f, 0.0f)))
+                      .ok());
+      answer(core, fake, submitAll(core));
+      ASSERT_TRUE(core.replan().ok());
+      core.finishPose();
+      if (step > 0) {
+        EXPECT_NEAR(core.poseLinkReserve(), expected, 1e-6 * expected) << rate;
+      }
+      // What the scheduler plans with: the rate less the reserve.
+      const backbone::Budget planned = core.schedulingBudget();
+      ASSERT_TRUE(planned.maxLinkBytesPerSecond.has_value());
+      EXPECT_DOUBLE_EQ(*planned.maxLinkBytesPerSecond, rate - core.poseLinkReserve());
+    }
+  }
+  // Without a link budget nothing is reserved.
+  auto created = animatedCore(polygonBudget(5000));
+  ASSERT_TRUE(created.ok());
+  BackboneCore& core = **created;
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+  int step = 0;
+  ASSERT_TRUE(sendFigure(core, fake, step));
+  ASSERT_TRUE(core.beginPose(poseAt(step + 1, 0.1 * (step + 1), glm::vec3(0.3f, 0.3f, 2.0f),
+                                    glm::vec3(0.0f, 0.2f, 0.0f)))
+                  .ok());
+  core.finishPose();
+  EXPECT_EQ(core.poseLinkReserve(), 0.0);
+  EXPECT_FALSE(core.schedulingBudget().maxLinkBytesPerSecond.has_value());
+}
+
 }  // namespace
 }  // namespace thinlod::backbone_daemon

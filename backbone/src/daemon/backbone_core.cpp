@@ -971,13 +971,35 @@ backbone::Budget BackboneCore::budgetAtPose() const {
   return budget;
 }
 
+double BackboneCore::poseLinkReserve() const {
+  const std::optional<double> rate = budgetAtPose().maxLinkBytesPerSecond;
+  if (!rate || !(poseIntervalSeconds_ > 0.0)) return 0.0;
+  double bytesPerPose = 0.0;
+  for (std::uint32_t k = 0; k < animationOf_.size(); ++k) {
+    if (animationOf_[k] == nullptr || !(mirror_.trianglesOf(k) > 0.0)) continue;
+    bytesPerPose += kBonePoseOverheadBytes +
+                    kBytesPerBoneMatrix * double(animationOf_[k]->palette.bones.size());
+  }
+  // Decision (docs/animation.md, "Served"): poses get at most half the link
+  // in planning. Above that the shaper defers some of them (the frontend
+  // keeps its last pose), rather than the plan starving geometry entirely.
+  return std::min(bytesPerPose / poseIntervalSeconds_, 0.5 * *rate);
+}
+
+backbone::Budget BackboneCore::schedulingBudget() const {
+  backbone::Budget budget = budgetAtPose();
+  const double reserve = poseLinkReserve();
+  if (budget.maxLinkBytesPerSecond && reserve > 0.0) *budget.maxLinkBytesPerSecond -= reserve;
+  return budget;
+}
+
 Status BackboneCore::runPlan() {
   if (dirty_) {
     backbone::updateSubtreeVersions(scene_);
     dirty_ = false;
     THINLOD_RETURN_IF_ERROR(backbone::validateScene(scene_));
   }
-  Result<backbone::Plan> planned = scheduler_->plan(scene_, viewer_, budgetAtPose(), planner_);
+  Result<backbone::Plan> planned = scheduler_->plan(scene_, viewer_, schedulingBudget(), planner_);
   if (!planned.ok()) return planned.status();
   plan_ = std::move(planned).value();
   ++plansThisPose_;
@@ -1030,6 +1052,13 @@ Status BackboneCore::beginPose(const protocol::ViewerPose& pose) {
       posesBeyondStep_ = 0;  // the jump is taken; the next one is judged afresh
     }
     poseNs = std::max(poseNs, *lastPoseNs_);
+    // The pose rate, for the poses' share of the link (poseLinkReserve):
+    // spacing smoothed over about five poses; equal stamps say nothing.
+    if (poseNs > *lastPoseNs_) {
+      const double interval = double(poseNs - *lastPoseNs_) * 1e-9;
+      poseIntervalSeconds_ =
+          poseIntervalSeconds_ > 0.0 ? 0.8 * poseIntervalSeconds_ + 0.2 * interval : interval;
+    }
   }
   lastPoseNs_ = poseNs;
   poseTimeNs_ = poseNs;
@@ -1373,6 +1402,7 @@ void BackboneCore::resetFrontend() {
   shapedBytes_ = 0;
   lastTime_ = -1e300;
   lastPoseNs_.reset();
+  poseIntervalSeconds_ = 0.0;
   posesBeyondStep_ = 0;
   lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   inPose_ = false;

@@ -332,6 +332,16 @@ class BackboneCore {
   // Bytes the link shaper let through since the frontend session began
   // (kept here: a grown burst replaces the shaper).
   std::uint64_t shapedLinkBytes() const { return shapedBytes_; }
+  // The link rate the scheduler leaves to bone poses (it plans geometry with
+  // the rest): bytes per second of the poses of the animated objects the
+  // frontend holds, at the measured pose rate, capped at half the link rate
+  // (the other half stays for geometry). 0 without a link budget or before
+  // two poses with distinct times.
+  double poseLinkReserve() const;
+  // What the scheduler plans with: the pose's budget (the link schedule's
+  // rate) less poseLinkReserve(), so geometry and poses together fit the
+  // link; the shaper still enforces the whole rate.
+  backbone::Budget schedulingBudget() const;
   const CoreOptions& options() const { return options_; }
   const char* schedulerName() const;
   std::uint64_t sceneFingerprint() const { return sceneGraph_.fingerprint; }
@@ -431,6 +441,7 @@ class BackboneCore {
   std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   // The budget of this pose: options_.budget with the link schedule's rate.
   backbone::Budget budgetAtPose() const;
+  double poseIntervalSeconds_ = 0.0;  // smoothed pose spacing (pose time); 0: unknown
   std::optional<protocol::LinkShaper> shaper_;
   std::uint64_t shapedBytes_ = 0;
   std::map<std::uint64_t, double> promised_;  // copy/request id -> time it was planned
