@@ -94,6 +94,9 @@ def run_stats(run_dir):
     fresh = [number(r["snr_db"]) for r in frames[3:] if own_pose(r)]
     mean, sd, cv = cv_stats(render)
     smean, ssd, scv = cv_stats(steady)
+    # A robust spread of the same frames: median absolute deviation over the median.
+    smed = statistics.median(steady) if steady else math.nan
+    smad = statistics.median([abs(v - smed) for v in steady]) / smed if steady else math.nan
     drawn3 = [d for d, s in zip(deformed, skinned) if s == 3]
     return {
         "frames": len(frames), "budget": budget,
@@ -101,7 +104,7 @@ def run_stats(run_dir):
         "over_budget": sum(1 for t in tris if t > budget),
         "frames_all_three": sum(1 for s in skinned if s == 3),
         "render_mean": mean, "render_sd": sd, "render_cv": cv,
-        "steady_frames": len(steady), "steady_mean": smean, "steady_cv": scv,
+        "steady_frames": len(steady), "steady_mean": smean, "steady_cv": scv, "steady_mad": smad,
         "render_max": max(render),
         "deformed_med": nearest_rank(deformed, 0.5), "deformed_min3": min(drawn3) if drawn3 else None,
         "deformed_max": max(deformed), "full_vertices": 3 * FULL_VERTICES,
@@ -231,15 +234,16 @@ def main(argv):
                       f"{st['vertex_mismatch_frames']} frames -->")
     print()
     print("| folder | scheduler | render ms mean / sd / max | CV all frames | CV frames without "
-          "uploads (n) | frames receiving no pose | frames 3+ drawn with an older pose | SNR med / p10 / "
+          "uploads (n) | MAD / median, same frames | frames receiving no pose | frames 3+ drawn with an older pose | SNR med / p10 / "
           "min dB | SNR med, frames 3+ with their own pose / an older one |")
-    print("|" + " --- |" * 9)
+    print("|" + " --- |" * 10)
     for root, runs in all_runs:
         for s, st in runs.items():
             print(f"| {os.path.basename(root.rstrip('/'))} | {s} | "
                   f"{fmt(st['render_mean'], 2)} / {fmt(st['render_sd'], 2)} / {fmt(st['render_max'], 1)} | "
                   f"{fmt(100 * st['render_cv'])} % | {fmt(100 * st['steady_cv'])} % "
-                  f"({st['steady_frames']}) | {st['frames_without_pose']} | "
+                  f"({st['steady_frames']}) | {fmt(100 * st['steady_mad'])} % | "
+                  f"{st['frames_without_pose']} | "
                   f"{st['frames_older_pose']} | "
                   f"{fmt(st['snr_med'])} / {fmt(st['snr_p10'])} / {fmt(st['snr_min'])} | "
                   f"{fmt(st['snr_med_fresh'])} / {fmt(st['snr_med_stale'])} |")
