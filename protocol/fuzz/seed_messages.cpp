@@ -256,6 +256,11 @@ std::vector<NamedMessage> seedMessages() {
   hybridRequest.representation = RepresentationKind::kHybrid;
   hybridRequest.kappa = 3.0;
   out.push_back({"simplify_request_hybrid", hybridRequest});
+  // A region object's request: levels keep the mesh's open boundary (docs/regions.md).
+  SimplifyRequest regionRequest = byPath;
+  regionRequest.requestId = 9;
+  regionRequest.keepBoundary = true;
+  out.push_back({"simplify_request_keep_boundary", regionRequest});
   SimplifyResult hybridResult;
   hybridResult.requestId = 8;
   hybridResult.objectId = 100;

@@ -160,10 +160,10 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Scene
 std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const SimplifyRequest& m) {
   auto path = stringOrNull(b, m.sourcePath);
   auto mesh = bytesOrNull(b, m.sourceMesh);
-  auto t = w::CreateSimplifyRequest(b, m.requestId, m.objectId, path, mesh,
-                                    static_cast<w::SimplifyTarget>(m.target), m.targetTriangles,
-                                    m.targetAccuracy, m.curvePoints, m.sceneFingerprint,
-                                    static_cast<w::RepresentationKind>(m.representation), m.kappa);
+  auto t = w::CreateSimplifyRequest(
+      b, m.requestId, m.objectId, path, mesh, static_cast<w::SimplifyTarget>(m.target),
+      m.targetTriangles, m.targetAccuracy, m.curvePoints, m.sceneFingerprint,
+      static_cast<w::RepresentationKind>(m.representation), m.kappa, m.keepBoundary);
   return {w::Body::SimplifyRequest, t.Union()};
 }
 
@@ -532,6 +532,7 @@ Result<Message> fromWire(const FieldPath& path, const w::SimplifyRequest* m) {
   out.sceneFingerprint = m->scene_fingerprint();
   out.representation = static_cast<RepresentationKind>(m->representation());
   out.kappa = m->kappa();
+  out.keepBoundary = m->keep_boundary();
   return Message(std::move(out));
 }
 

@@ -110,7 +110,8 @@ bool operator==(const SimplifyRequest& a, const SimplifyRequest& b) {
          a.sourceMesh == b.sourceMesh && a.target == b.target &&
          a.targetTriangles == b.targetTriangles && a.targetAccuracy == b.targetAccuracy &&
          a.curvePoints == b.curvePoints && a.sceneFingerprint == b.sceneFingerprint &&
-         a.representation == b.representation && a.kappa == b.kappa;
+         a.representation == b.representation && a.kappa == b.kappa &&
+         a.keepBoundary == b.keepBoundary;
 }
 bool operator==(const SimplifyResult& a, const SimplifyResult& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && sameStatus(a.status, b.status) &&

@@ -448,6 +448,8 @@ Status check(const FieldPath& path, const SimplifyRequest& m) {
     return invalidField(path.child("representation"), "must be Mesh or Hybrid");
   }
   THINLOD_RETURN_IF_ERROR(checkKappa(path.child("kappa"), m.representation, m.kappa, true));
+  if (m.keepBoundary && m.representation != RepresentationKind::kMesh)
+    return invalidField(path.child("keep_boundary"), "applies to Mesh only");
   return Status();
 }
 

@@ -243,6 +243,12 @@ struct SimplifyRequest {
   // frame, curve resources in primitive units = triangles + points / kappa).
   RepresentationKind representation = RepresentationKind::kMesh;
   double kappa = 0.0;  // kHybrid: in [1, kMaxKappa]; 0: the simplifier's default
+  // kMesh only: every level keeps every vertex on an open boundary of the
+  // source mesh where it is (never removed, never moved): a region object's
+  // borders, so independent per-region levels meet without cracks
+  // (docs/regions.md, "In the running system"). Also the mesh's own outer
+  // border, which is kept too.
+  bool keepBoundary = false;
 };
 
 struct SimplifyResult {
