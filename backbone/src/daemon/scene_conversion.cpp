@@ -165,14 +165,15 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
                                     const std::vector<scene::SceneObject>& objects) {
   const std::vector<scene::NodeInstance> instances = scene::flattenInstances(sceneGraph);
   const std::size_t n = instances.size();
-  std::vector<int> objectOfInstance(n, -1);
+  // Objects of each instance: one, or a region Shape's N (scene_objects.h).
+  std::vector<std::vector<std::uint32_t>> objectsOfInstance(n);
   for (std::size_t k = 0; k < objects.size(); ++k) {
     if (objects[k].id != k + 1)
       return Status(ErrorCode::kInvalidArgument,
                     "scene objects must be numbered 1..n in order (collectSceneObjects)");
     if (objects[k].instance < 0 || static_cast<std::size_t>(objects[k].instance) >= n)
       return Status(ErrorCode::kInvalidArgument, "scene object instance out of range");
-    objectOfInstance[objects[k].instance] = static_cast<int>(k);
+    objectsOfInstance[objects[k].instance].push_back(static_cast<std::uint32_t>(k));
   }
   // Pre-order: the subtree of instance i is [i, subtreeEnd[i]).
   std::vector<std::size_t> subtreeEnd(n);
@@ -184,7 +185,7 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
   auto objectsBelow = [&](std::size_t i) {
     std::vector<std::uint32_t> below;
     for (std::size_t j = i; j < subtreeEnd[i]; ++j)
-      if (objectOfInstance[j] >= 0) below.push_back(static_cast<std::uint32_t>(objectOfInstance[j]));
+      below.insert(below.end(), objectsOfInstance[j].begin(), objectsOfInstance[j].end());
     return below;
   };
 
@@ -368,8 +369,9 @@ Result<ConvertedScene> convertScene(const scene::Scene& sceneGraph,
         continue;
       }
     }
-    if (objectOfInstance[i] >= 0) {
-      ObjectRecord record = plainRecord(static_cast<std::uint32_t>(objectOfInstance[i]));
+    // Each object is a leaf: a region Shape's regions are leaves side by side.
+    for (std::uint32_t k : objectsOfInstance[i]) {
+      ObjectRecord record = plainRecord(k);
       if (meshOnly[i]) {
         record.meshedImpostor = notOffered();
         record.simpleImpostor = notOffered();

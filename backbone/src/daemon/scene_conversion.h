@@ -32,6 +32,10 @@
 //     Figure 10), is ONE leaf (the first level's object id) whose options
 //     are the levels' kinds, each valid in its level's range (world); the
 //     other levels' object ids get no leaf.
+// - A region Shape (an Inline's `regions N`) is N objects of one instance:
+//   N leaves side by side, each with its region's sphere and its own curve
+//   (docs/regions.md, "In the running system"); below an imposter node they
+//   count as N objects, inside an LOD level they do not collapse (Figure 10).
 // - Leaf bounds are the objects' world bounding spheres; a parent's sphere
 //   encloses its children's (validateScene holds). Level groups without any
 //   object get a tiny sphere at their parent's centre (they render nothing).

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <limits>
 #include <map>
+#include <optional>
 #include <unordered_map>
 
 namespace thinlod::scene {
@@ -1042,12 +1043,28 @@ class Parser {
   bool parseInlineBody(const Token& type, Geometry* g) {
     g->kind = GeometryKind::kMeshFile;
     bool emptyAnimation = false;
-    bool ok = parseBody(type, [&](std::string_view f, const Token&) {
+    bool animation = false;
+    std::optional<Token> regionsField;
+    bool ok = parseBody(type, [&](std::string_view f, const Token& field) {
       if (f == "url") return parseMFString(&g->urls);
       // thinlod extension: the clip of a skinned, animated file to play.
       if (f == "animation") {
         if (!parseString(&g->animationClip)) return false;
         emptyAnimation = g->animationClip.empty();
+        animation = true;
+        return true;
+      }
+      // thinlod extension: split the mesh into this many region objects
+      // (docs/regions.md, "In the running system").
+      if (f == "regions") {
+        std::int32_t n = 0;
+        if (!parseInt(&n)) return false;
+        if (n < 2 || n > static_cast<std::int32_t>(kMaxInlineRegions)) {
+          return fail(field, "Inline regions is " + std::to_string(n) + ", must be in [2, " +
+                                 std::to_string(kMaxInlineRegions) + "]");
+        }
+        g->regionCount = static_cast<std::uint32_t>(n);
+        regionsField = field;
         return true;
       }
       if (isField(f, {"bboxCenter", "bboxSize"})) return skipBboxField(f);
@@ -1057,6 +1074,9 @@ class Parser {
     if (g->urls.empty()) return fail(type, "Inline needs a url");
     if (emptyAnimation) {
       return fail(type, "Inline animation is empty; name a clip or \"#N\" for the N-th");
+    }
+    if (regionsField && animation) {
+      return fail(*regionsField, "Inline regions cannot be combined with animation");
     }
     return true;
   }

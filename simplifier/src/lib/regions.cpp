@@ -31,32 +31,6 @@ namespace {
 
 constexpr std::uint32_t kUnmapped = 0xffffffffu;
 
-void bisect(const std::vector<glm::vec3>& positions, std::uint32_t* begin, std::uint32_t* end,
-            std::uint32_t firstLabel, std::size_t regions, std::vector<std::uint32_t>& labels) {
-  if (regions == 1) {
-    for (std::uint32_t* it = begin; it != end; ++it) labels[*it] = firstLabel;
-    return;
-  }
-  Bounds bounds;
-  for (std::uint32_t* it = begin; it != end; ++it) bounds.extend(positions[*it]);
-  const glm::vec3 extent = bounds.max - bounds.min;
-  int axis = 0;
-  if (extent.y > extent[axis]) axis = 1;
-  if (extent.z > extent[axis]) axis = 2;
-  const std::size_t count = static_cast<std::size_t>(end - begin);
-  const std::size_t leftRegions = (regions + 1) / 2;
-  // count >= regions, so both sides keep at least one vertex per region.
-  const std::size_t leftCount = count * leftRegions / regions;
-  std::uint32_t* middle = begin + leftCount;
-  std::nth_element(begin, middle, end, [&](std::uint32_t a, std::uint32_t b) {
-    const float pa = positions[a][axis], pb = positions[b][axis];
-    return pa < pb || (pa == pb && a < b);
-  });
-  bisect(positions, begin, middle, firstLabel, leftRegions, labels);
-  bisect(positions, middle, end, firstLabel + static_cast<std::uint32_t>(leftRegions),
-         regions - leftRegions, labels);
-}
-
 template <typename T>
 std::vector<T> gather(const std::vector<T>& values, const std::vector<std::uint32_t>& source) {
   std::vector<T> out;
@@ -83,39 +57,8 @@ Result<IndexedMesh> cleanedMesh(const IndexedMesh& mesh, const RegionBuildOption
 
 }  // namespace
 
-std::uint32_t triangleRegion(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-  if (a == b || a == c) return a;
-  if (b == c) return b;
-  return std::min({a, b, c});
-}
-
-Result<std::vector<std::uint32_t>> partitionVertices(const std::vector<glm::vec3>& positions,
-                                                     std::size_t regionCount) {
-  if (regionCount == 0) {
-    return Status(ErrorCode::kInvalidArgument, "partition: region count must be >= 1");
-  }
-  if (regionCount > positions.size()) {
-    return Status(ErrorCode::kInvalidArgument, "partition: " + std::to_string(regionCount) +
-                                                   " regions for " +
-                                                   std::to_string(positions.size()) +
-                                                   " vertices (at most one region per vertex)");
-  }
-  if (positions.size() >= kUnmapped) {
-    return Status(ErrorCode::kResourceExhausted, "partition: too many vertices");
-  }
-  for (std::size_t v = 0; v < positions.size(); ++v) {
-    const glm::vec3& p = positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "partition: vertex " + std::to_string(v) + " has a non-finite coordinate");
-    }
-  }
-  std::vector<std::uint32_t> order(positions.size());
-  std::iota(order.begin(), order.end(), 0u);
-  std::vector<std::uint32_t> labels(positions.size(), 0);
-  bisect(positions, order.data(), order.data() + order.size(), 0, regionCount, labels);
-  return labels;
-}
+// triangleRegion and partitionVertices live in common/mesh/mesh_regions.h
+// (the scene splits region objects with them too).
 
 Result<RegionMesh> RegionMesh::build(const IndexedMesh& mesh,
                                      const std::vector<std::uint32_t>& labels,

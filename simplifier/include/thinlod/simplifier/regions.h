@@ -53,6 +53,7 @@
 
 #include "thinlod/common/core/indexed_mesh.h"
 #include "thinlod/common/core/status.h"
+#include "thinlod/common/mesh/mesh_regions.h"
 #include "thinlod/simplifier/mesh_curve.h"
 #include "thinlod/simplifier/progressive_mesh.h"
 
@@ -61,16 +62,13 @@ namespace thinlod::simplifier {
 // Owner of a triangle with corners in regions a, b, c: the majority region,
 // or min(a, b, c) when all three differ (a function of the ids only, so
 // collapses, which keep vertices in their region, never change it).
-std::uint32_t triangleRegion(std::uint32_t a, std::uint32_t b, std::uint32_t c);
-
-// Recursive bisection: the vertex set is cut at the longest axis of its
-// bounding box, at the count that splits the regions ceil(k/2) : floor(k/2),
-// until one region is left. Sizes differ by at most one vertex per level of
-// recursion; ties on a coordinate go by vertex index (deterministic).
-// Returns one label in [0, regionCount) per position. Errors: regionCount 0
-// or > positions.size(), a non-finite position.
-Result<std::vector<std::uint32_t>> partitionVertices(const std::vector<glm::vec3>& positions,
-                                                     std::size_t regionCount);
+// Recursive bisection partitionVertices: the vertex set is cut at the
+// longest axis of its bounding box, at the count that splits the regions
+// ceil(k/2) : floor(k/2), until one region is left; ties on a coordinate go
+// by vertex index (deterministic). Both live in common (mesh_regions.h),
+// where the scene splits an Inline's `regions N` into objects with them.
+using thinlod::partitionVertices;
+using thinlod::triangleRegion;
 
 enum class BorderRule : std::uint8_t { kLowerIdSide, kBothSidesKept, kPaperUnchecked };
 

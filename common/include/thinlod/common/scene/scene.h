@@ -116,7 +116,12 @@ struct Geometry {
   // then imports the file skinned and sets `animation` beside `mesh`.
   std::string animationClip;
   std::shared_ptr<const SkinnedAnimation> animation;
+  // kMeshFile: an Inline's `regions N` (2..kMaxInlineRegions; 0: none).
+  // collectSceneObjects makes the mesh N objects, one per region
+  // (scene_objects.h; docs/regions.md, "In the running system").
+  std::uint32_t regionCount = 0;
 };
+inline constexpr std::uint32_t kMaxInlineRegions = 1024;
 
 struct Node;
 using NodePtr = std::shared_ptr<Node>;

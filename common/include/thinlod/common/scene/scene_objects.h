@@ -22,6 +22,13 @@
 //   enclose it at every (sampled) pose. Relative accuracies measured against
 //   the bind mesh's sphere convert to this one by anim::animatedRelativeAccuracy
 //   (docs/animation.md, "Served").
+// - Regions: a mesh-file Shape with Geometry::regionCount N (an Inline's
+//   `regions N`) becomes N consecutive objects, one per region of
+//   splitMeshIntoRegions (mesh/mesh_regions.h): fullMesh is the region's
+//   owned triangles (vertices renumbered), same shape (appearance) and
+//   transform; spheres and bounds are the region's. Every instance of the
+//   Shape shares the N meshes. A split that fails (a region owning no
+//   triangle) is kInvalidArgument naming the Inline's file:line:column.
 // - Pointers refer into the Scene, which must outlive the objects.
 // - Errors: a mesh-file Shape whose mesh was not resolved -> kNotFound naming
 //   the url; an invalid primitive -> kInvalidArgument.
@@ -48,6 +55,10 @@ struct SceneObject {
   Bounds worldBounds;
   BoundingSphere contentSphere;  // reference sphere, content frame
   BoundingSphere worldSphere;    // contentSphere mapped to world
+  // A region object (an Inline's `regions N`): region index in [0, regionCount)
+  // and N; regionCount 0 for every other object.
+  std::uint32_t region = 0;
+  std::uint32_t regionCount = 0;
 };
 
 struct SceneObjectOptions {
