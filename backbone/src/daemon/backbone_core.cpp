@@ -42,6 +42,13 @@ constexpr double kMinTrianglesToLearnBytes = 64.0;
 
 Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
 
+// A region object's mesh levels keep its borders (SimplifyRequest::keepBoundary):
+// independent per-region levels then meet without cracks (docs/regions.md).
+bool keepsBoundary(const ObjectRecord& record, protocol::RepresentationKind kind) {
+  return kind == protocol::RepresentationKind::kMesh && !record.cluster &&
+         record.object != nullptr && record.object->regionCount > 0;
+}
+
 bool isMeshKind(OptionKind kind) {
   return kind == OptionKind::kOriginalMesh || kind == OptionKind::kSimplifiedMesh ||
          kind == OptionKind::kHybrid;
@@ -457,6 +464,7 @@ void BackboneCore::queueStartupRequest(std::uint32_t object, std::uint32_t optio
     message.representation = protocol::RepresentationKind::kHybrid;
     message.kappa = options_.hybridKappa;
   }
+  message.keepBoundary = keepsBoundary(record, message.representation);
   // Fresh ids from the planner's counter are never known to the ledger.
   if (!ledger_.ask(request).ok()) return;
   if (!warmup) {
@@ -705,6 +713,7 @@ Status BackboneCore::issueRequest(const backbone::RepresentationRequest& r) {
       simplify.representation = protocol::RepresentationKind::kHybrid;
       simplify.kappa = options_.hybridKappa;
     }
+    simplify.keepBoundary = keepsBoundary(record, simplify.representation);
     message = std::move(simplify);
   } else {
     request.impostor = true;

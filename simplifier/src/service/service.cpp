@@ -14,6 +14,7 @@
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/mesh/mesh_regions.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
 #include "thinlod/protocol/codec.h"
@@ -150,7 +151,7 @@ void SimplifierService::Impl::dropUnusedModels() {
 }
 
 Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const IndexedMesh> mesh,
-                                                       float attributeWeight,
+                                                       float attributeWeight, bool keepBoundary,
                                                        const std::string& what) {
   auto model = std::make_unique<MeshModel>();
   // Builds of large meshes take a second or more: say so in the log.
@@ -163,6 +164,16 @@ Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const Ind
   BuildOptions build;
   build.attributeWeight = attributeWeight;
   model->attributeWeight = attributeWeight;
+  model->keepBoundary = keepBoundary;
+  if (keepBoundary) {
+    // A region object's borders (and the mesh's outer border) stay where
+    // they are at every level: independent levels of neighbouring regions
+    // then meet on the same vertices (docs/regions.md, "In the running system").
+    const std::vector<bool> boundary = openBoundaryVertices(*mesh);
+    build.vertexConstraints.assign(mesh->positions.size(), VertexConstraint::kFree);
+    for (std::size_t v = 0; v < boundary.size(); ++v)
+      if (boundary[v]) build.vertexConstraints[v] = VertexConstraint::kKeep;
+  }
   Result<ProgressiveMesh> pm = ProgressiveMesh::build(*mesh, build);
   if (!pm.ok()) return Status(pm.status().code(), what + ": " + pm.status().message());
   ++stats.progressiveMeshBuilds;
@@ -178,21 +189,22 @@ Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const Ind
     return invalid(what + ": no triangles or zero size after cleanup");
   }
   MeshModel* raw = model.get();
-  meshModels.emplace(raw->original.get(), std::move(model));
+  meshModels.emplace(ModelKey(raw->original.get(), keepBoundary), std::move(model));
   return raw;
 }
 
-Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObject& object) {
+Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObject& object,
+                                                         bool keepBoundary) {
   if (!object.fullMesh) return invalid("object " + std::to_string(object.id) + " has no mesh");
-  auto found = meshModels.find(object.fullMesh.get());
+  auto found = meshModels.find(ModelKey(object.fullMesh.get(), keepBoundary));
   if (found != meshModels.end()) return found->second.get();
   // A textured object's levels keep their uvs (extract always carries them);
   // attribute quadrics keep the texture from sliding across the surface.
   const bool textured = object.shape != nullptr && !object.shape->appearance.texturePath.empty() &&
                         !object.fullMesh->uvs.empty();
   const std::string what = "object " + std::to_string(object.id);
-  Result<MeshModel*> built =
-      buildModel(object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, what);
+  Result<MeshModel*> built = buildModel(
+      object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, keepBoundary, what);
   if (!built.ok() || object.shape == nullptr || !object.shape->geometry.animation) return built;
   // A skinned object's levels carry their vertices' skins in the palette's
   // bone indices (the backbone's bone poses hold one matrix per palette bone).
@@ -201,7 +213,7 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   Result<std::vector<anim::VertexSkin>> skin =
       tomSkin(model.pm, *object.fullMesh, palette.skin, palette.bones.size());
   if (!skin.ok()) {
-    meshModels.erase(object.fullMesh.get());
+    meshModels.erase(ModelKey(object.fullMesh.get(), keepBoundary));
     return Status(skin.status().code(), what + ": " + skin.status().message());
   }
   model.tomSkin = std::move(skin).value();
@@ -209,9 +221,10 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   return built;
 }
 
-Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::Bytes& bytes) {
-  const std::uint64_t key =
-      codec::frameChecksum(bytes.data(), bytes.size()) ^ (bytes.size() * 0x9e37u);
+Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::Bytes& bytes,
+                                                               bool keepBoundary) {
+  const std::pair<std::uint64_t, bool> key(
+      codec::frameChecksum(bytes.data(), bytes.size()) ^ (bytes.size() * 0x9e37u), keepBoundary);
   auto found = sourceMeshModels.find(key);
   if (found != sourceMeshModels.end()) return found->second.get();
   Result<IndexedMesh> decoded = codec::decodeMesh(bytes.data(), bytes.size());
@@ -219,10 +232,10 @@ Result<MeshModel*> SimplifierService::Impl::meshModelForSource(const protocol::B
     return Status(decoded.status().code(), "sourceMesh: " + decoded.status().message());
   }
   auto mesh = std::make_shared<const IndexedMesh>(std::move(decoded).value());
-  Result<MeshModel*> built = buildModel(mesh, 0.0f, "sourceMesh");
+  Result<MeshModel*> built = buildModel(mesh, 0.0f, keepBoundary, "sourceMesh");
   if (!built.ok()) return built.status();
   // Move it from the scene-mesh map into the source map (bounded).
-  auto node = meshModels.extract(mesh.get());
+  auto node = meshModels.extract(ModelKey(mesh.get(), keepBoundary));
   constexpr std::size_t kMaxSourceMeshes = 16;
   if (sourceMeshModels.size() >= kMaxSourceMeshes) sourceMeshModels.erase(sourceMeshModels.begin());
   MeshModel* raw = node.mapped().get();
@@ -235,7 +248,8 @@ bool SimplifierService::Impl::curveWithoutMeasuring(MeshModel& model) {
   if (!curveCache || model.cacheLookedUp) return false;
   model.cacheLookedUp = true;
   Result<MeshCurves> curves =
-      curveCache->find(*model.original, curveProducerFor(model.attributeWeight), model.pm, options.curve);
+      curveCache->find(*model.original, curveProducerFor(model.attributeWeight, model.keepBoundary),
+                       model.pm, options.curve);
   if (!curves.ok() || curves->levels.empty()) return false;
   ++stats.curvesFromDisk;
   model.ladder = creditLevels(curves->levels, options.curve.minRelativeError);
@@ -263,8 +277,9 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   };
   if (curveCache) {
     const int hitsBefore = curveCache->stats().hits;
-    curves = curveCache->getOrMeasure(*model.original, curveProducerFor(model.attributeWeight), minTriangles,
-                                      model.pm.maxTriangles(), extract, curveOptions);
+    curves = curveCache->getOrMeasure(*model.original,
+                                      curveProducerFor(model.attributeWeight, model.keepBoundary),
+                                      minTriangles, model.pm.maxTriangles(), extract, curveOptions);
     if (curves.ok()) {
       if (curveCache->stats().hits > hitsBefore) {
         ++stats.curvesFromDisk;
@@ -422,7 +437,8 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
     if (!valid.ok()) {
       result = valid;
     } else if (!request.sourceMesh.empty()) {
-      Result<MeshModel*> model = impl_->meshModelForSource(request.sourceMesh);
+      Result<MeshModel*> model =
+          impl_->meshModelForSource(request.sourceMesh, request.keepBoundary);
       result = !model.ok() ? Result<protocol::SimplifyResult>(model.status())
                : request.representation == protocol::RepresentationKind::kHybrid
                    ? impl_->simplifyHybrid(request, **model)
@@ -448,7 +464,7 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
                                         ": analytic primitives have no hybrid representation"))
                        : impl_->simplifyPrimitive(request, object->shape->geometry.primitive);
         } else {
-          Result<MeshModel*> model = impl_->meshModelFor(*object);
+          Result<MeshModel*> model = impl_->meshModelFor(*object, request.keepBoundary);
           result = !model.ok() ? Result<protocol::SimplifyResult>(model.status())
                    : request.representation == protocol::RepresentationKind::kHybrid
                        ? impl_->simplifyHybrid(request, **model)

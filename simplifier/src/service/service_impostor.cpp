@@ -250,14 +250,15 @@ Result<protocol::Representation> SimplifierService::Impl::impostor(
       // Cold start: without a known curve (memory or cache file) the full
       // mesh is rendered (error 0) rather than measuring the curve first.
       if (options.answerBeforeCurve && object->fullMesh) {
-        auto built = meshModels.find(object->fullMesh.get());
+        // A region object's levels come from its border-keeping model.
+        auto built = meshModels.find(ModelKey(object->fullMesh.get(), object->regionCount > 0));
         if (built == meshModels.end() || !curveWithoutMeasuring(*built->second)) {
           impostorScene.parts.push_back(ImpostorPart{object->fullMesh, object->objectToWorld,
                                                      scene::shapeMaterial(*object->shape)});
           continue;
         }
       }
-      Result<MeshModel*> model = meshModelFor(*object);
+      Result<MeshModel*> model = meshModelFor(*object, object->regionCount > 0);
       if (!model.ok()) return model.status();
       THINLOD_RETURN_IF_ERROR(ensureCurve(**model));
       MeshModel& m = **model;

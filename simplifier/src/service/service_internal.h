@@ -31,8 +31,10 @@ namespace thinlod::simplifier::service_detail {
 // BuildOptions or the simplifier's behaviour change.
 inline constexpr const char* kCurveProducer = "qem-service v1 boundaries=1 flips=1";
 // The producer of a textured object's curves (attribute quadrics on its uvs,
-// ServiceOptions::texturedAttributeWeight): another progressive mesh.
-std::string curveProducerFor(float attributeWeight);
+// ServiceOptions::texturedAttributeWeight) and of a mesh built with its open
+// boundary kept (SimplifyRequest::keepBoundary, region objects): another
+// progressive mesh each, so another cache key.
+std::string curveProducerFor(float attributeWeight, bool keepBoundary = false);
 // Share of a level's error budget that Draco quantization may add.
 inline constexpr double kQuantizationBudget = 0.1;
 
@@ -94,6 +96,8 @@ struct MeshModel {
   double diameter = 0.0;  // L of `original` (referenceLength(referenceSphere(original)))
   ProgressiveMesh pm;
   float attributeWeight = 0.0f;  // BuildOptions::attributeWeight pm was built with
+  // pm keeps every open-boundary vertex (kKeep): SimplifyRequest::keepBoundary.
+  bool keepBoundary = false;
   bool curveReady = false;
   bool cacheLookedUp = false;  // curveWithoutMeasuring found no file once: do not ask again
   std::vector<LevelCredit> ladder;
@@ -165,8 +169,12 @@ struct SimplifierService::Impl {
   std::vector<std::unique_ptr<service_detail::LoadedScene>> scenes;
   std::uint64_t useClock = 0;
   const service_detail::LoadedScene* lastScene = nullptr;
-  std::map<const IndexedMesh*, std::unique_ptr<service_detail::MeshModel>> meshModels;
-  std::map<std::uint64_t, std::unique_ptr<service_detail::MeshModel>> sourceMeshModels;
+  // By full mesh and keepBoundary (a region object's model keeps its borders).
+  using ModelKey = std::pair<const IndexedMesh*, bool>;
+  std::map<ModelKey, std::unique_ptr<service_detail::MeshModel>> meshModels;
+  // By the source bytes' checksum and keepBoundary.
+  std::map<std::pair<std::uint64_t, bool>, std::unique_ptr<service_detail::MeshModel>>
+      sourceMeshModels;
   std::map<service_detail::PrimitiveLevelKey, std::shared_ptr<const IndexedMesh>> primitiveLevels;
   std::unique_ptr<MeshCurveCache> curveCache;
   // Measured hybrid ladders, same directory (null without curveCacheDir).
@@ -181,10 +189,14 @@ struct SimplifierService::Impl {
   ~Impl();
 
   Result<service_detail::LoadedScene*> scene(const std::string& path);
-  Result<service_detail::MeshModel*> meshModelFor(const scene::SceneObject& object);
-  Result<service_detail::MeshModel*> meshModelForSource(const protocol::Bytes& bytes);
+  // keepBoundary: the progressive mesh keeps every vertex on an open boundary
+  // of the mesh (VertexConstraint::kKeep), docs/regions.md.
+  Result<service_detail::MeshModel*> meshModelFor(const scene::SceneObject& object,
+                                                  bool keepBoundary = false);
+  Result<service_detail::MeshModel*> meshModelForSource(const protocol::Bytes& bytes,
+                                                        bool keepBoundary = false);
   Result<service_detail::MeshModel*> buildModel(std::shared_ptr<const IndexedMesh> mesh,
-                                                float attributeWeight,
+                                                float attributeWeight, bool keepBoundary,
                                                 const std::string& what);
   Status ensureCurve(service_detail::MeshModel& model);
   // The curve from memory or the cache file only (never measured): true when

@@ -25,9 +25,11 @@ DeliveredLevel deliveredLevel(double relativeError) {
   return out;
 }
 
-std::string curveProducerFor(float attributeWeight) {
-  if (!(attributeWeight > 0.0f)) return kCurveProducer;
-  return std::string(kCurveProducer) + " attributes=" + std::to_string(attributeWeight);
+std::string curveProducerFor(float attributeWeight, bool keepBoundary) {
+  std::string producer = kCurveProducer;
+  if (attributeWeight > 0.0f) producer += " attributes=" + std::to_string(attributeWeight);
+  if (keepBoundary) producer += " keep_boundary=1";
+  return producer;
 }
 
 std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
