@@ -575,6 +575,16 @@ TEST(SceneImport, TheImportedSceneFuzzSeedsImport) {
       EXPECT_TRUE(plain.ok()) << "signs, a leading point and an exponent are plain decimals: "
                               << plain.status().toString();
     }
+    // Fuzz finding 38: a second document after the first. Assimp reads the
+    // first only, the pre-check resolved the first's urls against both.
+    {
+      { std::ofstream(path, std::ios::binary | std::ios::trunc) << text << "\n" << text; }
+      Result<Scene> twice = importScene(path);
+      EXPECT_EQ(twice.status().code(), ErrorCode::kParseError);
+      EXPECT_NE(twice.status().message().find("a second document element <COLLADA>"),
+                std::string::npos)
+          << twice.status().toString();
+    }
     fs::remove(path);
   }
 

@@ -252,6 +252,7 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     std::uint32_t node;  // index of the enclosing <node> (this one if a node), or kNoNode
   };
   std::vector<Open> open;
+  bool sawRoot = false;  // the document element has been opened
   std::vector<std::vector<std::uint32_t>> children;
   std::vector<std::uint32_t> roots;
   std::map<std::string_view, std::uint32_t> nodeById;
@@ -322,6 +323,19 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
       }
       open.pop_back();
       continue;
+    }
+    // One document element: Assimp reads the first and stops, while this
+    // scan went on into a second one and resolved the first's urls against
+    // it (fuzz finding 38: a second <COLLADA> after the first made "#scene"
+    // look defined; Assimp threw on the first and leaked).
+    if (open.empty()) {
+      if (sawRoot) {
+        return Status(ErrorCode::kParseError, path + ": a second document element <" +
+                                                  std::string(name.substr(0, 64)) +
+                                                  "> at byte " + std::to_string(i) +
+                                                  " (XML has one)");
+      }
+      sawRoot = true;
     }
     const std::uint32_t enclosing = open.empty() ? kNoNode : open.back().node;
     std::uint32_t self = enclosing;

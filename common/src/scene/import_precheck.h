@@ -29,8 +29,9 @@ Status checkNodeGraph(const std::string& path,
                       const std::vector<std::uint32_t>& roots, const ImportLimits& limits);
 
 // Collada: a light scan of the XML (tags, quotes, comments, CDATA; no DTD)
-// before Assimp parses it. Refuses unterminated markup and a file whose
-// elements are left open (truncated), element nesting deeper than
+// before Assimp parses it. Refuses unterminated markup, a file whose
+// elements are left open (truncated) or with a second document element
+// (Assimp reads the first only), element nesting deeper than
 // limits.maxDepth + 64, an accessor reading past the array it names
 // (count * stride > the array's count), a transform without exactly its
 // count of plain finite decimal numbers, an index list (p, vcount, v, h)
