@@ -167,6 +167,21 @@ Result<std::vector<std::uint8_t>> encodeMeshFrame(const IndexedMesh& input,
       options.decodeSpeed > 10) {
     return invalid("Draco speeds must be in [0, 10]");
   }
+  const bool grid = options.positionRange != 0.0f;
+  if (grid) {
+    const auto& o = options.positionOrigin;
+    if (!(options.positionRange > 0.0f) || !std::isfinite(options.positionRange) ||
+        !std::isfinite(o[0]) || !std::isfinite(o[1]) || !std::isfinite(o[2])) {
+      return invalid("position grid: origin and range must be finite, range > 0");
+    }
+    for (const glm::vec3& p : input.positions) {
+      for (int k = 0; k < 3; ++k) {
+        if (p[k] < o[k] || p[k] > o[k] + options.positionRange) {
+          return invalid("position grid: a vertex lies outside the grid's cube");
+        }
+      }
+    }
+  }
   std::vector<SkinValue> compactSkin;
   const IndexedMesh mesh = compactForEncoding(input, skin, compactSkin);
   if (mesh.triangleCount() == 0) return invalid("no non-degenerate triangles");
@@ -207,7 +222,13 @@ Result<std::vector<std::uint8_t>> encodeMeshFrame(const IndexedMesh& input,
     }
 
     draco::Encoder encoder;
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.positionBits);
+    if (grid) {
+      encoder.SetAttributeExplicitQuantization(
+          draco::GeometryAttribute::POSITION, options.positionBits, 3,
+          options.positionOrigin.data(), options.positionRange);
+    } else {
+      encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.positionBits);
+    }
     encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.normalBits);
     encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, options.texcoordBits);
     encoder.SetSpeedOptions(options.encodeSpeed, options.decodeSpeed);

@@ -205,6 +205,12 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   const std::string what = "object " + std::to_string(object.id);
   Result<MeshModel*> built = buildModel(
       object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, keepBoundary, what);
+  if (built.ok() && keepBoundary && object.regionCount > 0 && object.shape != nullptr &&
+      object.shape->geometry.mesh) {
+    // Every region of the mesh on one quantization grid: the border
+    // vertices they keep decode to the same floats (docs/regions.md).
+    (*built)->grid = gridOf(*object.shape->geometry.mesh);
+  }
   if (!built.ok() || object.shape == nullptr || !object.shape->geometry.animation) return built;
   // A skinned object's levels carry their vertices' skins in the palette's
   // bone indices (the backbone's bone poses hold one matrix per palette bone).
@@ -312,7 +318,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     ++stats.levelsMeasuredAlone;
     const double d =
         std::max(relativeError(error->max(), model.diameter), options.curve.minRelativeError);
-    return encodedMeshResult(mesh, deliveredLevel(d), model.skinOf(mesh));
+    return encodedMeshResult(mesh, model.delivered(d), model.skinOf(mesh), model.grid);
   }
   THINLOD_RETURN_IF_ERROR(ensureCurve(model));
   const ProgressiveMesh& pm = model.pm;
@@ -321,7 +327,7 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     target = std::min<std::size_t>(request.targetTriangles, pm.maxTriangles());
   } else {
     for (const LevelCredit& rung : model.ladder) {
-      if (deliveredLevel(rung.relativeError).accuracy >= request.targetAccuracy) {
+      if (model.delivered(rung.relativeError).accuracy >= request.targetAccuracy) {
         target = rung.requestedTriangles;
         break;
       }
@@ -335,14 +341,14 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
   const IndexedMesh mesh = original ? *model.original : pm.extract(target);
   const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
   Result<protocol::SimplifyResult> encoded =
-      encodedMeshResult(mesh, deliveredLevel(credit.relativeError),
-                        original ? model.originalSkin : model.skinOf(mesh));
+      encodedMeshResult(mesh, model.delivered(credit.relativeError),
+                        original ? model.originalSkin : model.skinOf(mesh), model.grid);
   if (!encoded.ok()) return encoded.status();
   protocol::SimplifyResult result = std::move(encoded).value();
   if (request.curvePoints > 0) {
     std::vector<AccuracySample> points;
     for (const LevelCredit& rung : model.ladder) {
-      points.push_back(AccuracySample{deliveredLevel(rung.relativeError).accuracy,
+      points.push_back(AccuracySample{model.delivered(rung.relativeError).accuracy,
                                       static_cast<double>(rung.triangles)});
     }
     result.curve = curveSamples(std::move(points), request.curvePoints);

@@ -3,6 +3,7 @@
 // service_impostor.cpp.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -57,6 +58,22 @@ struct DeliveredLevel {
   double accuracy = 0.0;
 };
 DeliveredLevel deliveredLevel(double relativeError);
+// A shared quantization grid (codec::MeshEncodeOptions positionOrigin /
+// positionRange) for every region object of one mesh: the whole mesh's box,
+// kRegionGridBits bits, so a border vertex two regions keep decodes to the
+// same floats in both (docs/regions.md). range 0: each level's own box.
+struct PositionGrid {
+  std::array<float, 3> origin{0.0f, 0.0f, 0.0f};
+  float range = 0.0f;
+};
+inline constexpr int kRegionGridBits = 18;
+// The grid of `whole` (a cube from its bounds' minimum, side its largest
+// extent, widened by a few ulps so every vertex lies inside).
+PositionGrid gridOf(const IndexedMesh& whole);
+// deliveredLevel on a grid: kRegionGridBits bits over grid.range, whose
+// quantization relative to a part of reference length `diameter` is
+// (range / diameter) * quantizationError(kRegionGridBits). range 0: deliveredLevel.
+DeliveredLevel deliveredOnGrid(double relativeError, const PositionGrid& grid, double diameter);
 // Triangle count stored in an encodeMesh frame (header offset 12, u32 LE):
 // what the client will hold; 0 for a frame shorter than its header.
 std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame);
@@ -66,7 +83,8 @@ std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame);
 // scene's palette indices; empty: a static mesh) in the frame.
 Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
                                                    const DeliveredLevel& delivered,
-                                                   const std::vector<anim::VertexSkin>& skin = {});
+                                                   const std::vector<anim::VertexSkin>& skin = {},
+                                                   const PositionGrid& grid = {});
 
 // Credits from measured levels (increasing triangles): each rung gets the
 // worst error measured at it or any finer rung, so credits never improve by
@@ -98,6 +116,11 @@ struct MeshModel {
   float attributeWeight = 0.0f;  // BuildOptions::attributeWeight pm was built with
   // pm keeps every open-boundary vertex (kKeep): SimplifyRequest::keepBoundary.
   bool keepBoundary = false;
+  // A region object's levels (keepBoundary, from a scene): its whole mesh's grid.
+  PositionGrid grid;
+  DeliveredLevel delivered(double relativeError) const {
+    return deliveredOnGrid(relativeError, grid, diameter);
+  }
   bool curveReady = false;
   bool cacheLookedUp = false;  // curveWithoutMeasuring found no file once: do not ask again
   std::vector<LevelCredit> ladder;

@@ -39,11 +39,36 @@ std::uint32_t frameTriangles(const std::vector<std::uint8_t>& frame) {
          (static_cast<std::uint32_t>(frame[15]) << 24);
 }
 
+PositionGrid gridOf(const IndexedMesh& whole) {
+  PositionGrid grid;
+  const Bounds bounds = whole.bounds();
+  if (bounds.empty) return grid;
+  const glm::vec3 extent = bounds.max - bounds.min;
+  const float side = std::max({extent.x, extent.y, extent.z});
+  if (!(side > 0.0f)) return grid;
+  grid.origin = {bounds.min.x, bounds.min.y, bounds.min.z};
+  // origin + range must not round below the maximum.
+  grid.range = side * (1.0f + 1e-5f);
+  return grid;
+}
+
+DeliveredLevel deliveredOnGrid(double relativeError, const PositionGrid& grid, double diameter) {
+  if (!(grid.range > 0.0f) || !(diameter > 0.0)) return deliveredLevel(relativeError);
+  DeliveredLevel out;
+  out.positionBits = kRegionGridBits;
+  const double d = std::max(relativeError, 0.0);
+  out.accuracy = 1.0 / (d + double(grid.range) / diameter * quantizationError(kRegionGridBits));
+  return out;
+}
+
 Result<protocol::SimplifyResult> encodedMeshResult(const IndexedMesh& mesh,
                                                    const DeliveredLevel& delivered,
-                                                   const std::vector<anim::VertexSkin>& skin) {
+                                                   const std::vector<anim::VertexSkin>& skin,
+                                                   const PositionGrid& grid) {
   codec::MeshEncodeOptions encode;
   encode.positionBits = delivered.positionBits;
+  encode.positionOrigin = grid.origin;
+  encode.positionRange = grid.range;
   Result<std::vector<std::uint8_t>> frame =
       skin.empty() ? codec::encodeMesh(mesh, encode) : codec::encodeSkinnedMesh(mesh, skin, encode);
   if (!frame.ok()) return frame.status();

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -63,6 +64,13 @@ struct DecodeLimits {
 // --- Meshes ---
 struct MeshEncodeOptions {
   int positionBits = 14;  // [8, 20]; see positionBitsForAccuracy
+  // positionRange > 0: quantize positions on this grid (origin, cube side
+  // positionRange, positionBits) instead of the mesh's own bounding box, so
+  // meshes encoded on one grid decode a shared position bit-identically
+  // (the regions of one mesh, docs/regions.md). Every position must lie in
+  // the cube; a non-finite origin or range is kInvalidArgument.
+  std::array<float, 3> positionOrigin{0.0f, 0.0f, 0.0f};
+  float positionRange = 0.0f;
   int normalBits = 10;
   int texcoordBits = 12;
   int encodeSpeed = 5;  // Draco 0 (smallest) .. 10 (fastest)
