@@ -125,11 +125,19 @@ TEST(SkinnedImport, TruncatedOrMalformedSmdAndUntestedFormatsAreRefusedBeforeAss
         std::string(valid).replace(valid.find("1 \"arm\" 0"), 9, "1 \"arm\" 5"),  // parent
         std::string(valid).replace(valid.find("0 0 0 0 0 0 0\n"), 13, "0 0 0 nan 0 0 0"),
         std::string(valid).replace(valid.find("1 0 2 0 0 0 1 0 1 1 1 1.0"), 25,
-                                   "1 0 2 0 0 0 1 0 1 1 7 1.0")}) {  // link to bone 7
+                                   "1 0 2 0 0 0 1 0 1 1 7 1.0"),  // link to bone 7
+        // Fuzz finding 39: 19 integer digits (Assimp asked for 11 GB on 32).
+        std::string(valid).replace(valid.find("1 0 2 0 0 0 1 0 1 1 1 1.0"), 25,
+                                   "1 0 2 0 0 3333333333333333333 1 0 1 1 1 1.0")}) {
     const Result<SkinnedModel> model = import(bad);
     EXPECT_EQ(model.status().code(), ErrorCode::kParseError) << bad;
     EXPECT_NE(model.status().message().find(path), std::string::npos) << model.status().toString();
   }
+  // 18 integer digits (and larger magnitudes with an exponent) still read.
+  const Result<SkinnedModel> eighteen =
+      import(std::string(valid).replace(valid.find("1 0 2 0 0 0 1 0 1 1 1 1.0"), 25,
+                                        "1 0 2 0 0 333333333333333333 1 0 1 1 1 1.0"));
+  EXPECT_TRUE(eighteen.ok()) << eighteen.status().toString();
   EXPECT_EQ(importSkinnedModel(testing::TempDir() + "/figure.md5mesh").status().code(),
             ErrorCode::kUnsupported);
   std::remove(path.c_str());
