@@ -4,7 +4,9 @@ table across runs (table.md, table.csv, table.json), a gnuplot plot of SNR per f
 scheduler of each case (snr-<case>.png) and a self-contained results page (index.html: table,
 plots, frame / reference / difference images inlined as base64, the settings of every run).
 
-Usage: deploy/workbench_report.py RESULTS_DIR [--doc FILE.md]
+Usage: deploy/workbench_report.py RESULTS_DIR [--doc FILE.md] [--from-time SECONDS]
+  --from-time leaves out every frame whose time_s is below SECONDS (a trace's warm-up hold, e.g.
+  deploy/data/parts-fly-hold.trace's 25 s) from every metric, plot and page of this report.
   --doc replaces the part of FILE.md between the lines "<!-- workbench:begin -->" and
   "<!-- workbench:end -->" with this folder's table, settings and images (the images are copied
   to img/ beside FILE.md as workbench-*.png); deploy/compare --write-doc uses it for
@@ -33,6 +35,7 @@ COLUMNS = [
     ("psnr_db_min", "PSNR min", 1),
     ("blank_frames", "blank", None), ("incomplete_frames", "incomplete", None),
     ("frames_over_budget", "over budget", None), ("polygons_max", "tris max", None),
+    ("units_max", "units max", 1),
     ("link_kb_total", "link KB", 1), ("link_kb_worst_1s", "worst 1 s KB", 1),
     ("simplifier_requests", "requests", None),
     ("update_latency_ms_median", "update med ms", 0), ("update_latency_ms_p99", "update p99 ms", 0),
@@ -76,6 +79,19 @@ def worst_window(times, amounts, window=1.0):
     return best
 
 
+def frame_units(row):
+    """A frame's primitive units, what the budget counts: its "units" column (triangles + points /
+    kappa, thinlod-frontend) when it holds a number; its triangles ("polygons") when it drew no
+    points or frames.csv predates the column; NaN when points were drawn at an unknown kappa."""
+    units = number(row.get("units"))
+    if not math.isnan(units):
+        return units
+    points = number(row.get("points"))
+    if math.isnan(points) or points == 0:
+        return number(row.get("polygons"))
+    return math.nan
+
+
 def first_complete(rows):
     """(frame, shown_at_ms) of the first frame that shows every visible object (at least one
     visible, none missing), or (None, None)."""
@@ -103,14 +119,20 @@ def read_rows(path):
         return list(csv.DictReader(f))
 
 
-def run_metrics(run_dir):
+def run_metrics(run_dir, from_time=None):
+    """Metrics of one run folder; with from_time, of its frames with time_s >= from_time."""
     meta = json.load(open(os.path.join(run_dir, "run.json")))
     rows = read_rows(os.path.join(run_dir, "frames.csv"))
+    if from_time is not None:
+        rows = [r for r in rows if number(r.get("time_s")) >= from_time]
     decisions = read_rows(os.path.join(run_dir, "decisions.csv"))
     summary_path = os.path.join(run_dir, "frontend-summary.json")
     summary = json.load(open(summary_path)) if os.path.exists(summary_path) else {}
     col = lambda key: [number(r.get(key)) for r in rows]
     snr, psnr, polygons = col("snr_db"), col("psnr_db"), col("polygons")
+    units = [frame_units(r) for r in rows]
+    known_units = [u for u in units if not math.isnan(u)]
+    points = [p for p in col("points") if not math.isnan(p)]
     budget = meta.get("budget_polygons")
     frame, complete_ms = first_complete(rows)
     m = {
@@ -126,7 +148,13 @@ def run_metrics(run_dir):
         "blank_frames": sum(1 for r in rows if r.get("blank") == "1"),
         "incomplete_frames": sum(1 for r in rows if number(r.get("missing_objects")) > 0),
         "polygons_max": int(max(polygons)) if polygons else None,
-        "frames_over_budget": sum(1 for p in polygons if budget and p > budget),
+        "units_max": max(known_units) if known_units else None,
+        # Over the budget in units (triangles + points / kappa); frames whose units are unknown
+        # (points at an unknown kappa) are counted apart, never as within it.
+        "frames_over_budget": sum(1 for u in known_units if budget and u > budget),
+        "frames_units_unknown": len(units) - len(known_units),
+        "points_max": int(max(points)) if points else None,
+        "from_time_s": from_time,
         "link_kb_total": sum(x for x in col("link_bytes") if not math.isnan(x)) / 1000.0,
         "link_kb_worst_1s": worst_window(col("time_s"), [0 if math.isnan(x) else x
                                                          for x in col("link_bytes")]) / 1000.0,
@@ -384,7 +412,14 @@ def write_doc(doc, out_dir, settings, metrics, table_text, plots):
 
 
 def main(argv):
-    doc = None
+    doc, from_time = None, None
+    if "--from-time" in argv:
+        i = argv.index("--from-time")
+        if i + 1 >= len(argv) or math.isnan(number(argv[i + 1])):
+            print(__doc__, file=sys.stderr)
+            return 2
+        from_time = number(argv[i + 1])
+        argv = argv[:i] + argv[i + 2:]
     if "--doc" in argv:
         i = argv.index("--doc")
         if i + 1 >= len(argv):
@@ -405,7 +440,7 @@ def main(argv):
         return 1
     metrics, metas, rows_by_run = [], [], {}
     for n in names:
-        m, meta, rows = run_metrics(os.path.join(out_dir, n))
+        m, meta, rows = run_metrics(os.path.join(out_dir, n), from_time)
         with open(os.path.join(out_dir, n, "metrics.json"), "w") as f:
             json.dump(m, f, indent=2)
         with open(os.path.join(out_dir, n, "metrics.csv"), "w", newline="") as f:

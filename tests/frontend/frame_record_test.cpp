@@ -65,13 +65,13 @@ TEST(FrameRecord, HeaderHasTheRequiredColumnsInOrder) {
             "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,"
             "wait_ms,updates_received,updates_rejected,lockstep_timeout,shown_at_ms,"
             "visible_objects,missing_objects,blank,skinned_objects,deformed_vertices,"
-            "pose_bytes\n");
+            "pose_bytes,points,units\n");
 }
 
 TEST(FrameRecord, RowFormatsEveryColumn) {
   EXPECT_EQ(formatFrameCsvRow(sampleRecord()),
             "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,31.5000,3,2,524288,"
-            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0,0\n");
+            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0,0,0,\n");
 }
 
 TEST(FrameRecord, SkinnedColumnsComeLastAfterTheOlderOnes) {
@@ -80,7 +80,27 @@ TEST(FrameRecord, SkinnedColumnsComeLastAfterTheOlderOnes) {
   r.deformedVertices = 4453;
   r.poseBytes = 3 * 37 * 48;
   const std::string row = formatFrameCsvRow(r);
-  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,3,4453,5328\n");
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,3,4453,5328,0,\n");
+}
+
+TEST(FrameRecord, PointsAndUnitsComeAfterPoseBytes) {
+  FrameRecord r = sampleRecord();
+  r.poseBytes = 96;
+  r.points = 30;
+  r.units = primitiveUnits(r.polygons, r.points, 1.5);
+  const std::string row = formatFrameCsvRow(r);
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,0,0,96,30,368.00\n");
+}
+
+TEST(FrameRecord, UnitsAreTrianglesPlusPointsOverKappa) {
+  EXPECT_EQ(primitiveUnits(348, 30, 1.5), 368.0);
+  EXPECT_EQ(primitiveUnits(100, 25, 10.0), 102.5);
+  // No points: the triangles, whether kappa is known or not.
+  EXPECT_EQ(primitiveUnits(348, 0, 0.0), 348.0);
+  EXPECT_EQ(primitiveUnits(0, 0, 3.0), 0.0);
+  // Points at an unknown price: missing, never the triangles alone.
+  EXPECT_TRUE(std::isnan(primitiveUnits(348, 30, 0.0)));
+  EXPECT_TRUE(std::isnan(primitiveUnits(348, 30, FrameRecord::kMissing)));
 }
 
 TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
@@ -88,7 +108,7 @@ TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
   r.frame = 1;
   r.quality.snrDb = kInf;
   r.quality.psnrDb = kInf;
-  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0,0\n");
+  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0,0,0,\n");
   r.quality.snrDb = -kInf;
   EXPECT_NE(formatFrameCsvRow(r).find(",-inf,"), std::string::npos);
 }

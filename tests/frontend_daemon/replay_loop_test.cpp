@@ -105,6 +105,7 @@ class SceneProducer final : public FrameProducer {
     clock_.now += renderNs;
     ProducedFrame produced;
     produced.triangles = scene.polygons();
+    produced.points = points;
     produced.appliedPlan = scene.lastAppliedPlan();
     produced.committedBatches = committed.plans.size();
     produced.renderMs = static_cast<double>(renderNs) / kMs;
@@ -124,6 +125,7 @@ class SceneProducer final : public FrameProducer {
   std::int64_t renderNs = 5 * kMs;
   std::int64_t measureNs = 20 * kMs;
   double snrDb = 12.0;
+  std::size_t points = 0;  // discs "drawn" every frame
   std::optional<std::uint64_t> failAtFrame;
   std::vector<std::int64_t> renderStartNs;
 
@@ -404,6 +406,51 @@ TEST_F(ReplayLoopTest, PoseBytesCountTheBonePosesOfTheUpdatesReceivedInTheFrame)
   EXPECT_EQ(result.records[3].poseBytes, 8u * 48u);
   // They are part of link_bytes (the fake link counts 1000 bytes of framing an update).
   EXPECT_EQ(result.records[1].linkBytes, 1000u + 8u * 48u);
+}
+
+TEST_F(ReplayLoopTest, PointsAndUnitsOfEachFrameAtTheGivenKappa) {
+  options.rate = 10.0;
+  options.hybridKappa = 1.5;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
+    if (pose.sequence == 0) reply = std::make_pair(0, sphereUpdate(1, 0, 1, 5.0));
+    return reply;
+  };
+  producer.points = 30;
+  Replayed result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  for (const FrameRecord& record : result.records) {
+    EXPECT_EQ(record.points, 30u);
+    EXPECT_DOUBLE_EQ(record.units, double(record.polygons) + 20.0) << record.frame;
+  }
+  EXPECT_GT(result.records[1].polygons, 0u);
+}
+
+TEST_F(ReplayLoopTest, UnitsAreMissingWhenPointsWereDrawnAtAnUnknownKappa) {
+  options.rate = 10.0;
+  producer.points = 30;
+  Replayed result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  for (const FrameRecord& record : result.records) {
+    EXPECT_EQ(record.points, 30u);
+    EXPECT_TRUE(std::isnan(record.units)) << record.frame;
+  }
+}
+
+TEST_F(ReplayLoopTest, UnitsAreTheTrianglesWhenNoPointsWereDrawn) {
+  options.rate = 10.0;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
+    if (pose.sequence == 0) reply = std::make_pair(0, sphereUpdate(1, 0, 1, 5.0));
+    return reply;
+  };
+  Replayed result = run(traceAt({0.0, 0.1}));
+  ASSERT_EQ(result.records.size(), 2u);
+  EXPECT_GT(result.records[1].polygons, 0u);
+  for (const FrameRecord& record : result.records) {
+    EXPECT_EQ(record.points, 0u);
+    EXPECT_EQ(record.units, double(record.polygons)) << record.frame;
+  }
 }
 
 TEST_F(ReplayLoopTest, ATraceGivesWaitsNoDescriptorToWakeOn) {

@@ -26,7 +26,7 @@ def frame_row(frame, time_s, polygons, link, snr, update, shown, visible, missin
             f"{update},{frame},1,0,20,0.1,1,0,0,{shown},{visible},{missing},{blank}")
 
 
-def write_run(out, case, scheduler, budget, rows, requests):
+def write_run(out, case, scheduler, budget, rows, requests, header=FRAME_HEADER):
     name = f"{case}-{scheduler}-{budget}"
     d = os.path.join(out, name)
     os.makedirs(os.path.join(d, "frames"), exist_ok=True)
@@ -35,7 +35,7 @@ def write_run(out, case, scheduler, budget, rows, requests):
                    "mode": "live", "backbone_args": "--scheduler " + scheduler,
                    "frontend_args": "--deferred-reference", "wall_s": 1.0, "exit_code": 0}, f)
     with open(os.path.join(d, "frames.csv"), "w") as f:
-        f.write(FRAME_HEADER + "\n" + "\n".join(rows) + "\n")
+        f.write(header + "\n" + "\n".join(rows) + "\n")
     with open(os.path.join(d, "decisions.csv"), "w") as f:
         f.write("frame,requests\n" + "".join(f"{i},{r}\n" for i, r in enumerate(requests)))
     with open(os.path.join(d, "frontend-summary.json"), "w") as f:

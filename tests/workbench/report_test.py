@@ -14,7 +14,7 @@ SOURCE = os.environ.get("THINLOD_SOURCE_DIR",
 sys.path.insert(0, os.path.join(SOURCE, "deploy"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import workbench_report as report  # noqa: E402
-from fixture import write_fixture  # noqa: E402
+from fixture import FRAME_HEADER, frame_row, write_fixture, write_run  # noqa: E402
 
 
 def read(path):
@@ -49,6 +49,62 @@ class Functions(unittest.TestCase):
             [{"frame": "0", "visible_objects": "", "missing_objects": "", "shown_at_ms": ""}]),
             (None, None))
 
+    def test_frame_units_prefer_the_units_column_then_the_triangles_of_a_frame_without_points(self):
+        self.assertEqual(report.frame_units({"polygons": "150", "points": "30", "units": "170.00"}),
+                         170.0)
+        # frames.csv before the columns, and a frame without points: units are triangles.
+        self.assertEqual(report.frame_units({"polygons": "150"}), 150.0)
+        self.assertEqual(report.frame_units({"polygons": "150", "points": "0", "units": ""}), 150.0)
+        # Points at an unknown kappa: unknown, never the triangles alone.
+        self.assertTrue(math.isnan(report.frame_units({"polygons": "150", "points": "30",
+                                                       "units": ""})))
+
+
+def hybrid_row(frame, time_s, polygons, points, units):
+    """A frame row with the newer columns: skinned_objects ... pose_bytes, points, units."""
+    return frame_row(frame, time_s, polygons, 1000, "10", "", 100 * frame, 1, 0, 0) + \
+        f",0,0,0,{points},{units}"
+
+
+class HybridUnits(unittest.TestCase):
+    """A run that drew points: the budget is checked in units, and --from-time drops a hold."""
+
+    def report(self, *extra):
+        d = tempfile.TemporaryDirectory()
+        self.addCleanup(d.cleanup)
+        with open(os.path.join(d.name, "settings.json"), "w") as f:
+            json.dump({"mode": "live", "cases": ["field"], "schedulers": ["curves-hybrid"]}, f)
+        write_run(d.name, "field", "curves-hybrid", 200, [
+            hybrid_row(0, 0.0, 100, 0, "100.00"),
+            hybrid_row(1, 1.0, 190, 30, "210.00"),   # 190 triangles, but 210 units: over
+            hybrid_row(2, 2.0, 150, 60, ""),         # points at an unknown kappa
+            hybrid_row(3, 3.0, 180, 15, "190.00")], [1, 0, 0, 0],
+            header=FRAME_HEADER + ",skinned_objects,deformed_vertices,pose_bytes,points,units")
+        done = subprocess.run([sys.executable, os.path.join(SOURCE, "deploy", "workbench_report.py"),
+                               d.name] + list(extra), capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        runs = json.loads(read(os.path.join(d.name, "table.json")))["runs"]
+        self.assertEqual(len(runs), 1)
+        return runs[0], read(os.path.join(d.name, "table.md"))
+
+    def test_the_budget_is_checked_in_units(self):
+        m, table = self.report()
+        self.assertEqual(m["polygons_max"], 190)
+        self.assertEqual(m["units_max"], 210.0)
+        self.assertEqual(m["points_max"], 60)
+        self.assertEqual(m["frames_over_budget"], 1)
+        self.assertEqual(m["frames_units_unknown"], 1)
+        self.assertIn("| units max |", table)
+        self.assertIn("| 190 | 210.0 |", table)
+
+    def test_from_time_leaves_out_the_frames_before_it(self):
+        m, _ = self.report("--from-time", "2")
+        self.assertEqual(m["frames"], 2)
+        self.assertEqual(m["from_time_s"], 2.0)
+        self.assertEqual(m["frames_over_budget"], 0)
+        self.assertEqual(m["units_max"], 190.0)
+        self.assertEqual(m["polygons_max"], 180)
+
 
 class Report(unittest.TestCase):
     @classmethod
@@ -81,6 +137,9 @@ class Report(unittest.TestCase):
         self.assertEqual(m["incomplete_frames"], 2)  # frames 0 and 3
         self.assertEqual(m["frames_over_budget"], 1)  # 210 > 200
         self.assertEqual(m["polygons_max"], 210)
+        # frames.csv without points / units: units are the triangles.
+        self.assertEqual(m["units_max"], 210.0)
+        self.assertEqual(m["frames_units_unknown"], 0)
         self.assertAlmostEqual(m["link_kb_total"], 116.0)
         self.assertAlmostEqual(m["link_kb_worst_1s"], 115.0)  # frames 0-2 within 1 s
         self.assertEqual(m["simplifier_requests"], 3)

@@ -96,6 +96,7 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
   }
   ProducedFrame produced;
   produced.triangles = report->triangles;
+  produced.points = report->discs;
   produced.appliedPlan = report->appliedPlan;
   produced.earlyPolygons = report->earlyPolygons;
   produced.committedBatches = report->committedBatches;

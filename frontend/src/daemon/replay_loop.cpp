@@ -247,6 +247,8 @@ class Replay {
     record.frame = frame;
     record.timeS = pose.time;
     record.polygons = produced.triangles;
+    record.points = produced.points;
+    record.units = primitiveUnits(produced.triangles, produced.points, options_.hybridKappa);
     record.plan = produced.appliedPlan;
     record.earlyPolygons = std::min(produced.earlyPolygons, produced.triangles);
     record.renderMs = produced.renderMs;

@@ -59,6 +59,8 @@
 // - link_bytes: link.bytesReceived() since the previous frame; pose_bytes: the
 //   bone poses of the updates received since then, 48 bytes a matrix (also
 //   those of updates then rejected: they crossed the link).
+// - points: hybrid discs drawn; units: primitiveUnits(triangles, points,
+//   options.hybridKappa) (frame_record.h).
 // - Errors: a failed render or measurement ends the replay; the frames so
 //   far have been handed on and the Status is in ReplayResult::status.
 // - Single-threaded; the interfaces are called from the caller's thread.
@@ -112,6 +114,7 @@ class BackboneLink {
 
 struct ProducedFrame {
   std::size_t triangles = 0;  // drawn
+  std::size_t points = 0;     // hybrid disc points drawn (FrameReport::discs)
   std::uint64_t appliedPlan = 0;
   std::size_t earlyPolygons = 0;  // of triangles, first representations shown before their plan
   std::size_t committedBatches = 0;
@@ -176,6 +179,10 @@ struct ReplayOptions {
   std::uint32_t viewportWidth = 0;
   std::uint32_t viewportHeight = 0;
   std::chrono::milliseconds pollSlice{50};
+  // The point rate the backbone prices hybrids with (its --hybrid-kappa), for
+  // the record's units = triangles + points / kappa; 0 = not known (units
+  // then missing on frames that drew points).
+  double hybridKappa = 0.0;
   ConversionOptions conversion;
 };
 

@@ -72,7 +72,7 @@ std::string frameCsvHeader() {
   return "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
          "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,wait_ms,"
          "updates_received,updates_rejected,lockstep_timeout,shown_at_ms,visible_objects,"
-         "missing_objects,blank,skinned_objects,deformed_vertices,pose_bytes\n";
+         "missing_objects,blank,skinned_objects,deformed_vertices,pose_bytes,points,units\n";
 }
 
 std::string formatFrameCsvRow(const FrameRecord& r) {
@@ -103,8 +103,16 @@ std::string formatFrameCsvRow(const FrameRecord& r) {
   row += ',' + std::to_string(r.skinnedObjects);
   row += ',' + std::to_string(r.deformedVertices);
   row += ',' + std::to_string(r.poseBytes);
+  row += ',' + std::to_string(r.points);
+  row += ',' + formatNumber(r.units, "%.2f");
   row += '\n';
   return row;
+}
+
+double primitiveUnits(std::size_t triangles, std::size_t points, double kappa) {
+  if (points == 0) return static_cast<double>(triangles);
+  if (!(kappa > 0.0) || !std::isfinite(kappa)) return kMissingValue;
+  return static_cast<double>(triangles) + static_cast<double>(points) / kappa;
 }
 
 std::string objectCsvHeader() {

@@ -96,6 +96,11 @@ struct FrameRecord {
   // matrix, as payloadBytes counts them): the part of link_bytes that is
   // poses rather than geometry, textures or framing.
   std::uint64_t poseBytes = 0;
+  // Hybrid disc points drawn (FrameReport::discs) and the frame's primitive
+  // units, triangles + points / kappa (primitiveUnits; the unit the
+  // backbone's polygon budget counts when hybrids are on).
+  std::size_t points = 0;
+  double units = kMissing;
   FrameQuality quality;  // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
 // FrameLog spills pending records as raw bytes.
@@ -105,10 +110,16 @@ static_assert(std::is_trivially_copyable_v<FrameRecord>);
 //  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,
 //  reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,
 //  shown_at_ms,visible_objects,missing_objects,blank,skinned_objects,
-//  deformed_vertices,pose_bytes\n"
+//  deformed_vertices,pose_bytes,points,units\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);
+
+// Primitive units of a frame that drew `triangles` and `points` hybrid discs:
+// `triangles` when there are no points (whatever kappa), triangles + points /
+// kappa when kappa > 0 (the backbone's --hybrid-kappa), else missing (NaN:
+// points drawn at an unknown price).
+double primitiveUnits(std::size_t triangles, std::size_t points, double kappa);
 
 // "frame,time_s,object,kind,triangles,vertices,skinned,posed,x,y,z\n": per
 // held object, its representation's kind (representationKindName), triangles
