@@ -10,6 +10,10 @@
 // Prints a markdown report (per-frame table and summary) to stdout.
 //   bench_hybrid_flythrough [--kappa K] [--tau T] [--frames N] [--instances N]
 //                           [--pixels P] [--backend egl|osmesa] [--size WxH]
+//                           [--path diagonal|front] [--standoff D]
+// --path front: a pass along the field's front edge at D (default 6) in front
+// of its first row, looking at its centre: no instance nearer than about D,
+// most of the field several times farther (the diagonal path flies into it).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -83,6 +87,16 @@ Pose poseAt(int frame, int frames, double fieldLength, double fieldDepth) {
   return {eye, target};
 }
 
+// Along the field's front edge, `standoff` in front of its first row and
+// 1.5 up, from a fifth of its length left of it to a fifth right, always
+// looking at the field's centre.
+Pose frontPoseAt(int frame, int frames, double fieldLength, double fieldDepth, double standoff) {
+  const double u = frames > 1 ? static_cast<double>(frame) / (frames - 1) : 0.0;
+  const glm::dvec3 eye(-0.2 * fieldLength + 1.4 * fieldLength * u, 1.5, standoff);
+  const glm::dvec3 target(0.5 * fieldLength, 0.0, -0.5 * fieldDepth);
+  return {eye, target};
+}
+
 bool inFrustum(const glm::dmat4& viewProjection, const Instance& inst) {
   // Conservative: the sphere against the six clip planes.
   const glm::dmat4 m = glm::transpose(viewProjection);
@@ -147,7 +161,8 @@ Holes countHoles(const RgbaImage& full, const RgbaImage& other, double tolerance
 
 int main(int argc, char** argv) {
   CLI::App app{"hybrid fly-through: units vs triangles only and coverage per frame"};
-  double kappa = 3.0, tau = 1.0, pixels = 3.0;
+  double kappa = 3.0, tau = 1.0, pixels = 3.0, standoff = 6.0;
+  std::string path = "diagonal";
   int frames = 60, instances = 70, parts = 300;
   std::string backendName = "egl", size = "640x480";
   app.add_option("--kappa", kappa, "point rate / triangle rate of the hybrid graph");
@@ -155,14 +170,18 @@ int main(int argc, char** argv) {
   app.add_option("--pixels", pixels, "screen-space tolerance");
   app.add_option("--frames", frames, "poses along the path");
   app.add_option("--instances", instances, "instances of the model");
-  app.add_option("--parts", parts, "parts of the generated model (generateScatteredParts(N, 2, 7))");
+  app.add_option("--parts", parts,
+                 "parts of the generated model (generateScatteredParts(N, 2, 7))");
+  app.add_option("--path", path, "diagonal (into the field, the default) or front (along it)");
+  app.add_option("--standoff", standoff, "--path front: distance in front of the first row");
   app.add_option("--backend", backendName, "egl or osmesa");
   app.add_option("--size", size, "frame size WxH");
   CLI11_PARSE(app, argc, argv);
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
-      width > 4096 || height > 4096 || frames < 1 || instances < 1 || parts < 1 ||
-      !(kappa > 1.0) || !(tau > 0.0) || !(pixels > 0.0)) {
+      width > 4096 || height > 4096 || frames < 1 || instances < 1 || parts < 1 || !(kappa > 1.0) ||
+      !(tau > 0.0) || !(pixels > 0.0) || (path != "diagonal" && path != "front") ||
+      !(standoff > 0.0)) {
     std::cerr << "bench_hybrid_flythrough: bad options\n";
     return 2;
   }
@@ -218,28 +237,42 @@ int main(int argc, char** argv) {
   const double fovY = 60.0 * 3.14159265358979 / 180.0;
   const double pixelsPerRadian = height / (2.0 * std::tan(fovY / 2.0));
 
-  std::printf("### Fly-through: %d instances of scattered-%d (%zu triangles each), %d frames, "
-              "%dx%d, fov 60 deg, %.3g-pixel tolerance, kappa %.3g, tau %.3g\n\n",
-              instances, parts, model.triangleCount(), frames, width, height, pixels, kappa, tau);
+  std::printf(
+      "### Fly-through: %d instances of scattered-%d (%zu triangles each), %d frames, "
+      "%dx%d, fov 60 deg, %.3g-pixel tolerance, kappa %.3g, tau %.3g, path %s",
+      instances, parts, model.triangleCount(), frames, width, height, pixels, kappa, tau,
+      path.c_str());
+  if (path == "front") std::printf(" (standoff %.3g)", standoff);
+  std::printf("\n\n");
   // (Build times: bench_hybrid.)
-  std::printf("Graphs: hybrid %zu triangles, %zu points; triangles only %zu triangles; renderer: "
-              "%s %s\n\n",
-              hybrid->stats().graphTriangles, hybrid->stats().graphPoints,
-              trianglesOnly->stats().graphTriangles, backendName.c_str(),
-              gl.context->rendererName().c_str());
-  std::printf("| frame | in view | triangles-only units | hybrid triangles | hybrid points | "
-              "hybrid units | reduction | full-res pixels | uncovered hybrid / tri-only | "
-              "hybrid coverage %% | holes beyond tolerance hybrid / tri-only |\n");
+  std::printf(
+      "Graphs: hybrid %zu triangles, %zu points; triangles only %zu triangles; renderer: "
+      "%s %s\n\n",
+      hybrid->stats().graphTriangles, hybrid->stats().graphPoints,
+      trianglesOnly->stats().graphTriangles, backendName.c_str(),
+      gl.context->rendererName().c_str());
+  std::printf(
+      "| frame | in view | triangles-only units | hybrid triangles | hybrid points | "
+      "hybrid units | reduction | full-res pixels | uncovered hybrid / tri-only | "
+      "hybrid coverage %% | holes beyond tolerance hybrid / tri-only |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
 
   HybridCut hybridCut(*hybrid);
   HybridCut triangleCut(*trianglesOnly);
   std::vector<double> reductions;
+  // Units by the instance's distance from the eye (centre), summed over every
+  // frame: does the reduction depend on distance, and which instances hold
+  // the units? Bins [0, 2), [2, 4), [4, 8), [8, 16), [16, inf).
+  constexpr int kBins = 5;
+  const double binEdges[kBins + 1] = {0.0, 2.0, 4.0, 8.0, 16.0, 1e300};
+  double binTriangleUnits[kBins] = {}, binHybridUnits[kBins] = {};
+  std::size_t binInstances[kBins] = {};
   double minCoverage = 1.0;
   std::size_t totalHoles = 0, totalTriangleHoles = 0, totalUncovered = 0,
               totalTriangleUncovered = 0, totalFull = 0;
   for (int f = 0; f < frames; ++f) {
-    const Pose pose = poseAt(f, frames, fieldLength, fieldDepth);
+    const Pose pose = path == "front" ? frontPoseAt(f, frames, fieldLength, fieldDepth, standoff)
+                                      : poseAt(f, frames, fieldLength, fieldDepth);
     render::Camera camera;
     camera.view = glm::lookAt(glm::vec3(pose.eye), glm::vec3(pose.target), glm::vec3(0, 1, 0));
     camera.projection = glm::perspective(static_cast<float>(fovY),
@@ -264,6 +297,14 @@ int main(int argc, char** argv) {
       hybridCut.adaptToScreen(view, pixels);
       triangleUnits += triangleCut.units();
       hybridUnits += hybridCut.units();
+      {
+        const double distance = glm::length(inst.centre - pose.eye);
+        int bin = 0;
+        while (bin + 1 < kBins && distance >= binEdges[bin + 1]) ++bin;
+        binTriangleUnits[bin] += triangleCut.units();
+        binHybridUnits[bin] += hybridCut.units();
+        ++binInstances[bin];
+      }
       hybridTriangles += hybridCut.triangleCount();
       hybridPoints += hybridCut.pointCount();
       fullItems.push_back(render::DrawItem{*fullHandle, glm::mat4(inst.model), white});
@@ -291,9 +332,10 @@ int main(int argc, char** argv) {
     // Full-resolution mask, then the hybrid frame.
     RgbaImage full, cut;
     const glm::vec4 black(0.0f, 0.0f, 0.0f, 1.0f);
-    bool ok = gl.meshes->beginFrame(*gl.target, black).ok() &&
-              gl.meshes->draw(fullItems.data(), fullItems.size(), camera, render::Lighting()).ok() &&
-              gl.target->readColor(full).ok();
+    bool ok =
+        gl.meshes->beginFrame(*gl.target, black).ok() &&
+        gl.meshes->draw(fullItems.data(), fullItems.size(), camera, render::Lighting()).ok() &&
+        gl.target->readColor(full).ok();
     ok = ok && gl.meshes->beginFrame(*gl.target, black).ok() &&
          gl.meshes->draw(cutItems.data(), cutItems.size(), camera, render::Lighting()).ok();
     render::DiscHandle discHandle;
@@ -333,10 +375,11 @@ int main(int argc, char** argv) {
     totalUncovered += hybridHoles.uncovered;
     totalTriangleUncovered += triangleHoles.uncovered;
     totalFull += fullPixels;
-    std::printf("| %d | %zu | %.0f | %zu | %zu | %.1f | %.2f | %zu | %zu / %zu | %.3f | %zu / %zu |\n",
-                f, inView, triangleUnits, hybridTriangles, hybridPoints, hybridUnits, reduction,
-                fullPixels, hybridHoles.uncovered, triangleHoles.uncovered, 100.0 * coverage,
-                hybridHoles.beyondTolerance, triangleHoles.beyondTolerance);
+    std::printf(
+        "| %d | %zu | %.0f | %zu | %zu | %.1f | %.2f | %zu | %zu / %zu | %.3f | %zu / %zu |\n", f,
+        inView, triangleUnits, hybridTriangles, hybridPoints, hybridUnits, reduction, fullPixels,
+        hybridHoles.uncovered, triangleHoles.uncovered, 100.0 * coverage,
+        hybridHoles.beyondTolerance, triangleHoles.beyondTolerance);
     std::fflush(stdout);
   }
   gl.meshes->deleteMesh(*fullHandle);
@@ -346,17 +389,37 @@ int main(int argc, char** argv) {
   }
   double sum = 0.0;
   for (double r : reductions) sum += r;
-  std::printf("\nSummary: reduction (triangles-only units / hybrid units) mean %.2fx, min %.2fx, "
-              "max %.2fx over %zu frames with instances in view; hybrid coverage of the "
-              "full-resolution mask min %.3f %% (a frame), overall %.3f %% (triangles only "
-              "%.3f %%); holes beyond the %.3g-pixel tolerance: hybrid %zu, triangles only %zu "
-              "of %zu full-resolution pixels\n",
-              sum / reductions.size(), *std::min_element(reductions.begin(), reductions.end()),
-              *std::max_element(reductions.begin(), reductions.end()), reductions.size(),
-              100.0 * minCoverage,
-              totalFull > 0 ? 100.0 * (1.0 - double(totalUncovered) / double(totalFull)) : 100.0,
-              totalFull > 0 ? 100.0 * (1.0 - double(totalTriangleUncovered) / double(totalFull))
-                            : 100.0,
-              pixels, totalHoles, totalTriangleHoles, totalFull);
+  std::printf(
+      "\nSummary: reduction (triangles-only units / hybrid units) mean %.2fx, min %.2fx, "
+      "max %.2fx over %zu frames with instances in view; hybrid coverage of the "
+      "full-resolution mask min %.3f %% (a frame), overall %.3f %% (triangles only "
+      "%.3f %%); holes beyond the %.3g-pixel tolerance: hybrid %zu, triangles only %zu "
+      "of %zu full-resolution pixels\n",
+      sum / reductions.size(), *std::min_element(reductions.begin(), reductions.end()),
+      *std::max_element(reductions.begin(), reductions.end()), reductions.size(),
+      100.0 * minCoverage,
+      totalFull > 0 ? 100.0 * (1.0 - double(totalUncovered) / double(totalFull)) : 100.0,
+      totalFull > 0 ? 100.0 * (1.0 - double(totalTriangleUncovered) / double(totalFull)) : 100.0,
+      pixels, totalHoles, totalTriangleHoles, totalFull);
+  double allTriangleUnits = 0.0, allHybridUnits = 0.0;
+  for (int b = 0; b < kBins; ++b) {
+    allTriangleUnits += binTriangleUnits[b];
+    allHybridUnits += binHybridUnits[b];
+  }
+  std::printf(
+      "\nUnits by the instance's distance from the eye, summed over the frames (instances "
+      "in view):\n\n| distance | instance-frames | triangles-only units | share | hybrid "
+      "units | reduction |\n|---|---|---|---|---|---|\n");
+  for (int b = 0; b < kBins; ++b) {
+    if (binInstances[b] == 0) continue;
+    const std::string range = b + 1 < kBins ? std::to_string(int(binEdges[b])) + "-" +
+                                                  std::to_string(int(binEdges[b + 1]))
+                                            : ">= " + std::to_string(int(binEdges[b]));
+    std::printf("| %s | %zu | %.0f | %.1f %% | %.1f | %.2fx |\n", range.c_str(), binInstances[b],
+                binTriangleUnits[b], 100.0 * binTriangleUnits[b] / allTriangleUnits,
+                binHybridUnits[b], binTriangleUnits[b] / binHybridUnits[b]);
+  }
+  std::printf("| all | | %.0f | 100 %% | %.1f | %.2fx |\n", allTriangleUnits, allHybridUnits,
+              allTriangleUnits / allHybridUnits);
   return 0;
 }
