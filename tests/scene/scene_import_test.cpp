@@ -330,6 +330,53 @@ TEST(SceneImport, PackageInvalidFilesAreRefusedCleanly) {
 // Fuzz finding 34: "fox ..." passed the OBJ pre-check (a statement it has no
 // use for) and Assimp took it for a face and read past its buffer. Only
 // v vt vn f o g s mtllib usemtl (and comments) reach Assimp.
+// Fuzz finding 40: Assimp's FBX parser leaked a scope's elements when it
+// threw inside it. ASCII FBX is parsed by the pre-check's replay of
+// Assimp's tokenizer and grammar first; what it would throw on is refused.
+TEST(SceneImport, AsciiFbxThatAssimpsParserWouldThrowOnIsRefusedBeforeIt) {
+  const std::string dir = testing::TempDir() + "/fbx-precheck-" + std::to_string(::getpid());
+  fs::create_directories(dir);
+  const std::string path = dir + "/model.fbx";
+  auto import = [&](const std::string& text) {
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
+    return importScene(path);
+  };
+  std::ifstream in("/usr/share/assimp/models/FBX/cubes_with_names.fbx", std::ios::binary);
+  const std::string cubes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(cubes.empty()) << "deploy/setup installs the Debian package assimp-testmodels";
+  ASSERT_TRUE(import(cubes).ok()) << "the package file loads";
+  const std::size_t scope = cubes.find("Objects:  {");
+  ASSERT_NE(scope, std::string::npos);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {std::string("\x04\x0b:\x0b\x0b:\x0b", 7), "unexpected end of file"},  // the finding
+      {cubes.substr(0, scope + 4000), "unexpected end of file"},             // cut in a scope
+      {"A: 1 2 3\n", "expected a bracket, comma or key"},  // data after data on its line
+      {"A: {\n 1: 2\n}\n}", ""},  // a stray closing bracket ends the document (accepted)
+      {"A: :\n", "unexpected colon"},
+      {"A: \"open\n", "unexpected end of file"},  // an unclosed quote drops the token
+      {std::string("A: 1\0B: 2\n", 10), "NUL byte"},
+      {std::string(300, '{'), "unexpected token, expected a key"},
+      {[] {
+         std::string deep;
+         for (int i = 0; i < 5000; ++i) deep += "A: {\n";
+         return deep;
+       }(),
+       "nested deeper than"}};
+  for (const auto& [text, why] : cases) {
+    const Result<Scene> r = import(text);
+    if (why.empty()) {
+      // Past the pre-check: Assimp's own verdict.
+      EXPECT_NE(r.status().message().find("FBX import failed"), std::string::npos)
+          << r.status().toString();
+      continue;
+    }
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << why;
+    EXPECT_NE(r.status().message().find(why), std::string::npos)
+        << why << ": " << r.status().toString();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(SceneImport, ObjStatementsOutsideTheReadListAreRefusedBeforeAssimp) {
   std::ifstream in(dataPath("colored_quad.obj"));
   const std::string quad((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -639,9 +639,9 @@ Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
     std::optional<GltfDeclared> declared;
     const std::string ext = lowerExtension(path);
     // The formats with a pre-check of ours are read once here; the others
-    // (.fbx, .x) reach Assimp through BoundedIOSystem's byte limits only.
+    // (.x, binary .fbx) reach Assimp through BoundedIOSystem's byte limits only.
     const bool prechecked = ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".obj" ||
-                            ext == ".smd";
+                            ext == ".smd" || ext == ".fbx";
     std::string bytes;
     if (prechecked) {
       Result<std::string> read = readFileBounded(path, size);
@@ -669,6 +669,8 @@ Result<T> readThroughAssimp(const std::string& path, const ImportLimits& limits,
       THINLOD_RETURN_IF_ERROR(detail::checkObjStatementsForAssimp(path, bytes));
     } else if (ext == ".smd") {
       THINLOD_RETURN_IF_ERROR(detail::precheckSmd(path, bytes));
+    } else if (ext == ".fbx") {
+      THINLOD_RETURN_IF_ERROR(detail::precheckFbx(path, bytes, limits));
     }
     Assimp::Importer importer;  // Assimp's DefaultLogger stays the null logger
     auto* io = new BoundedIOSystem(limits);

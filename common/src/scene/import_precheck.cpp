@@ -605,6 +605,181 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
   return Status();
 }
 
+namespace {
+
+// The token kinds of Assimp's FBX ASCII tokenizer.
+enum class FbxToken : std::uint8_t { kOpen, kClose, kData, kComma, kKey };
+
+struct FbxTok {
+  FbxToken type;
+  std::size_t line;
+};
+
+bool fbxLineEnd(char c) { return c == '\r' || c == '\n' || c == '\0' || c == '\f'; }
+bool fbxSpaceOrNewLine(char c) { return c == ' ' || c == '\t' || fbxLineEnd(c); }
+
+// Assimp's parser over the tokens (Scope / Element), without building
+// anything: returns the first error it would throw, or an empty string.
+class FbxGrammar {
+ public:
+  FbxGrammar(const std::vector<FbxTok>& tokens, std::size_t maxDepth)
+      : tokens_(tokens), maxDepth_(maxDepth) {}
+
+  std::string parse() { return scope(true, 0); }
+
+ private:
+  const FbxTok* advance() {
+    current_ = next_ < tokens_.size() ? &tokens_[next_++] : nullptr;
+    return current_;
+  }
+
+  std::string scope(bool topLevel, std::size_t depth) {
+    if (depth > maxDepth_) return "scopes nested deeper than " + std::to_string(maxDepth_);
+    const FbxTok* n = advance();
+    if (n == nullptr) return "unexpected end of file";
+    while (n->type != FbxToken::kClose) {
+      if (n->type != FbxToken::kKey) return "unexpected token, expected a key";
+      if (std::string error = element(depth); !error.empty()) return error;
+      n = current_;
+      if (n == nullptr) return topLevel ? std::string() : "unexpected end of file";
+    }
+    return std::string();
+  }
+
+  std::string element(std::size_t depth) {
+    const FbxTok* n = nullptr;
+    do {
+      n = advance();
+      if (n == nullptr) return "unexpected end of file, expected a closing bracket";
+      if (n->type == FbxToken::kData) {
+        const FbxTok* previous = n;
+        n = advance();
+        if (n == nullptr) return "unexpected end of file, expected a bracket, comma or key";
+        // Assimp accepts a missing comma before data on the next line.
+        if (n->type == FbxToken::kData && n->line == previous->line + 1) continue;
+        if (n->type == FbxToken::kData) return "unexpected token; expected a bracket, comma or key";
+      }
+      if (n->type == FbxToken::kOpen) {
+        if (std::string error = scope(false, depth + 1); !error.empty()) return error;
+        advance();  // past the closing bracket the scope ended on
+        return std::string();
+      }
+    } while (n->type != FbxToken::kKey && n->type != FbxToken::kClose);
+    return std::string();
+  }
+
+  const std::vector<FbxTok>& tokens_;
+  std::size_t maxDepth_;
+  std::size_t next_ = 0;
+  const FbxTok* current_ = nullptr;
+};
+
+}  // namespace
+
+Status precheckFbx(const std::string& path, std::string_view bytes, const ImportLimits& limits) {
+  if (bytes.substr(0, 18) == "Kaydara FBX Binary") return Status();
+  auto refuse = [&path](std::size_t line, const std::string& why) {
+    return Status(ErrorCode::kParseError,
+                  path + ": FBX line " + std::to_string(line) + ": " + why);
+  };
+  if (bytes.find('\0') != std::string_view::npos) return refuse(1, "a NUL byte");
+  // The tokenizer, as Assimp's (its peek for a key after whitespace never
+  // matches, so a token before spaces and a colon is data; a token left
+  // unterminated at the end of the file is dropped; '\r' and '\n' each
+  // count a line).
+  std::vector<FbxTok> tokens;
+  std::size_t line = 1;
+  bool comment = false;
+  bool inQuotes = false;
+  bool pending = false;
+  bool hasBegin = false;  // a token has started (Assimp: token_begin != nullptr)
+  std::size_t begin = 0;
+  std::size_t end = 0;
+  auto dataToken = [&](FbxToken type, bool mustHaveToken) -> std::string {
+    if (hasBegin) {
+      bool quoted = false;
+      for (std::size_t k = begin; k <= end; ++k) {
+        if (bytes[k] == '"') quoted = !quoted;
+        if (!quoted && fbxSpaceOrNewLine(bytes[k])) return "unexpected whitespace in a token";
+      }
+      if (quoted) return "a double quote is not closed";
+      tokens.push_back({type, line});
+    } else if (mustHaveToken) {
+      return "unexpected character, expected a data token";
+    }
+    hasBegin = false;
+    return std::string();
+  };
+  for (std::size_t at = 0; at < bytes.size(); ++at) {
+    const char c = bytes[at];
+    if (fbxLineEnd(c)) {
+      comment = false;
+      ++line;
+    }
+    if (comment) continue;
+    std::string error;
+    if (inQuotes) {
+      if (c == '"') {
+        inQuotes = false;
+        end = at;
+        error = dataToken(FbxToken::kData, false);
+        pending = false;
+      }
+      if (!error.empty()) return refuse(line, error);
+      continue;
+    }
+    bool handled = true;
+    switch (c) {
+      case '"':
+        if (hasBegin) return refuse(line, "unexpected double quote");
+        hasBegin = true;
+        begin = at;
+        inQuotes = true;
+        break;
+      case ';':
+        error = dataToken(FbxToken::kData, false);
+        comment = true;
+        break;
+      case '{':
+      case '}':
+        error = dataToken(FbxToken::kData, false);
+        tokens.push_back({c == '{' ? FbxToken::kOpen : FbxToken::kClose, line});
+        break;
+      case ',':
+        if (pending) error = dataToken(FbxToken::kData, true);
+        tokens.push_back({FbxToken::kComma, line});
+        break;
+      case ':':
+        if (!pending) return refuse(line, "unexpected colon");
+        error = dataToken(FbxToken::kKey, true);
+        break;
+      default:
+        handled = false;
+    }
+    if (!error.empty()) return refuse(line, error);
+    if (handled) continue;
+    if (fbxSpaceOrNewLine(c)) {
+      if (hasBegin) error = dataToken(FbxToken::kData, false);
+      if (!error.empty()) return refuse(line, error);
+      pending = false;
+    } else {
+      end = at;
+      if (!hasBegin) {
+        hasBegin = true;
+        begin = at;
+      }
+      pending = true;
+    }
+    if (tokens.size() > limits.maxFileBytes) return refuse(line, "too many tokens");
+  }
+  const std::size_t maxDepth = static_cast<std::size_t>(std::max(limits.maxDepth, 0)) + 64;
+  FbxGrammar grammar(tokens, maxDepth);
+  if (std::string error = grammar.parse(); !error.empty()) {
+    return Status(ErrorCode::kParseError, path + ": FBX: " + error);
+  }
+  return Status();
+}
+
 Status checkObjStatementsForAssimp(const std::string& path, std::string_view text) {
   if (text.find('\0') != std::string_view::npos) {
     return Status(ErrorCode::kParseError, path + ": a NUL byte in an OBJ file");

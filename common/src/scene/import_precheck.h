@@ -51,6 +51,16 @@ Status precheckCollada(const std::string& path, std::string_view xml, const Impo
 // material line and three vertex lines.
 Status precheckSmd(const std::string& path, std::string_view bytes);
 
+// FBX (ASCII; a binary file, "Kaydara FBX Binary", passes untouched):
+// Assimp's FBX parser leaked the elements of a scope when it threw inside
+// it (fuzz finding 40: the 7 bytes "\x04\x0b:\x0b\x0b:\x0b" as .fbx).
+// The tokenizer and the parser's grammar are replayed here as Assimp 5.2
+// runs them (FBXTokenizer.cpp, FBXParser.cpp): every input Assimp's parser
+// would throw on is refused, and so are a NUL byte (Assimp's tokenizer
+// stops at it) and scopes nested deeper than limits.maxDepth + 64 (its
+// parser recurses).
+Status precheckFbx(const std::string& path, std::string_view bytes, const ImportLimits& limits);
+
 // OBJ on the route to Assimp (after the mesh loader's OBJ pre-check): every
 // line is blank, a comment or one of v vt vn f o g s mtllib usemtl, and
 // there is no NUL byte. Assimp dispatches on a line's first characters, so
