@@ -56,6 +56,24 @@ TEST(AccuracyCurve, FromTriplesStoresValueAtSegmentStart) {
   EXPECT_EQ(c.maxAccuracy(), 10.0);
 }
 
+// Resources mapped affinely (triangles -> link bytes): every value and slope
+// mapped, the domain unchanged, monotone; scale 0 gives a constant curve.
+TEST(AccuracyCurve, AffineResourcesMapsValuesAndSlopesOnTheSameDomain) {
+  const AccuracyCurve c = twoPartCurve();
+  const AccuracyCurve bytes = c.affineResources(100.0, 3.0);
+  ASSERT_EQ(bytes.segments().size(), 2u);
+  expectSegment(bytes.segments()[0], 0, 130, 6);
+  expectSegment(bytes.segments()[1], 5, 190, 3);
+  EXPECT_EQ(bytes.maxAccuracy(), c.maxAccuracy());
+  for (const double a : {0.0, 2.5, 5.0, 7.5, 10.0}) {
+    EXPECT_DOUBLE_EQ(bytes.resourcesFor(a), 100.0 + 3.0 * c.resourcesFor(a)) << a;
+  }
+  const AccuracyCurve flat = c.affineResources(7.0, 0.0);
+  EXPECT_DOUBLE_EQ(flat.resourcesFor(0.0), 7.0);
+  EXPECT_DOUBLE_EQ(flat.resourcesFor(10.0), 7.0);
+  EXPECT_TRUE(AccuracyCurve().affineResources(1.0, 2.0).empty());
+}
+
 TEST(AccuracyCurve, TriplesRoundTrip) {
   const std::vector<CurveTriple> t = twoPartCurve().triples();
   ASSERT_EQ(t.size(), 2u);

@@ -32,17 +32,6 @@ std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
   return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
 }
 
-AccuracyCurve affine(const AccuracyCurve& curve, double offset, double scale) {
-  std::vector<CurveSegment> segments = curve.segments();
-  for (CurveSegment& s : segments) {
-    s.value = offset + scale * s.value;
-    s.slope *= scale;
-  }
-  Result<AccuracyCurve> mapped =
-      AccuracyCurve::fromSegments(std::move(segments), curve.maxAccuracy());
-  return mapped.ok() ? std::move(mapped).value() : curve;
-}
-
 }  // namespace
 
 double terrainHeight(double x, double y, double side) {
@@ -114,7 +103,7 @@ Result<SchedulingScene> regionScene(const std::vector<RegionLeaf>& leaves) {
     backbone::RepresentationOption option;
     option.kind = backbone::OptionKind::kSimplifiedMesh;
     option.relativeTriangles = leaves[r].curves.triangles;
-    option.relativeLinkBytes = affine(option.relativeTriangles, kBytesOverhead, kBytesPerTriangle);
+    option.relativeLinkBytes = option.relativeTriangles.affineResources(kBytesOverhead, kBytesPerTriangle);
     SceneObject object;
     object.firstOption = static_cast<std::uint32_t>(scene.options.size());
     object.optionCount = 1;

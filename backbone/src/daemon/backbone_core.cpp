@@ -67,18 +67,6 @@ double payloadBytes(const protocol::Representation& rep) {
   return static_cast<double>(rep.mesh.size() + rep.texture.data.size()) + kOperationOverheadBytes;
 }
 
-// r(a) -> offset + scale * r(a) on the same accuracy domain.
-AccuracyCurve affineResources(const AccuracyCurve& curve, double offset, double scale) {
-  std::vector<CurveSegment> segments = curve.segments();
-  for (CurveSegment& s : segments) {
-    s.value = offset + scale * s.value;
-    s.slope *= scale;
-  }
-  Result<AccuracyCurve> mapped =
-      AccuracyCurve::fromSegments(std::move(segments), curve.maxAccuracy());
-  return mapped.ok() ? std::move(mapped).value() : curve;
-}
-
 std::string idText(std::uint64_t id) { return std::to_string(id); }
 
 backbone::SchedulerOptions schedulerOptions(const CoreOptions& o) {
@@ -486,7 +474,7 @@ void BackboneCore::rebuildCurves(std::uint32_t index) {
                                    ? state.baseTriangles
                                    : state.baseTriangles.scaledAccuracy(state.calibration);
     option.relativeLinkBytes =
-        affineResources(option.relativeTriangles, kOperationOverheadBytes + kMeshFrameOverheadBytes,
+        option.relativeTriangles.affineResources(kOperationOverheadBytes + kMeshFrameOverheadBytes,
                         meshBytesPerTriangle_[state.object]);
   } else {
     const double accuracy = state.textureAccuracy * state.parallaxFactor;

@@ -707,6 +707,18 @@ std::optional<double> AccuracyCurve::maxAccuracyWithin(double budget) const {
   return fromOrderedKey(lo);
 }
 
+AccuracyCurve AccuracyCurve::affineResources(double offset, double scale) const {
+  assert(std::isfinite(offset) && std::isfinite(scale) && scale >= 0.0 &&
+         "AccuracyCurve::affineResources: offset finite, scale finite and >= 0");
+  std::vector<CurveSegment> mapped = segments_;
+  for (CurveSegment& s : mapped) {
+    s.value = offset + scale * s.value;
+    s.slope *= scale;
+  }
+  Result<AccuracyCurve> out = fromSegments(std::move(mapped), maxAccuracy_);
+  return out.ok() ? std::move(out).value() : *this;
+}
+
 AccuracyCurve AccuracyCurve::scaledAccuracy(double factor) const {
   assert(std::isfinite(factor) && factor > 0.0 &&
          "AccuracyCurve::scaledAccuracy: factor must be finite and > 0");

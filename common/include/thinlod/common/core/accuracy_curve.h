@@ -90,6 +90,13 @@ class AccuracyCurve {
   // rescaling of a child into its group: factor = groupDiameter / childDiameter.
   AccuracyCurve scaledAccuracy(double factor) const;
 
+  // Maps the resource axis: new r(a) = offset + scale * r(a) on the same
+  // accuracy domain (triangles -> link bytes: offset = a frame's overhead,
+  // scale = bytes per triangle). offset finite, scale finite and >= 0 (the
+  // curve stays monotone). A result that overflows a double is refused by
+  // fromSegments; then the curve is returned unchanged.
+  AccuracyCurve affineResources(double offset, double scale) const;
+
   // Group node: r(a) = sum of children's resourcesForClamped(a), on the union
   // of the children's domains (horizontal extension both sides).
   // O(total knots * log children); values carry O(log children) roundings.
