@@ -203,6 +203,44 @@ TEST_P(SkinnedFrontendTest, ReferenceDrawsTheSkinnedFullMeshAtItsPose) {
             ErrorCode::kInvalidArgument);
 }
 
+// Poses extrapolated to the frame's time: the frame drawn at a time past the
+// newest pose is the frame drawn with extrapolateBonePose's matrices.
+TEST_P(SkinnedFrontendTest, DrawsTheExtrapolatedPoseAtALaterFrameTime) {
+  const anim::testing::ArticulatedFigure f = figure();
+  SceneBatch first;
+  first.plan = 1;
+  first.operations = {skinnedOp(1, f, kPlace)};
+  first.bonePoses = {{1, poseAt(f, 0.4)}};
+  first.poseTimeS = 0.4;
+  ASSERT_TRUE(renderer_->submit(std::move(first)).ok());
+  SceneBatch second;
+  second.plan = 2;
+  second.bonePoses = {{1, poseAt(f, 0.5)}};
+  second.poseTimeS = 0.5;
+  ASSERT_TRUE(renderer_->submit(std::move(second)).ok());
+
+  RgbaImage ahead;
+  auto report = renderer_->renderFrame(orthoCamera(), flatLighting(), ahead, 0.6);
+  ASSERT_TRUE(report.ok()) << report.status().toString();
+  EXPECT_EQ(report->skinnedObjects, 1u);
+  EXPECT_EQ(report->extrapolatedPoses, 1u);
+  RgbaImage newest;
+  report = renderer_->renderFrame(orthoCamera(), flatLighting(), newest, 0.5);
+  ASSERT_TRUE(report.ok()) << report.status().toString();
+  EXPECT_EQ(report->extrapolatedPoses, 0u) << "the frame of the newest pose's own time";
+  EXPECT_GT(differing(ahead, newest), 0);
+
+  BoneMatrices expected;
+  ASSERT_TRUE(extrapolateBonePose(poseAt(f, 0.4), 0.4, poseAt(f, 0.5), 0.5, 0.6, expected));
+  // Drawn as they are (an unknown pose time is never extrapolated).
+  submit(3, {}, {{1, expected}});
+  RgbaImage direct;
+  report = renderer_->renderFrame(orthoCamera(), flatLighting(), direct, 0.6);
+  ASSERT_TRUE(report.ok()) << report.status().toString();
+  EXPECT_EQ(report->extrapolatedPoses, 0u);
+  EXPECT_EQ(differing(ahead, direct), 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, SkinnedFrontendTest,
                          ::testing::Values(Backend::kEgl, Backend::kOsMesa), backendParamName);
 
@@ -252,6 +290,116 @@ TEST(FrontendSceneSkinned, BadSkinsAndPosesRefuseTheBatch) {
   many.bonePoses = {{1, BoneMatrices(kMaxBonesPerPose + 1, glm::mat4(1.0f))}};
   EXPECT_TRUE(refused(many));
   EXPECT_EQ(scene.pendingBatches(), 0u);
+}
+
+glm::mat4 shifted(float x) { return glm::translate(glm::mat4(1.0f), glm::vec3(x, 0.0f, 0.0f)); }
+
+// Enqueues a batch, uploads everything and commits it.
+void apply(FrontendScene& scene, std::vector<SceneOperation> ops,
+           std::vector<std::pair<ObjectId, BoneMatrices>> poses, double poseTimeS) {
+  SceneBatch batch;
+  batch.operations = std::move(ops);
+  batch.bonePoses = std::move(poses);
+  batch.poseTimeS = poseTimeS;
+  ASSERT_TRUE(scene.enqueue(std::move(batch)).ok());
+  for (const PendingUpload& upload : scene.planUploads(1 << 30))
+    ASSERT_TRUE(scene.markUploaded(upload.key).ok());
+  scene.commitReady();
+}
+
+// The x translation of bone 1 drawn at `t` (bone 0 stays the identity).
+float drawnX(const FrontendScene& scene, double t) {
+  BoneMatrices scratch;
+  const BoneMatrices* pose = scene.bonePoseAt(1, t, scratch);
+  EXPECT_NE(pose, nullptr);
+  if (pose == nullptr) return std::nanf("");
+  EXPECT_EQ((*pose)[0], glm::mat4(1.0f));
+  return (*pose)[1][3][0];
+}
+
+TEST(FrontendScenePoseExtrapolation, LinearPastTheNewestPoseWithinTwoSpacings) {
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  apply(scene, {skinnedOp(1, f, glm::mat4(1.0f))}, {{1, {glm::mat4(1.0f), shifted(0.0f)}}}, 1.0);
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.05), 0.0f) << "a single pose is never extrapolated";
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(1.0f)}}}, 1.1);
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.05), 1.0f) << "between the two poses: the newest";
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.1), 1.0f) << "at the newest pose's time: itself";
+  EXPECT_FLOAT_EQ(drawnX(scene, 0.9), 1.0f) << "before both: the newest";
+  EXPECT_NEAR(drawnX(scene, 1.15), 1.5f, 1e-4f);
+  EXPECT_NEAR(drawnX(scene, 1.2), 2.0f, 1e-4f);
+  EXPECT_NEAR(drawnX(scene, 1.299), 2.99f, 1e-3f) << "just within two spacings";
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.31), 1.0f) << "further than two spacings: the newest";
+  EXPECT_FLOAT_EQ(drawnX(scene, std::nan("")), 1.0f) << "no frame time: the newest";
+  EXPECT_EQ(*scene.bonePose(1), (BoneMatrices{glm::mat4(1.0f), shifted(1.0f)}))
+      << "bonePose stays the newest as received";
+  // The next pose pushes the oldest out: the two newest define the line.
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(1.5f)}}}, 1.2);
+  EXPECT_NEAR(drawnX(scene, 1.3), 2.0f, 1e-4f);
+  // Elements, not positions: a rotation is extrapolated element by element.
+  const glm::mat4 turn0 = glm::rotate(glm::mat4(1.0f), 0.0f, glm::vec3(0, 0, 1));
+  const glm::mat4 turn1 = glm::rotate(glm::mat4(1.0f), 0.2f, glm::vec3(0, 0, 1));
+  BoneMatrices out;
+  ASSERT_TRUE(extrapolateBonePose({turn0}, 0.0, {turn1}, 0.1, 0.2, out));
+  ASSERT_EQ(out.size(), 1u);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(out[0][c][r], 2 * turn1[c][r] - turn0[c][r], 1e-6f);
+}
+
+TEST(FrontendScenePoseExtrapolation, NotFromPosesTooFarApartUnknownOrMismatched) {
+  const BoneMatrices a{shifted(0.0f)};
+  const BoneMatrices b{shifted(1.0f)};
+  BoneMatrices out{shifted(7.0f)};
+  EXPECT_TRUE(extrapolateBonePose(a, 0.0, b, 0.5, 0.6, out)) << "0.5 s apart is allowed";
+  EXPECT_NEAR(out[0][3][0], 1.2f, 1e-5f);
+  out = {shifted(7.0f)};
+  EXPECT_FALSE(extrapolateBonePose(a, 0.0, b, 0.51, 0.6, out)) << "over 0.5 s apart";
+  EXPECT_FALSE(extrapolateBonePose(a, 0.5, b, 0.5, 0.6, out)) << "same pose time";
+  EXPECT_FALSE(extrapolateBonePose(a, 0.6, b, 0.5, 0.7, out)) << "older newest";
+  EXPECT_FALSE(extrapolateBonePose(a, std::nan(""), b, 0.5, 0.6, out));
+  EXPECT_FALSE(extrapolateBonePose(a, 0.4, b, std::nan(""), 0.6, out));
+  EXPECT_FALSE(extrapolateBonePose(a, 0.4, b, 0.5, std::nan(""), out));
+  EXPECT_FALSE(extrapolateBonePose({}, 0.4, b, 0.5, 0.6, out)) << "different bone counts";
+  EXPECT_FALSE(extrapolateBonePose(a, 0.4, b, 0.5, 0.5, out)) << "not ahead";
+  EXPECT_FALSE(extrapolateBonePose(a, 0.4, b, 0.5, 0.7000001, out)) << "past two spacings";
+  EXPECT_EQ(out, BoneMatrices{shifted(7.0f)}) << "untouched when refused";
+
+  // In the scene: poses of unknown time (a batch without poseTimeS) are drawn as they are.
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  apply(scene, {skinnedOp(1, f, glm::mat4(1.0f))}, {{1, {glm::mat4(1.0f), shifted(0.0f)}}},
+        std::nan(""));
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(1.0f)}}}, std::nan(""));
+  EXPECT_FLOAT_EQ(drawnX(scene, 5.0), 1.0f);
+  // A second answer for the newest pose's time replaces it and keeps the one before.
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(2.0f)}}}, 1.0);
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(3.0f)}}}, 1.1);
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(4.0f)}}}, 1.1);
+  EXPECT_NEAR(drawnX(scene, 1.2), 6.0f, 1e-4f);
+}
+
+TEST(FrontendScenePoseExtrapolation, HistoryFollowsThePoseAcrossRepresentations) {
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  apply(scene, {skinnedOp(1, f, glm::mat4(1.0f))}, {{1, {glm::mat4(1.0f), shifted(0.0f)}}}, 1.0);
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(1.0f)}}}, 1.1);
+  // Another level of the same skinned object keeps both poses.
+  apply(scene, {skinnedOp(1, f, shifted(5.0f))}, {}, std::nan(""));
+  EXPECT_NEAR(drawnX(scene, 1.2), 2.0f, 1e-4f);
+  // An unskinned replacement drops them; skinned again, one pose is not extrapolated.
+  apply(scene, {addOp(1, RepresentationKind::kMesh, quadMesh(0, 0, 1, 1, 0), nullptr)}, {},
+        std::nan(""));
+  BoneMatrices scratch;
+  EXPECT_EQ(scene.bonePoseAt(1, 1.2, scratch), nullptr);
+  apply(scene, {skinnedOp(1, f, glm::mat4(1.0f))}, {{1, {glm::mat4(1.0f), shifted(3.0f)}}}, 1.3);
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.35), 3.0f);
+  // Removal drops them too.
+  apply(scene, {}, {{1, {glm::mat4(1.0f), shifted(4.0f)}}}, 1.4);
+  EXPECT_NEAR(drawnX(scene, 1.5), 5.0f, 1e-4f);
+  apply(scene, {removeOp(1)}, {}, std::nan(""));
+  EXPECT_EQ(scene.bonePoseAt(1, 1.5, scratch), nullptr);
+  apply(scene, {skinnedOp(1, f, glm::mat4(1.0f))}, {{1, {glm::mat4(1.0f), shifted(6.0f)}}}, 1.6);
+  EXPECT_FLOAT_EQ(drawnX(scene, 1.65), 6.0f);
 }
 
 }  // namespace

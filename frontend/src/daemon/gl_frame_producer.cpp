@@ -89,7 +89,7 @@ Result<ProducedFrame> GlFrameProducer::renderFrame(std::uint64_t frame, const Po
     return Status(camera.status().code(),
                   "frame " + std::to_string(frame) + ": " + camera.status().message());
   }
-  Result<FrameReport> report = renderer_->renderFrame(*camera, lighting_, frame_);
+  Result<FrameReport> report = renderer_->renderFrame(*camera, lighting_, frame_, pose.time);
   if (!report.ok()) {
     return Status(report.status().code(),
                   "frame " + std::to_string(frame) + ": " + report.status().message());

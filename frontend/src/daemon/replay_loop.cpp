@@ -88,6 +88,7 @@ class Replay {
       last = pose;
       if (!fresh) ++result_.framesRedrawingAPose;
       poseSentNs_.push_back(-1);
+      poseTimeS_.push_back(pose.time);
       answered_.push_back(false);
       const std::int64_t sampledNs =
           fresh ? source_.lastArrivalNs().value_or(clock_.nowNs()) : clock_.nowNs();
@@ -197,6 +198,10 @@ class Replay {
       notePlanGap(update.plan);
       if (update.frame < answered_.size()) answered_[update.frame] = true;
       Result<SceneBatch> batch = convertUpdate(update, options_.conversion);
+      // The pose time its bone poses were computed for: the timestamp of the
+      // pose it answered (unknown for a frame this replay did not send).
+      if (batch.ok() && update.frame < poseTimeS_.size())
+        batch->poseTimeS = poseTimeS_[update.frame];
       const Status submitted =
           batch.ok() ? producer_.submit(std::move(batch).value()) : batch.status();
       if (!submitted.ok()) {
@@ -312,6 +317,7 @@ class Replay {
   ReplayObserver& observer_;
   const std::function<bool()>& stop_;
   std::vector<std::int64_t> poseSentNs_;  // -1: not sent
+  std::vector<double> poseTimeS_;         // each frame's pose time (SceneBatch::poseTimeS)
   std::vector<bool> answered_;            // an update for this pose arrived
   std::deque<SubmittedUpdate> submitted_;
   // Plans of updates refused, dropped or missed since the last FrameStats.

@@ -21,9 +21,10 @@
 //   reconnect says (a restarted or timed-out backbone) tells the new session
 //   what is held; the frontend keeps drawing it meanwhile.
 // - Memory: the loop keeps no records (the observer streams them, e.g. into a
-//   FrameLog); per frame it keeps 8 bytes (when the pose was sent, for
-//   update_latency_ms of a later answer) and 1 bit (answered), whatever the
-//   run length.
+//   FrameLog); per frame it keeps 16 bytes (when the pose was sent, for
+//   update_latency_ms of a later answer, and the pose's time, which the
+//   answer's bone poses were computed for: SceneBatch::poseTimeS) and 1 bit
+//   (answered), whatever the run length.
 // - Deferred measurement (measure && deferMeasure, the live workbench mode):
 //   instead of rendering the reference inline, the frame just shown is kept
 //   with the pose it was drawn for (FrameProducer::keepShown) and nothing

@@ -91,6 +91,9 @@ struct FrontendRenderer::Impl {
   IndexedMesh mergeScratch;
   std::vector<std::uint16_t> layerScratch;
   std::vector<render::DrawItem> items;
+  // Per skinned object drawn this frame: its pose extrapolated to the frame's
+  // time (FrontendScene::bonePoseAt); sized before items point into it.
+  std::vector<BoneMatrices> extrapolated;
   // Hybrid discs: one merged, pre-lit world-space set drawn in one call.
   std::unique_ptr<render::DiscRenderer> discs;
   render::DiscHandle discHandle;
@@ -433,7 +436,7 @@ Status FrontendRenderer::submit(SceneBatch batch) { return impl_->scene.enqueue(
 
 Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
                                                   const render::Lighting& lighting,
-                                                  RgbaImage& frame) {
+                                                  RgbaImage& frame, double poseTimeS) {
   Impl& impl = *impl_;
   if (!impl.context->isCurrent()) {
     return Status(ErrorCode::kUnavailable,
@@ -477,10 +480,15 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
   }
   // Skinned objects, one draw each with their pose; one without a pose (or
   // whose pose has fewer bones than its skin names) is not drawn this frame.
+  // The scratch poses are sized once, so the pointers items keep stay valid.
+  if (impl.extrapolated.size() < impl.scene.objects().size())
+    impl.extrapolated.resize(impl.scene.objects().size());
+  std::size_t slot = 0;
   for (const auto& [id, object] : impl.scene.objects()) {
     auto part = impl.parts.find(object.key);
     if (part == impl.parts.end() || !part->second.skinnedMesh.valid()) continue;
-    const BoneMatrices* pose = impl.scene.bonePose(id);
+    BoneMatrices& scratch = impl.extrapolated[slot++];
+    const BoneMatrices* pose = impl.scene.bonePoseAt(id, poseTimeS, scratch);
     if (pose == nullptr || pose->size() < impl.renderer->bonesNeeded(part->second.skinnedMesh)) {
       ++report.skinnedWithoutPose;
       continue;
@@ -492,6 +500,7 @@ Result<FrameReport> FrontendRenderer::renderFrame(const render::Camera& camera,
     item.bones = pose;
     impl.items.push_back(item);
     ++report.skinnedObjects;
+    if (pose == &scratch) ++report.extrapolatedPoses;
     report.deformedVertices += part->second.skinnedVertices;
   }
   THINLOD_RETURN_IF_ERROR(impl.renderer->beginFrame(*impl.target, impl.options.clearColor));

@@ -162,6 +162,7 @@ Status FrontendScene::enqueue(SceneBatch batch) {
   queued.sequence = nextSequence_++;
   queued.plan = batch.plan;
   queued.bonePoses = std::move(batch.bonePoses);
+  queued.poseTimeS = batch.poseTimeS;
   queued.types.reserve(batch.operations.size());
   queued.objects.reserve(batch.operations.size());
   for (SceneOperation& op : batch.operations) {
@@ -279,8 +280,17 @@ CommitResult FrontendScene::commitReady() {
     }
     for (auto& [id, matrices] : batch.bonePoses) {
       auto held = objects_.find(id);
-      if (held != objects_.end() && held->second.representation.skin != nullptr)
-        poses_[id] = std::move(matrices);
+      if (held == objects_.end() || held->second.representation.skin == nullptr) continue;
+      HeldPose& pose = poses_[id];
+      // A second answer for the same pose time replaces the newest; a later
+      // one pushes it back. Unknown times (NaN) never compare equal, so the
+      // pair they leave is never extrapolated (extrapolateBonePose).
+      if (!pose.newest.empty() && !(batch.poseTimeS == pose.newestTimeS)) {
+        pose.previous = std::move(pose.newest);
+        pose.previousTimeS = pose.newestTimeS;
+      }
+      pose.newest = std::move(matrices);
+      pose.newestTimeS = batch.poseTimeS;
     }
     result.plans.push_back(batch.plan);
     lastPlan_ = batch.plan;
@@ -333,7 +343,46 @@ void FrontendScene::showFirstRepresentationsEarly(CommitResult& result) {
 
 const BoneMatrices* FrontendScene::bonePose(ObjectId id) const {
   auto it = poses_.find(id);
-  return it == poses_.end() ? nullptr : &it->second;
+  return it == poses_.end() ? nullptr : &it->second.newest;
+}
+
+const BoneMatrices* FrontendScene::bonePoseAt(ObjectId id, double timeS,
+                                              BoneMatrices& scratch) const {
+  auto it = poses_.find(id);
+  if (it == poses_.end()) return nullptr;
+  const HeldPose& pose = it->second;
+  if (pose.previous.empty()) return &pose.newest;
+  return extrapolateBonePose(pose.previous, pose.previousTimeS, pose.newest, pose.newestTimeS,
+                             timeS, scratch)
+             ? &scratch
+             : &pose.newest;
+}
+
+bool extrapolateBonePose(const BoneMatrices& m0, double t0, const BoneMatrices& m1, double t1,
+                         double t, BoneMatrices& out) {
+  // The comparisons are written so that a NaN time fails them.
+  const double spacing = t1 - t0;
+  const double ahead = t - t1;
+  if (!(spacing > 0.0 && spacing <= kMaxPoseSpacingS)) return false;
+  // Linear in the matrix elements is right only for small steps: a rotation
+  // extrapolated this way shears and scales the limb in proportion to the
+  // angle it is pushed on, and a figure changes direction within a few
+  // tenths of a second (Wuson_Run's clip is 0.967 s). So never further than
+  // two pose spacings ahead (a late update or two; longer gaps keep the
+  // newest pose rather than fling limbs on), and not from poses over half
+  // a second apart, whose difference says little about the motion now.
+  if (!(ahead > 0.0 && ahead <= kMaxExtrapolationSpacings * spacing)) return false;
+  if (m0.size() != m1.size()) return false;
+  // Looping clips are continuous at the wrap (the backbone plays them looped
+  // on pose time; an authored loop such as Wuson_Run ends on its first key),
+  // so two poses either side of a wrap differ by one small step like any
+  // other two: no special case. (A clip whose last key differs from its
+  // first jumps there anyway; extrapolation carries that jump at most two
+  // spacings, until the next pose arrives.)
+  const float s = static_cast<float>(ahead / spacing);
+  out.resize(m1.size());
+  for (std::size_t i = 0; i < m1.size(); ++i) out[i] = m1[i] + (m1[i] - m0[i]) * s;
+  return true;
 }
 
 const SceneObject* FrontendScene::find(ObjectId id) const {

@@ -14,11 +14,13 @@
 // - Batching: all textures live in layers of a few array textures ("pages");
 //   geometry is merged per (page, lit/unlit), so a frame costs about two draw
 //   calls per page used; a skinned mesh (Representation::skin) is drawn on
-//   its own with its bone pose (FrontendScene::bonePose), the vertex shader
-//   deforming only its level's vertices. Meshes are lit (with `lighting`); impostors are unlit
-//   (their lighting is baked in) and alpha-tested (or blended, unsorted).
-//   Only changed objects are re-uploaded; merged vertex buffers are rebuilt
-//   on frames where the set of drawn objects changes.
+//   its own with its bone pose at the frame's pose time `poseTimeS`
+//   (FrontendScene::bonePoseAt: the newest pose, extrapolated from the two
+//   newest when the frame is later than it; NaN: the newest as is), the
+//   vertex shader deforming only its level's vertices. Meshes are lit (with `lighting`); impostors
+//   are unlit (their lighting is baked in) and alpha-tested (or blended, unsorted). Only changed
+//   objects are re-uploaded; merged vertex buffers are rebuilt on frames where the set of drawn
+//   objects changes.
 // - Textures larger than `layerSize` are shrunk to fit (box filter); smaller
 //   ones occupy a corner of a layer. uvs outside [0,1] clamp.
 // - Errors: bad camera/lighting is kInvalidArgument (nothing drawn); a batch
@@ -36,6 +38,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -98,6 +101,8 @@ struct FrameReport {
   std::size_t skinnedObjects = 0;
   std::size_t deformedVertices = 0;
   std::size_t skinnedWithoutPose = 0;
+  // Of skinnedObjects, those drawn with a pose extrapolated to the frame's time.
+  std::size_t extrapolatedPoses = 0;
 };
 
 class FrontendRenderer {
@@ -111,8 +116,10 @@ class FrontendRenderer {
   Status warmUp(const render::Lighting& lighting);
   Status submit(SceneBatch batch);
   // `frame` is resized to width x height (no reallocation when already so).
+  // `poseTimeS`: the pose time the frame shows (seconds, as SceneBatch::poseTimeS).
   Result<FrameReport> renderFrame(const render::Camera& camera, const render::Lighting& lighting,
-                                  RgbaImage& frame);
+                                  RgbaImage& frame,
+                                  double poseTimeS = std::numeric_limits<double>::quiet_NaN());
 
   const FrontendScene& scene() const;
   const FrontendRendererOptions& options() const;

@@ -39,7 +39,9 @@
 //   unique). Poses apply when their batch commits, after its operations, to
 //   objects then held with a skin; others are ignored. An object's pose
 //   stays until a newer one, its removal or its replacement by an unskinned
-//   representation.
+//   representation. The scene keeps an object's two newest poses with the
+//   pose times they were computed for (SceneBatch::poseTimeS); bonePoseAt()
+//   extrapolates them to a frame's time (extrapolateBonePose).
 // - Removing an id that is not held is not an error (counted, see CommitResult).
 // - Keys: every queued representation gets a unique RepresentationKey, never
 //   reused, so GPU resources can be tracked by key across replacements.
@@ -51,6 +53,7 @@
 #include <deque>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
+#include <limits>
 #include <map>
 #include <memory>
 #include <utility>
@@ -109,7 +112,22 @@ struct SceneBatch {
   std::uint64_t plan = 0;  // the backbone's planning step, reported back when applied
   std::vector<SceneOperation> operations;
   std::vector<std::pair<ObjectId, BoneMatrices>> bonePoses;  // applied after the operations
+  // The pose time (seconds: the timestamp of the viewer pose the update
+  // answered) the bone poses were computed for; NaN = unknown (such poses
+  // are drawn as they are, never extrapolated).
+  double poseTimeS = std::numeric_limits<double>::quiet_NaN();
 };
+
+// Bone poses extrapolated to a frame's time (docs/animation.md, "Served"):
+// per matrix element M(t) = M1 + (M1 - M0) * (t - t1) / (t1 - t0), from the
+// newest pose M1 (pose time t1) and the one before M0 (t0), only when
+// 0 < t1 - t0 <= kMaxPoseSpacingS and 0 < t - t1 <= kMaxExtrapolationSpacings
+// * (t1 - t0) and both have the same number of matrices. Returns false (and
+// leaves `out` alone) otherwise: then M1 is drawn as it is. Pure.
+inline constexpr double kMaxPoseSpacingS = 0.5;
+inline constexpr double kMaxExtrapolationSpacings = 2.0;
+bool extrapolateBonePose(const BoneMatrices& m0, double t0, const BoneMatrices& m1, double t1,
+                         double t, BoneMatrices& out);
 
 // One held (or queued) representation after validation.
 struct SceneObject {
@@ -179,8 +197,14 @@ class FrontendScene {
   // lastAppliedPlan() left (FrameStats.early_polygons).
   std::size_t earlyPolygons() const { return earlyPolygons_; }
   std::size_t pendingBatches() const { return pending_.size(); }
-  // The bone pose of a held skinned object, or null before its first.
+  // The newest bone pose of a held skinned object, or null before its first.
   const BoneMatrices* bonePose(ObjectId id) const;
+  // The pose to draw it with at pose time `timeS` (seconds; NaN = the newest
+  // as is): the newest, extrapolated to timeS from the two newest when
+  // extrapolateBonePose allows (then written into `scratch` and the result
+  // points there); null before its first pose. History follows the pose:
+  // a skinned replacement keeps both, removal or an unskinned one drops them.
+  const BoneMatrices* bonePoseAt(ObjectId id, double timeS, BoneMatrices& scratch) const;
   std::size_t pendingUploadBytes() const;
   std::uint64_t lastAppliedPlan() const { return lastPlan_; }
 
@@ -193,13 +217,22 @@ class FrontendScene {
     std::vector<bool> uploaded;        // per operation; removals start true
     std::vector<bool> shownEarly;      // per operation: a first representation already held
     std::vector<std::pair<ObjectId, BoneMatrices>> bonePoses;
+    double poseTimeS = std::numeric_limits<double>::quiet_NaN();
+  };
+  // A held skinned object's two newest poses and their pose times (NaN:
+  // unknown; `previous` empty before the second).
+  struct HeldPose {
+    BoneMatrices newest;
+    double newestTimeS = std::numeric_limits<double>::quiet_NaN();
+    BoneMatrices previous;
+    double previousTimeS = std::numeric_limits<double>::quiet_NaN();
   };
   // Activates first representations early (see the contract); appends to `result`.
   void showFirstRepresentationsEarly(CommitResult& result);
 
   SceneLimits limits_;
   std::map<ObjectId, SceneObject> objects_;
-  std::map<ObjectId, BoneMatrices> poses_;  // held skinned objects only
+  std::map<ObjectId, HeldPose> poses_;  // held skinned objects only
   std::deque<QueuedBatch> pending_;
   std::uint64_t nextSequence_ = 1;
   RepresentationKey nextKey_ = 1;
