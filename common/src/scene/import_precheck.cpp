@@ -73,6 +73,13 @@ Status checkNodeGraph(const std::string& path,
 
 namespace {
 
+// XML's white space (S: space, tab, CR, LF). Not std::isspace: a form feed
+// or vertical tab is no separator to Assimp's Collada number reader, which
+// then read a transform differently from this scan (fuzz finding 41:
+// "0 \f\f...\f0 0" counted as three numbers here).
+bool isXmlSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+
 // Value of attribute `name` in a start tag's text (after the element name),
 // empty when absent.
 std::string_view attribute(std::string_view tag, std::string_view name) {
@@ -81,13 +88,13 @@ std::string_view attribute(std::string_view tag, std::string_view name) {
     const std::size_t eq = tag.find('=', at);
     if (eq == std::string_view::npos) return {};
     std::size_t keyEnd = eq;
-    while (keyEnd > at && std::isspace(static_cast<unsigned char>(tag[keyEnd - 1]))) --keyEnd;
+    while (keyEnd > at && isXmlSpace(tag[keyEnd - 1])) --keyEnd;
     std::size_t keyStart = keyEnd;
-    while (keyStart > at && !std::isspace(static_cast<unsigned char>(tag[keyStart - 1]))) {
+    while (keyStart > at && !isXmlSpace(tag[keyStart - 1])) {
       --keyStart;
     }
     std::size_t q = eq + 1;
-    while (q < tag.size() && std::isspace(static_cast<unsigned char>(tag[q]))) ++q;
+    while (q < tag.size() && isXmlSpace(tag[q])) ++q;
     if (q >= tag.size() || (tag[q] != '"' && tag[q] != '\'')) return {};
     const std::size_t close = tag.find(tag[q], q + 1);
     if (close == std::string_view::npos) return {};
@@ -168,10 +175,10 @@ bool countNumbers(std::string_view text, std::uint64_t* count) {
   *count = 0;
   std::size_t i = 0;
   while (i < text.size()) {
-    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    while (i < text.size() && isXmlSpace(text[i])) ++i;
     if (i >= text.size()) break;
     const std::size_t start = i;
-    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    while (i < text.size() && !isXmlSpace(text[i])) ++i;
     if (!isPlainFiniteNumber(text.substr(start, i - start))) return false;
     ++*count;
   }
@@ -222,7 +229,7 @@ bool allUnsignedIntegers(std::string_view text) {
     if (c >= '0' && c <= '9') {
       value = value * 10 + static_cast<std::uint64_t>(c - '0');
       if (++digits > 10 || value >= (std::uint64_t{1} << 31)) return false;
-    } else if (std::isspace(static_cast<unsigned char>(c))) {
+    } else if (isXmlSpace(c)) {
       digits = 0;
       value = 0;
     } else {
@@ -318,7 +325,7 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     std::string_view tag =
         xml.substr(i + (closing ? 2 : 1), end - i - (closing ? 2 : 1) - (selfClosing ? 1 : 0));
     std::size_t nameEnd = 0;
-    while (nameEnd < tag.size() && !std::isspace(static_cast<unsigned char>(tag[nameEnd]))) {
+    while (nameEnd < tag.size() && !isXmlSpace(tag[nameEnd])) {
       ++nameEnd;
     }
     const std::string_view name = tag.substr(0, nameEnd);
