@@ -94,7 +94,10 @@ class FakeLink final : public BackboneLink {
 class SceneProducer final : public FrameProducer {
  public:
   explicit SceneProducer(FakeClock& clock) : clock_(clock) {}
-  Status submit(SceneBatch batch) override { return scene.enqueue(std::move(batch)); }
+  Status submit(SceneBatch batch) override {
+    submittedPoseTimes.push_back(batch.poseTimeS);
+    return scene.enqueue(std::move(batch));
+  }
   Result<ProducedFrame> renderFrame(std::uint64_t frame, const Pose&) override {
     if (failAtFrame && *failAtFrame == frame) return Status(ErrorCode::kInternal, "GL lost");
     renderStartNs.push_back(clock_.now);
@@ -127,6 +130,7 @@ class SceneProducer final : public FrameProducer {
   double snrDb = 12.0;
   std::size_t points = 0;  // discs "drawn" every frame
   std::optional<std::uint64_t> failAtFrame;
+  std::vector<double> submittedPoseTimes;  // SceneBatch::poseTimeS of each submit
   std::vector<std::int64_t> renderStartNs;
 
  private:
@@ -406,6 +410,22 @@ TEST_F(ReplayLoopTest, PoseBytesCountTheBonePosesOfTheUpdatesReceivedInTheFrame)
   EXPECT_EQ(result.records[3].poseBytes, 8u * 48u);
   // They are part of link_bytes (the fake link counts 1000 bytes of framing an update).
   EXPECT_EQ(result.records[1].linkBytes, 1000u + 8u * 48u);
+}
+
+TEST_F(ReplayLoopTest, EachBatchCarriesThePoseTimeOfThePoseItsUpdateAnswered) {
+  options.rate = 10.0;
+  // Pose 1's answer claims a frame this replay never sent: its time is unknown.
+  link.responder = [](const protocol::ViewerPose& pose) {
+    const std::uint64_t frame = pose.sequence == 1 ? 99 : pose.sequence;
+    return std::make_optional(
+        std::make_pair(std::int64_t{0}, sphereUpdate(pose.sequence + 1, frame, 1, 5.0)));
+  };
+  Replayed result = run(traceAt({0.0, 0.25, 0.5}));
+  ASSERT_EQ(result.records.size(), 3u);
+  ASSERT_EQ(producer.submittedPoseTimes.size(), 3u);
+  EXPECT_DOUBLE_EQ(producer.submittedPoseTimes[0], 0.0);
+  EXPECT_TRUE(std::isnan(producer.submittedPoseTimes[1]));
+  EXPECT_DOUBLE_EQ(producer.submittedPoseTimes[2], 0.5);
 }
 
 TEST_F(ReplayLoopTest, PointsAndUnitsOfEachFrameAtTheGivenKappa) {
