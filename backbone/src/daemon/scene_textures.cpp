@@ -14,10 +14,8 @@ SceneTextures loadSceneTextures(const std::vector<scene::SceneObject>& objects,
   std::map<std::string, std::uint64_t> idOfPath;  // 0: the file failed
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const scene::SceneObject& object = objects[i];
-    if (object.shape == nullptr || object.fullMesh == nullptr || object.fullMesh->uvs.empty())
-      continue;
+    if (!scene::isTextured(object)) continue;
     const std::string& path = object.shape->appearance.texturePath;
-    if (path.empty()) continue;
     auto known = idOfPath.find(path);
     if (known == idOfPath.end()) {
       std::uint64_t id = 0;

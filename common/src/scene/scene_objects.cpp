@@ -119,6 +119,11 @@ Result<std::vector<SceneObject>> collectSceneObjects(const Scene& scene,
   return objects;
 }
 
+bool isTextured(const SceneObject& object) {
+  return object.shape != nullptr && object.fullMesh != nullptr && !object.fullMesh->uvs.empty() &&
+         !object.shape->appearance.texturePath.empty();
+}
+
 const SceneObject* findSceneObject(const std::vector<SceneObject>& objects, std::uint64_t id) {
   if (id == 0 || id > objects.size()) return nullptr;
   return &objects[id - 1];

@@ -68,6 +68,11 @@ struct SceneObjectOptions {
 Result<std::vector<SceneObject>> collectSceneObjects(const Scene& scene,
                                                      const SceneObjectOptions& options = {});
 
+// True when the object is drawn with a texture: its shape names a texture
+// file and its full mesh carries uvs. The one test of the backbone's texture
+// table (scene_textures) and of the kinds that carry no uvs (hybrids).
+bool isTextured(const SceneObject& object);
+
 // The object with `id`, or nullptr.
 const SceneObject* findSceneObject(const std::vector<SceneObject>& objects, std::uint64_t id);
 
