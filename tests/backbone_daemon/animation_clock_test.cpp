@@ -91,8 +91,7 @@ TEST(BackboneAnimationClock, PosesOfHeldAnimatedObjectsFollowPoseTime) {
       EXPECT_EQ(outcome.update.bonePoses[0],
                 core.bonePosesAt(poseAt(step, 0.1 * step, eye, figure).timestampNs)[0]);
       EXPECT_EQ(outcome.bonePoseBytes,
-                std::uint64_t(kBonePoseOverheadBytes +
-                              kBytesPerBoneMatrix * double(wuson(core).palette.bones.size())));
+                std::uint64_t(bonePoseBytes(wuson(core).palette.bones.size())));
       EXPECT_GE(outcome.linkBytes, outcome.bonePoseBytes);
     }
   }
@@ -252,7 +251,7 @@ TEST(BackboneAnimationClock, PosesTakeTheirShareOfTheLinkBudgetBeforeGeometry) {
     int step = 0;
     ASSERT_TRUE(sendFigure(core, fake, step));
     const double poseBytes =
-        kBonePoseOverheadBytes + kBytesPerBoneMatrix * double(wuson(core).palette.bones.size());
+        bonePoseBytes(wuson(core).palette.bones.size());
     // Poses every 0.1 s of pose time (sendFigure's and the loop's spacing),
     // known from the second pose on.
     const double expected = std::min(poseBytes / 0.1, 0.5 * rate);

@@ -348,10 +348,7 @@ Status BackboneCore::initialize() {
     // a textured object: hybrids carry no uvs (docs/hybrid.md) and their
     // curve credits geometry only, so a hybrid would drop the texture while
     // claiming the accuracy of a textured copy.
-    const bool textured = record.object != nullptr && record.object->shape != nullptr &&
-                          record.object->fullMesh != nullptr &&
-                          !record.object->fullMesh->uvs.empty() &&
-                          !record.object->shape->appearance.texturePath.empty();
+    const bool textured = record.object != nullptr && scene::isTextured(*record.object);
     if (options_.hybridKappa > 0.0 && !record.primitive && record.mesh.offered && !animated &&
         !textured) {
       OptionState state;
@@ -969,13 +966,15 @@ backbone::Budget BackboneCore::budgetAtPose() const {
 }
 
 double BackboneCore::poseLinkReserve() const {
-  const std::optional<double> rate = budgetAtPose().maxLinkBytesPerSecond;
+  return poseLinkReserve(budgetAtPose().maxLinkBytesPerSecond);
+}
+
+double BackboneCore::poseLinkReserve(std::optional<double> rate) const {
   if (!rate || !(poseIntervalSeconds_ > 0.0)) return 0.0;
   double bytesPerPose = 0.0;
   for (std::uint32_t k = 0; k < animationOf_.size(); ++k) {
     if (animationOf_[k] == nullptr || !(mirror_.trianglesOf(k) > 0.0)) continue;
-    bytesPerPose += kBonePoseOverheadBytes +
-                    kBytesPerBoneMatrix * double(animationOf_[k]->palette.bones.size());
+    bytesPerPose += bonePoseBytes(animationOf_[k]->palette.bones.size());
   }
   // Decision (docs/animation.md, "Served"): poses get at most half the link
   // in planning. Above that the shaper defers some of them (the frontend
@@ -985,7 +984,7 @@ double BackboneCore::poseLinkReserve() const {
 
 backbone::Budget BackboneCore::schedulingBudget() const {
   backbone::Budget budget = budgetAtPose();
-  const double reserve = poseLinkReserve();
+  const double reserve = poseLinkReserve(budget.maxLinkBytesPerSecond);
   if (budget.maxLinkBytesPerSecond && reserve > 0.0) *budget.maxLinkBytesPerSecond -= reserve;
   return budget;
 }
@@ -1291,8 +1290,7 @@ PoseOutcome BackboneCore::finishPose() {
   out.frontendTriangles = mirror_.triangles();
   // Each object's pose on its own: the ones the shaper has tokens for go.
   for (protocol::BonePose& pose : bonePosesAt(poseTimeNs_)) {
-    const auto bytes = static_cast<std::uint64_t>(
-        kBonePoseOverheadBytes + kBytesPerBoneMatrix * double(pose.matrices.size()));
+    const auto bytes = static_cast<std::uint64_t>(bonePoseBytes(pose.matrices.size()));
     if (shaper_ && !shaper_->trySend(bytes, now)) {
       ++out.posesDeferredByLink;
       continue;

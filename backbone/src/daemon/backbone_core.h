@@ -51,6 +51,7 @@
 //   frontend. Without a frame-time budget the constants are not used.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -150,6 +151,11 @@ struct SessionFrameCost {
 // tests/protocol/bone_pose_fields_test.cpp).
 inline constexpr double kBonePoseOverheadBytes = 64.0;
 inline constexpr double kBytesPerBoneMatrix = 48.0;
+// The link bytes of one object's pose of `bones` matrices: what the shaper
+// charges (finishPose) and what planning reserves (poseLinkReserve).
+inline constexpr double bonePoseBytes(std::size_t bones) {
+  return kBonePoseOverheadBytes + kBytesPerBoneMatrix * double(bones);
+}
 
 struct OutgoingRequest {
   std::uint64_t requestId = 0;  // == the message's requestId
@@ -441,6 +447,8 @@ class BackboneCore {
   std::int64_t lastShaperNs_ = std::numeric_limits<std::int64_t>::min();
   // The budget of this pose: options_.budget with the link schedule's rate.
   backbone::Budget budgetAtPose() const;
+  // poseLinkReserve() at a given link rate (the budget's, computed once).
+  double poseLinkReserve(std::optional<double> linkRate) const;
   double poseIntervalSeconds_ = 0.0;  // smoothed pose spacing (pose time); 0: unknown
   std::optional<protocol::LinkShaper> shaper_;
   std::uint64_t shapedBytes_ = 0;
