@@ -777,7 +777,6 @@ Status precheckFbx(const std::string& path, std::string_view bytes, const Import
       }
       pending = true;
     }
-    if (tokens.size() > limits.maxFileBytes) return refuse(line, "too many tokens");
   }
   const std::size_t maxDepth = static_cast<std::size_t>(std::max(limits.maxDepth, 0)) + 64;
   FbxGrammar grammar(tokens, maxDepth);
