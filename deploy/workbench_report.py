@@ -40,6 +40,7 @@ COLUMNS = [
     ("simplifier_requests", "requests", None),
     ("update_latency_ms_median", "update med ms", 0), ("update_latency_ms_p99", "update p99 ms", 0),
     ("pose_to_frame_ms_p99", "pose->frame p99 ms", 1),
+    ("own_answer_pct", "own answer %", 0),
     ("first_complete_ms", "first complete ms", 0),
 ]
 
@@ -137,7 +138,9 @@ def run_metrics(run_dir, from_time=None):
     frame, complete_ms = first_complete(rows)
     m = {
         "name": meta["name"], "case": meta.get("case"), "scheduler": meta.get("scheduler"),
-        "budget_polygons": budget, "mode": meta.get("mode"),
+        "budget_polygons": budget,
+        "mode": meta.get("mode") + (f" +{meta['answer_wait_ms']} ms" if meta.get("answer_wait_ms")
+                                    else "") if meta.get("mode") else None,
         "reference_mode": summary.get("reference_mode"),
         "frames": len(rows), "frames_scored": sum(1 for s in snr if not math.isnan(s)),
         "frames_not_kept": summary.get("frames_not_kept"),
@@ -164,6 +167,10 @@ def run_metrics(run_dir, from_time=None):
         "update_latency_ms_median": nearest_rank(col("update_latency_ms"), 0.5),
         "update_latency_ms_p99": nearest_rank(col("update_latency_ms"), 0.99),
         "pose_to_frame_ms_p99": nearest_rank(col("pose_to_frame_ms"), 0.99),
+        # Frames drawn with the answer to their own pose (frames.csv own_answer; None for runs
+        # written before the column existed).
+        "own_answer_pct": (100.0 * sum(1 for r in rows if r.get("own_answer") == "1") / len(rows)
+                           if rows and "own_answer" in rows[0] else None),
         "first_complete_frame": frame,
         "first_complete_ms": complete_ms,
         "wall_s": meta.get("wall_s"), "exit_code": meta.get("exit_code"),

@@ -65,13 +65,13 @@ TEST(FrameRecord, HeaderHasTheRequiredColumnsInOrder) {
             "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,"
             "wait_ms,updates_received,updates_rejected,lockstep_timeout,shown_at_ms,"
             "visible_objects,missing_objects,blank,skinned_objects,deformed_vertices,"
-            "pose_bytes,points,units\n");
+            "pose_bytes,points,units,own_answer\n");
 }
 
 TEST(FrameRecord, RowFormatsEveryColumn) {
   EXPECT_EQ(formatFrameCsvRow(sampleRecord()),
             "12,0.400000,348,262144,200,11.2500,30.5000,2.6000,7.1250,31.5000,3,2,524288,"
-            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0,0,0,\n");
+            "20.2500,3.5000,1,0,1,400.1250,7,2,0,0,0,0,0,,0\n");
 }
 
 TEST(FrameRecord, SkinnedColumnsComeLastAfterTheOlderOnes) {
@@ -80,7 +80,7 @@ TEST(FrameRecord, SkinnedColumnsComeLastAfterTheOlderOnes) {
   r.deformedVertices = 4453;
   r.poseBytes = 3 * 37 * 48;
   const std::string row = formatFrameCsvRow(r);
-  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,3,4453,5328,0,\n");
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,3,4453,5328,0,,0\n");
 }
 
 TEST(FrameRecord, PointsAndUnitsComeAfterPoseBytes) {
@@ -89,7 +89,14 @@ TEST(FrameRecord, PointsAndUnitsComeAfterPoseBytes) {
   r.points = 30;
   r.units = primitiveUnits(r.polygons, r.points, 1.5);
   const std::string row = formatFrameCsvRow(r);
-  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,0,0,96,30,368.00\n");
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,0,0,96,30,368.00,0\n");
+}
+
+TEST(FrameRecord, OwnAnswerComesLast) {
+  FrameRecord r = sampleRecord();
+  r.ownAnswer = true;
+  const std::string row = formatFrameCsvRow(r);
+  EXPECT_EQ(row.substr(row.find(",400.1250,")), ",400.1250,7,2,0,0,0,0,0,,1\n");
 }
 
 TEST(FrameRecord, UnitsAreTrianglesPlusPointsOverKappa) {
@@ -108,7 +115,7 @@ TEST(FrameRecord, MissingValuesAreEmptyAndInfinitiesSpelledOut) {
   r.frame = 1;
   r.quality.snrDb = kInf;
   r.quality.psnrDb = kInf;
-  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0,0,0,\n");
+  EXPECT_EQ(formatFrameCsvRow(r), "1,0.000000,0,0,,inf,inf,,,,0,0,0,,0.0000,0,0,0,,,,,0,0,0,0,,0\n");
   r.quality.snrDb = -kInf;
   EXPECT_NE(formatFrameCsvRow(r).find(",-inf,"), std::string::npos);
 }
@@ -214,6 +221,10 @@ TEST(FrameSummary, JsonRoundTrips) {
   EXPECT_EQ(json["snr_db"]["min"], 11.25);
   EXPECT_EQ(json["snr_db"]["count"], 3);
   EXPECT_EQ(json["link_bytes_total"], 3 * 262144);
+  EXPECT_EQ(json["own_answer_frames"], 0);
+  records[0].ownAnswer = true;
+  records[2].ownAnswer = true;
+  EXPECT_EQ(nlohmann::json::parse(summaryJson(summarize(records)))["own_answer_frames"], 2);
 }
 
 TEST(FrameSummary, JsonSpellsInfinityAndNull) {

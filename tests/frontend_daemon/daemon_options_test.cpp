@@ -73,6 +73,16 @@ TEST(DaemonOptions, OutOfRangeValuesAreNamed) {
   options = validOptions();
   options.lockstepTimeoutMs = 0;
   expectRejected(options, "lockstep-timeout-ms");
+  for (int wait : {-1, 1001}) {
+    options = validOptions();
+    options.answerWaitMs = wait;
+    expectRejected(options, "answer-wait-ms");
+  }
+  options = validOptions();
+  options.answerWaitMs = 2;
+  EXPECT_TRUE(validateOptions(options).ok());
+  options.replay.lockstep = true;  // lockstep has its own wait
+  expectRejected(options, "answer-wait-ms");
   options = validOptions();
   options.maxUploadBytesPerFrame = -1;
   expectRejected(options, "max-upload-bytes-per-frame");

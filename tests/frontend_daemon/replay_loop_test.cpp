@@ -336,6 +336,55 @@ TEST_F(ReplayLoopTest, LockstepAppliesEachAnswerInTheFrameOfItsPose) {
   }
 }
 
+// Live with an answer wait: a frame whose answer comes within the wait shows
+// it (ownAnswer), one whose answer is later draws what it holds after the
+// wait, without a lockstep timeout or a warning; without the wait the same
+// answers show a frame late.
+TEST_F(ReplayLoopTest, AnswerWaitShowsAnAnswerThatComesWithinIt) {
+  options.rate = 0.0;  // the trace's own timing: 100 ms per frame
+  link.responder = [](const protocol::ViewerPose& pose) {
+    // Frame 1's answer takes 30 ms, the others 1 ms.
+    const std::int64_t delay = pose.sequence == 1 ? 30 * kMs : 1 * kMs;
+    return std::make_optional(std::make_pair(
+        delay, sphereUpdate(pose.sequence + 1, pose.sequence, 1, 10.0 * (pose.sequence + 1))));
+  };
+  const Trace trace = traceAt({0.0, 0.1, 0.2});
+
+  options.answerWait = std::chrono::milliseconds(2);
+  Replayed waited = run(trace);
+  ASSERT_TRUE(waited.status.ok()) << waited.status.toString();
+  ASSERT_EQ(waited.records.size(), 3u);
+  EXPECT_EQ(waited.answerWaitsExpired, 1u);
+  EXPECT_EQ(waited.lockstepTimeouts, 0u);
+  EXPECT_TRUE(observer.timeouts.empty()) << "an expired answer wait is not a lockstep timeout";
+  EXPECT_TRUE(waited.records[0].ownAnswer);
+  EXPECT_DOUBLE_EQ(waited.records[0].waitMs, 1.0);
+  EXPECT_EQ(waited.records[0].plan, 1u);
+  EXPECT_FALSE(waited.records[1].ownAnswer);
+  EXPECT_DOUBLE_EQ(waited.records[1].waitMs, 2.0);  // the whole wait, then what it holds
+  EXPECT_EQ(waited.records[1].plan, 1u);
+  EXPECT_TRUE(waited.records[2].ownAnswer);
+  EXPECT_EQ(waited.records[2].plan, 3u);
+}
+
+TEST_F(ReplayLoopTest, WithoutAnAnswerWaitTheAnswerShowsAFrameLate) {
+  options.rate = 0.0;
+  link.responder = [](const protocol::ViewerPose& pose) {
+    return std::make_optional(std::make_pair(
+        1 * kMs, sphereUpdate(pose.sequence + 1, pose.sequence, 1, 10.0 * (pose.sequence + 1))));
+  };
+  Replayed result = run(traceAt({0.0, 0.1, 0.2}));
+  ASSERT_TRUE(result.status.ok()) << result.status.toString();
+  ASSERT_EQ(result.records.size(), 3u);
+  EXPECT_EQ(result.answerWaitsExpired, 0u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_FALSE(result.records[i].ownAnswer);
+    EXPECT_DOUBLE_EQ(result.records[i].waitMs, 0.0);
+    EXPECT_EQ(result.records[i].plan, i);  // the previous pose's answer (none for frame 0)
+  }
+}
+
 TEST_F(ReplayLoopTest, LockstepTimeoutRendersWhatItHolds) {
   options.lockstep = true;
   options.lockstepTimeout = std::chrono::milliseconds(40);

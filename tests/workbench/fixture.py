@@ -26,14 +26,15 @@ def frame_row(frame, time_s, polygons, link, snr, update, shown, visible, missin
             f"{update},{frame},1,0,20,0.1,1,0,0,{shown},{visible},{missing},{blank}")
 
 
-def write_run(out, case, scheduler, budget, rows, requests, header=FRAME_HEADER):
+def write_run(out, case, scheduler, budget, rows, requests, header=FRAME_HEADER, meta_extra=None):
     name = f"{case}-{scheduler}-{budget}"
     d = os.path.join(out, name)
     os.makedirs(os.path.join(d, "frames"), exist_ok=True)
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump({"name": name, "case": case, "scheduler": scheduler, "budget_polygons": budget,
                    "mode": "live", "backbone_args": "--scheduler " + scheduler,
-                   "frontend_args": "--deferred-reference", "wall_s": 1.0, "exit_code": 0}, f)
+                   "frontend_args": "--deferred-reference", "wall_s": 1.0, "exit_code": 0,
+                   **(meta_extra or {})}, f)
     with open(os.path.join(d, "frames.csv"), "w") as f:
         f.write(header + "\n" + "\n".join(rows) + "\n")
     with open(os.path.join(d, "decisions.csv"), "w") as f:

@@ -106,6 +106,34 @@ class HybridUnits(unittest.TestCase):
         self.assertEqual(m["polygons_max"], 180)
 
 
+class OwnAnswer(unittest.TestCase):
+    """frames.csv's own_answer column: the share of frames drawn with their own pose's answer,
+    and the answer wait in the mode cell."""
+
+    def test_share_of_frames_with_their_own_answer_and_the_wait_in_the_mode(self):
+        d = tempfile.TemporaryDirectory()
+        self.addCleanup(d.cleanup)
+        with open(os.path.join(d.name, "settings.json"), "w") as f:
+            json.dump({"mode": "live", "cases": ["field"], "schedulers": ["curves"]}, f)
+        write_run(d.name, "field", "curves", 200, [
+            hybrid_row(k, 0.1 * k, 100, 0, "100.00") + f",{int(k != 1)}" for k in range(4)],
+            [0, 0, 0, 0],
+            header=FRAME_HEADER + ",skinned_objects,deformed_vertices,pose_bytes,points,units,"
+            "own_answer", meta_extra={"answer_wait_ms": 2})
+        done = subprocess.run([sys.executable, os.path.join(SOURCE, "deploy", "workbench_report.py"),
+                               d.name], capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        m = json.loads(read(os.path.join(d.name, "table.json")))["runs"][0]
+        self.assertEqual(m["own_answer_pct"], 75.0)
+        self.assertEqual(m["mode"], "live +2 ms")
+        self.assertIn("| own answer % |", read(os.path.join(d.name, "table.md")))
+
+    def test_runs_before_the_column_have_no_share(self):
+        m, _ = HybridUnits.report(self)
+        self.assertIsNone(m["own_answer_pct"])
+        self.assertEqual(m["mode"], "live")
+
+
 class Report(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

@@ -37,6 +37,10 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
                     "wait for the backbone's SceneUpdate of each frame before rendering it");
   runtime.addOption("lockstep-timeout-ms", &o->lockstepTimeoutMs,
                     "longest lockstep wait per frame, ms");
+  runtime.addOption("answer-wait-ms", &o->answerWaitMs,
+                    "live (not lockstep): after sending a pose, wait up to this long for the "
+                    "backbone's answer to it before drawing, so a frame can show the plan for "
+                    "its own pose; 0 = draw at once (the answer shows a frame later)");
   runtime.addOption("max-upload-bytes-per-frame", &o->maxUploadBytesPerFrame,
                     "representation bytes uploaded to the GPU per frame; 0 = unbounded");
   runtime.addOption("csv", &o->csvPath, "per-frame CSV output (empty: none)");
@@ -104,6 +108,10 @@ Status validateOptions(const DaemonOptions& o) {
                    "back to back; use 0 (a frame per pose) or a positive rate");
   }
   if (o.lockstepTimeoutMs < 1) return invalid("lockstep-timeout-ms", "must be at least 1");
+  if (o.answerWaitMs < 0 || o.answerWaitMs > 1000) return invalid("answer-wait-ms", "outside 0..1000");
+  if (o.answerWaitMs > 0 && o.replay.lockstep) {
+    return invalid("answer-wait-ms", "is for live replay; --lockstep waits per --lockstep-timeout-ms");
+  }
   if (o.maxUploadBytesPerFrame < 0) return invalid("max-upload-bytes-per-frame", "negative");
   if (o.replay.deferMeasure && o.noReference) {
     return invalid("deferred-reference", "needs the reference (drop --no-reference)");
@@ -135,6 +143,7 @@ void finishOptions(DaemonOptions& o) {
   o.gl.maxKeptBytes = static_cast<std::size_t>(o.deferredReferenceMaxMb) << 20;
   o.gl.visibleMinPixels = static_cast<std::uint32_t>(o.visibleMinPixels);
   o.replay.lockstepTimeout = std::chrono::milliseconds(o.lockstepTimeoutMs);
+  o.replay.answerWait = std::chrono::milliseconds(o.answerWaitMs);
   o.replay.maxFrames = static_cast<std::size_t>(o.frames);
   o.replay.measure = !o.noReference;
   o.replay.viewportWidth = static_cast<std::uint32_t>(o.gl.width);

@@ -27,6 +27,7 @@ struct DaemonOptions {
   // Converted into `replay` / `gl` by finishOptions(); defaults from them.
   std::string backend = render::backendName(GlProducerOptions{}.backend);
   int lockstepTimeoutMs = static_cast<int>(ReplayOptions{}.lockstepTimeout.count());
+  int answerWaitMs = static_cast<int>(ReplayOptions{}.answerWait.count());
   std::int64_t maxUploadBytesPerFrame =  // 0 = unbounded
       static_cast<std::int64_t>(GlProducerOptions{}.uploadBytesPerFrame);
   std::int64_t deferredReferenceMaxMb =

@@ -348,6 +348,7 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
   info.width = options.gl.width;
   info.height = options.gl.height;
   info.lockstep = options.replay.lockstep;
+  info.answerWaitMs = options.answerWaitMs;
   info.rate = options.replay.rate;
   info.reference = !options.noReference;
   info.deferredReference = options.replay.deferMeasure && !options.noReference;
@@ -380,11 +381,11 @@ int run(protocol::DaemonRuntime& runtime, DaemonOptions& options) {
   }
   spdlog::info(
       "event=finished frames={} interrupted={} updates_received={} updates_applied={} "
-      "updates_rejected={} lockstep_timeouts={} render_ms_median={:.2f} snr_db_median={:.2f} "
-      "polygons_max={}",
+      "updates_rejected={} lockstep_timeouts={} answer_waits_expired={} own_answer_frames={} "
+      "render_ms_median={:.2f} snr_db_median={:.2f} polygons_max={}",
       result.frames, result.interrupted, result.updatesReceived, result.updatesApplied,
-      result.updatesRejected, result.lockstepTimeouts, summary.renderMs.median, summary.snrMedianDb,
-      summary.polygonsMax);
+      result.updatesRejected, result.lockstepTimeouts, result.answerWaitsExpired,
+      summary.ownAnswerFrames, summary.renderMs.median, summary.snrMedianDb, summary.polygonsMax);
   return exitCode;
 }
 

@@ -31,6 +31,7 @@ std::string runSummaryJson(const ReplaySummary& frames, const ReplayResult& resu
   json["width"] = info.width;
   json["height"] = info.height;
   json["lockstep"] = info.lockstep;
+  json["answer_wait_ms"] = info.answerWaitMs;
   json["rate"] = info.rate;
   json["reference"] = info.reference;
   // inline: each frame measured as it is drawn; deferred: shown frames kept and
@@ -48,6 +49,7 @@ std::string runSummaryJson(const ReplaySummary& frames, const ReplayResult& resu
                                    {"applied", result.updatesApplied},
                                    {"rejected", result.updatesRejected}};
   json["lockstep_timeouts"] = result.lockstepTimeouts;
+  json["answer_waits_expired"] = result.answerWaitsExpired;
   json["poses_not_sent"] = result.posesNotSent;
   return json.dump(2) + "\n";
 }

@@ -25,6 +25,7 @@ struct RunInfo {
   int width = 0;
   int height = 0;
   bool lockstep = false;
+  int answerWaitMs = 0;  // --answer-wait-ms
   double rate = 0.0;
   bool reference = true;
   bool deferredReference = false;

@@ -102,7 +102,12 @@ class Replay {
           ++result_.lockstepTimeouts;
           observer_.onLockstepTimeout(i, (clock_.nowNs() - sentNs) / kNsPerMs);
         }
+      } else if (options_.answerWait.count() > 0 && poseSent_) {
+        waitUntil(sentNs + options_.answerWait.count() * 1'000'000LL,
+                  [&] { return answered_[i] || !link_.connected(); });
+        if (!answered_[i] && link_.connected() && !stop_()) ++result_.answerWaitsExpired;
       }
+      record_.ownAnswer = poseSent_ && answered_[i];
       record_.waitMs = (clock_.nowNs() - sentNs) / kNsPerMs;
 
       Result<ProducedFrame> produced = producer_.renderFrame(i, pose);

@@ -7,7 +7,8 @@
 //   for the frame's slot (pacing), take the frame's pose, send
 //   ViewerPose{sequence = i, timestampNs = pose time in ns}, take what the
 //   link has (0 ms) or, in lockstep, wait up
-//   to lockstepTimeout for the SceneUpdate with frame == i; convert and submit
+//   to lockstepTimeout for the SceneUpdate with frame == i (live with
+//   answerWait > 0: up to answerWait, silently); convert and submit
 //   every update in arrival order (a bad update is rejected whole); render
 //   the frame; then measure it against the reference (FrameProducer::measure
 //   fills FrameRecord::quality), hand the frame's FrameRecord to
@@ -49,6 +50,12 @@
 //   the frame draws the last pose again: no pose is sent, no lockstep wait,
 //   pose_to_frame_ms is NaN, and framesRedrawingAPose counts it. The replay
 //   ends when the source has ended and its last pose was drawn.
+// - Answer wait (live, answerWait > 0, ignored in lockstep): after sending a
+//   fresh pose the loop waits up to answerWait for the update answering it,
+//   so a frame can show the plan for its own pose rather than the previous
+//   one; an answer still missing then is counted (answerWaitsExpired), not
+//   logged, and the frame draws what it holds. FrameRecord::ownAnswer says
+//   whether the frame's own answer had arrived, in every mode.
 // - pose_to_frame_ms: every frame with a new pose: clock time when the frame
 //   was read back minus clock time when its pose was sampled: a trace pose
 //   when the frame takes it at its slot, a stream pose when it was read
@@ -173,6 +180,7 @@ class ReplayObserver {
 struct ReplayOptions {
   bool lockstep = false;
   std::chrono::milliseconds lockstepTimeout{5000};
+  std::chrono::milliseconds answerWait{0};  // live only; see "Answer wait"
   double rate = 0.0;          // see the pacing rule above
   std::size_t maxFrames = 0;  // 0: every pose of the trace
   bool measure = true;        // false: no reference, SNR/PSNR missing
@@ -196,6 +204,7 @@ struct ReplayResult {
   // reported as refused in FrameStats.
   std::size_t updatesMissed = 0;
   std::size_t lockstepTimeouts = 0;
+  std::size_t answerWaitsExpired = 0;  // live answer waits that ended without the answer
   std::size_t posesNotSent = 0;  // link down at the time
   std::size_t posesSkipped = 0;  // a stream's poses overtaken by newer ones before a frame
   std::size_t framesRedrawingAPose = 0;

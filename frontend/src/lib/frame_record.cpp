@@ -72,7 +72,7 @@ std::string frameCsvHeader() {
   return "frame,time_s,polygons,link_bytes,target_accuracy,snr_db,psnr_db,render_ms,"
          "pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,reference_ms,wait_ms,"
          "updates_received,updates_rejected,lockstep_timeout,shown_at_ms,visible_objects,"
-         "missing_objects,blank,skinned_objects,deformed_vertices,pose_bytes,points,units\n";
+         "missing_objects,blank,skinned_objects,deformed_vertices,pose_bytes,points,units,own_answer\n";
 }
 
 std::string formatFrameCsvRow(const FrameRecord& r) {
@@ -105,6 +105,7 @@ std::string formatFrameCsvRow(const FrameRecord& r) {
   row += ',' + std::to_string(r.poseBytes);
   row += ',' + std::to_string(r.points);
   row += ',' + formatNumber(r.units, "%.2f");
+  row += r.ownAnswer ? ",1" : ",0";
   row += '\n';
   return row;
 }
@@ -157,6 +158,7 @@ void FrameSummary::add(const FrameRecord& r) {
   polygonSum_ += static_cast<double>(r.polygons);
   polygonsMax_ = std::max(polygonsMax_, r.polygons);
   linkBytesTotal_ += r.linkBytes;
+  if (r.ownAnswer) ++ownAnswerFrames_;
 }
 
 ReplaySummary FrameSummary::summarize() {
@@ -180,6 +182,7 @@ ReplaySummary FrameSummary::summarize() {
   if (frames_ > 0) s.polygonsMean = polygonSum_ / static_cast<double>(frames_);
   s.polygonsMax = polygonsMax_;
   s.linkBytesTotal = linkBytesTotal_;
+  s.ownAnswerFrames = ownAnswerFrames_;
   return s;
 }
 
@@ -207,6 +210,7 @@ std::string summaryJson(const ReplaySummary& s) {
       {"psnr_db", {{"median", jsonNumber(s.psnrMedianDb)}}},
       {"polygons", {{"mean", jsonNumber(s.polygonsMean)}, {"max", s.polygonsMax}}},
       {"link_bytes_total", s.linkBytesTotal},
+      {"own_answer_frames", s.ownAnswerFrames},
   };
   return json.dump(2);
 }

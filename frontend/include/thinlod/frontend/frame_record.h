@@ -101,6 +101,11 @@ struct FrameRecord {
   // backbone's polygon budget counts when hybrids are on).
   std::size_t points = 0;
   double units = kMissing;
+  // The backbone's answer to this frame's own pose (SceneUpdate.frame ==
+  // frame) had arrived when the frame was drawn; false on a frame that sent
+  // no pose. Live without --answer-wait-ms nearly every frame shows the
+  // answer to an earlier pose (docs/frontend.md, "Answer wait").
+  bool ownAnswer = false;
   FrameQuality quality;  // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
 // FrameLog spills pending records as raw bytes.
@@ -110,7 +115,7 @@ static_assert(std::is_trivially_copyable_v<FrameRecord>);
 //  pose_to_frame_ms,update_latency_ms,plan,draw_calls,uploaded_bytes,
 //  reference_ms,wait_ms,updates_received,updates_rejected,lockstep_timeout,
 //  shown_at_ms,visible_objects,missing_objects,blank,skinned_objects,
-//  deformed_vertices,pose_bytes,points,units\n"
+//  deformed_vertices,pose_bytes,points,units,own_answer\n"
 std::string frameCsvHeader();
 // One line, '\n'-terminated, columns as in the header.
 std::string formatFrameCsvRow(const FrameRecord& record);
@@ -154,6 +159,7 @@ struct ReplaySummary {
   double polygonsMean = kMissingValue;
   std::size_t polygonsMax = 0;
   std::uint64_t linkBytesTotal = 0;
+  std::size_t ownAnswerFrames = 0;  // frames drawn with their own pose's answer
 };
 
 // A run's summary, accumulated frame by frame (memory: see the contract).
@@ -171,6 +177,7 @@ class FrameSummary {
   double polygonSum_ = 0.0;
   std::size_t polygonsMax_ = 0;
   std::uint64_t linkBytesTotal_ = 0;
+  std::size_t ownAnswerFrames_ = 0;
   std::vector<double> renderMs_, poseToFrameMs_, updateLatencyMs_, referenceMs_, waitMs_;
   std::vector<double> snrDb_, psnrDb_;  // measured: infinities kept, NaN dropped
 };
@@ -178,7 +185,7 @@ class FrameSummary {
 // A JSON object (nlohmann_json), indented by 2: frames, render_ms,
 // pose_to_frame_ms, update_latency_ms, reference_ms, wait_ms ({count, median,
 // p99, max}), snr_db {count, median, min}, psnr_db {median}, polygons {mean,
-// max}, link_bytes_total.
+// max}, link_bytes_total, own_answer_frames.
 std::string summaryJson(const ReplaySummary& summary);
 
 // frames.csv and the summary of one run.
