@@ -263,6 +263,24 @@ TEST(FrontendSceneSkinned, PosesApplyOnlyToHeldSkinnedObjects) {
   EXPECT_EQ(scene.bonePose(3), nullptr) << "object 3 is not held";
 }
 
+// The upload budget counts a skinned mesh's skin attribute (its own GPU
+// buffer, kGpuSkinBytes a vertex) besides the interleaved vertices.
+TEST(FrontendSceneSkinned, UploadBytesCountTheSkin) {
+  const anim::testing::ArticulatedFigure f = figure();
+  FrontendScene scene;
+  SceneBatch batch;
+  batch.plan = 1;
+  batch.operations = {skinnedOp(1, f, glm::mat4(1.0f))};
+  ASSERT_TRUE(scene.enqueue(std::move(batch)).ok());
+  const std::vector<PendingUpload> uploads = scene.planUploads(1 << 30);
+  ASSERT_EQ(uploads.size(), 1u);
+  const IndexedMesh& mesh = f.mesh;
+  EXPECT_EQ(uploads[0].object->uploadBytes, mesh.vertexCount() * (kGpuVertexBytes + kGpuSkinBytes) +
+                                  mesh.indices.size() * kGpuIndexBytes);
+  EXPECT_EQ(uploadBytesOf(mesh, nullptr, true) - uploadBytesOf(mesh, nullptr),
+            mesh.vertexCount() * kGpuSkinBytes);
+}
+
 TEST(FrontendSceneSkinned, BadSkinsAndPosesRefuseTheBatch) {
   const anim::testing::ArticulatedFigure f = figure();
   FrontendScene scene;

@@ -94,8 +94,9 @@ Status validateRepresentation(const Representation& rep, const std::string& what
 
 }  // namespace
 
-std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture) {
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture, bool skinned) {
   std::size_t bytes = mesh.vertexCount() * kGpuVertexBytes + mesh.indices.size() * kGpuIndexBytes;
+  if (skinned) bytes += mesh.vertexCount() * kGpuSkinBytes;
   if (texture != nullptr) bytes += texture->pixels.size();
   return bytes;
 }
@@ -182,7 +183,8 @@ Status FrontendScene::enqueue(SceneBatch batch) {
       object.triangleCount = rep.mesh->triangleCount();
       object.pointCount = rep.points != nullptr ? rep.points->size() : 0;
       object.uploadBytes =
-          uploadBytesOf(*rep.mesh, rep.texture.get()) + object.pointCount * kGpuDiscBytes;
+          uploadBytesOf(*rep.mesh, rep.texture.get(), rep.skin != nullptr) +
+          object.pointCount * kGpuDiscBytes;
     }
     queued.uploaded.push_back(op.type == SceneOperation::Type::kRemove);
     queued.shownEarly.push_back(false);

@@ -164,7 +164,11 @@ struct SceneLimits {
 constexpr std::size_t kGpuVertexBytes = 40;
 constexpr std::size_t kGpuIndexBytes = 4;
 constexpr std::size_t kGpuDiscBytes = 20;  // DiscRenderer's per-disc instance data
-std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture);
+// A skinned mesh's skin attribute (MeshRenderer::uploadSkinnedMesh: three
+// floats a vertex, two bones and a weight), in its own buffer.
+constexpr std::size_t kGpuSkinBytes = 12;
+// The GPU bytes of uploading `mesh` (with its skin when `skinned`) and `texture`.
+std::size_t uploadBytesOf(const IndexedMesh& mesh, const RgbaImage* texture, bool skinned = false);
 
 // Two counter-clockwise triangles spanning [-0.5, 0.5]^2 at z = 0, facing +z,
 // uv (0,0) at (-0.5,-0.5) and (1,1) at (0.5,0.5): the simple impostor default.
