@@ -281,6 +281,7 @@ std::vector<NamedMessage> seedMessages() {
   hybridOp.representation = sampleRepresentation(RepresentationKind::kHybrid, 260, 0);
   hybridOp.representation.pointCount = 90;
   hybridUpdate.operations.push_back(std::move(hybridOp));
+  hybridUpdate.unitsKappa = 3.0;  // what the plan counted the points with
   out.push_back({"scene_update_hybrid", hybridUpdate});
   // Appended last: tests index the earlier seeds.
   SceneUpdate shared;  // a textured mesh and the shared texture it names

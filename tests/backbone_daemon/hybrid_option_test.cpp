@@ -76,6 +76,8 @@ TEST(BackboneCoreHybrid, OffByDefault) {
     EXPECT_EQ(s.representation, protocol::RepresentationKind::kMesh);
     EXPECT_EQ(s.kappa, 0.0);
   }
+  ASSERT_TRUE((*core)->beginPose(poseAt(0, 0.0, kEntrance, kCow)).ok());
+  EXPECT_EQ((*core)->finishPose().update.unitsKappa, 0.0) << "no hybrids: no kappa";
 }
 
 TEST(BackboneCoreHybrid, KappaOutsideItsRangeIsRefused) {
@@ -187,6 +189,8 @@ TEST(BackboneCoreHybrid, ACheaperHybridIsSentWithinThePolygonBudget) {
     const std::vector<OutgoingRequest> requests = submitAll(core);
     const PoseOutcome outcome = core.finishPose();
     ASSERT_TRUE(outcome.planned) << outcome.planError.toString();
+    // The update names the kappa its units count points with (the frontend's units).
+    EXPECT_EQ(outcome.update.unitsKappa, kKappa);
     for (const auto& op : outcome.update.operations) {
       if (op.type != protocol::SceneOperation::Type::kAddOrReplace) continue;
       if (op.representation.kind == protocol::RepresentationKind::kHybrid) {

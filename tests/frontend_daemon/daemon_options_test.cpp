@@ -92,14 +92,6 @@ TEST(DaemonOptions, OutOfRangeValuesAreNamed) {
   options = validOptions();
   options.frames = -3;
   expectRejected(options, "frames");
-  for (double kappa : {-1.0, 0.5, 1.0, 65.0, std::nan("")}) {
-    options = validOptions();
-    options.replay.hybridKappa = kappa;
-    expectRejected(options, "hybrid-kappa");
-  }
-  options = validOptions();
-  options.replay.hybridKappa = 1.5;  // llvmpipe's sprite kappa
-  EXPECT_TRUE(validateOptions(options).ok());
 }
 
 TEST(DaemonOptions, BackendNames) {

@@ -477,12 +477,17 @@ TEST_F(ReplayLoopTest, EachBatchCarriesThePoseTimeOfThePoseItsUpdateAnswered) {
   EXPECT_DOUBLE_EQ(producer.submittedPoseTimes[2], 0.5);
 }
 
-TEST_F(ReplayLoopTest, PointsAndUnitsOfEachFrameAtTheGivenKappa) {
+// The units are counted with the kappa the backbone's budget counts points
+// with (SceneUpdate.unitsKappa), kept after the update that brought it.
+TEST_F(ReplayLoopTest, PointsAndUnitsOfEachFrameAtTheBackbonesKappa) {
   options.rate = 10.0;
-  options.hybridKappa = 1.5;
   link.responder = [](const protocol::ViewerPose& pose) {
     std::optional<std::pair<std::int64_t, protocol::SceneUpdate>> reply;
-    if (pose.sequence == 0) reply = std::make_pair(0, sphereUpdate(1, 0, 1, 5.0));
+    if (pose.sequence == 0) {
+      protocol::SceneUpdate update = sphereUpdate(1, 0, 1, 5.0);
+      update.unitsKappa = 1.5;
+      reply = std::make_pair(0, std::move(update));
+    }
     return reply;
   };
   producer.points = 30;

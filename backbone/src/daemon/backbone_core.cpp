@@ -1095,6 +1095,7 @@ protocol::SceneUpdate BackboneCore::emptyUpdate(const protocol::ViewerPose& pose
   update.plan = 0;
   update.frame = pose.sequence;
   update.targetAccuracy = 0.0;
+  update.unitsKappa = options_.hybridKappa;
   update.bonePoses = bonePosesAt(pose.timestampNs);
   return update;
 }
@@ -1103,6 +1104,8 @@ PoseOutcome BackboneCore::finishPose() {
   PoseOutcome out;
   out.update.plan = poseCounter_;
   out.update.frame = pose_.sequence;
+  // The frontend counts what it draws in the budget's units with it (frames.csv units).
+  out.update.unitsKappa = options_.hybridKappa;
   out.plans = plansThisPose_;
   out.frontendTriangles = mirror_.triangles();
   inPose_ = false;

@@ -72,10 +72,6 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("label", &o->label, "run name written into the summary");
   runtime.addOption("connect-timeout-ms", &o->connectTimeoutMs,
                     "how long to wait for the backbone handshake before replaying anyway, ms");
-  runtime.addOption("hybrid-kappa", &o->replay.hybridKappa,
-                    "the backbone's --hybrid-kappa (point rate / triangle rate), for frames.csv's "
-                    "units = triangles + points / kappa; 0 = not known (units empty on frames "
-                    "that drew points)");
   runtime.addOption("frame-cost", &o->frameCostPath,
                     "this machine's frame-cost constants (TOML written by bench_calibrate), sent "
                     "to the backbone at hello for its frame-time budget (empty: none)");
@@ -126,12 +122,6 @@ Status validateOptions(const DaemonOptions& o) {
   if (o.dumpEvery < 1) return invalid("dump-every", "must be at least 1");
   if (o.frames < 0) return invalid("frames", "negative");
   if (o.connectTimeoutMs < 0) return invalid("connect-timeout-ms", "negative");
-  if (!(o.replay.hybridKappa == 0.0 ||
-        (o.replay.hybridKappa > 1.0 && o.replay.hybridKappa <= protocol::kMaxKappa))) {
-    return invalid("hybrid-kappa", "0 (not known) or in (1, " +
-                                       std::to_string(static_cast<int>(protocol::kMaxKappa)) +
-                                       "], as the backbone's");
-  }
   return Status();
 }
 

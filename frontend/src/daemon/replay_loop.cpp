@@ -201,6 +201,7 @@ class Replay {
       for (const protocol::BonePose& pose : update.bonePoses)
         record_.poseBytes += kWireBytesPerBoneMatrix * pose.matrices.size();
       notePlanGap(update.plan);
+      if (update.unitsKappa > 0.0) unitsKappa_ = update.unitsKappa;
       if (update.frame < answered_.size()) answered_[update.frame] = true;
       Result<SceneBatch> batch = convertUpdate(update, options_.conversion);
       // The pose time its bone poses were computed for: the timestamp of the
@@ -258,7 +259,7 @@ class Replay {
     record.timeS = pose.time;
     record.polygons = produced.triangles;
     record.points = produced.points;
-    record.units = primitiveUnits(produced.triangles, produced.points, options_.hybridKappa);
+    record.units = primitiveUnits(produced.triangles, produced.points, unitsKappa_);
     record.plan = produced.appliedPlan;
     record.earlyPolygons = std::min(produced.earlyPolygons, produced.triangles);
     record.renderMs = produced.renderMs;
@@ -332,6 +333,7 @@ class Replay {
   std::deque<std::pair<std::uint64_t, int>> refusalsToRepeat_;
   std::uint64_t lastPlanSeen_ = 0;  // the highest plan number of this backbone process
   double targetAccuracy_ = kMissingValue;
+  double unitsKappa_ = 0.0;  // the newest SceneUpdate.unitsKappa > 0 (0: none yet)
   std::optional<std::int64_t> firstSampledNs_;  // frame 0's pose
   FrameRecord record_;                          // the frame being made
   bool poseSent_ = false;                       // this frame's pose went out

@@ -68,7 +68,8 @@
 //   bone poses of the updates received since then, 48 bytes a matrix (also
 //   those of updates then rejected: they crossed the link).
 // - points: hybrid discs drawn; units: primitiveUnits(triangles, points,
-//   options.hybridKappa) (frame_record.h).
+//   kappa) (frame_record.h), kappa the SceneUpdate.unitsKappa of the newest
+//   update received with one (> 0): what the backbone's budget counts.
 // - Errors: a failed render or measurement ends the replay; the frames so
 //   far have been handed on and the Status is in ReplayResult::status.
 // - Single-threaded; the interfaces are called from the caller's thread.
@@ -188,10 +189,6 @@ struct ReplayOptions {
   std::uint32_t viewportWidth = 0;
   std::uint32_t viewportHeight = 0;
   std::chrono::milliseconds pollSlice{50};
-  // The point rate the backbone prices hybrids with (its --hybrid-kappa), for
-  // the record's units = triangles + points / kappa; 0 = not known (units
-  // then missing on frames that drew points).
-  double hybridKappa = 0.0;
   ConversionOptions conversion;
 };
 

@@ -153,7 +153,7 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Scene
   }
   auto posesVector = poses.empty() ? 0 : b.CreateVector(poses);
   auto t = w::CreateSceneUpdate(b, m.plan, m.frame, m.targetAccuracy, opsVector, texturesVector,
-                                posesVector);
+                                posesVector, m.unitsKappa);
   return {w::Body::SceneUpdate, t.Union()};
 }
 
@@ -452,6 +452,7 @@ Result<Message> fromWire(const FieldPath& path, const w::SceneUpdate* m) {
   out.plan = m->plan();
   out.frame = m->frame();
   out.targetAccuracy = m->target_accuracy();
+  out.unitsKappa = m->units_kappa();
   const auto* ops = m->operations();
   THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("operations"), ops, kMaxSceneOperations));
   if (ops != nullptr) {

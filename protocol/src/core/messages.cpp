@@ -97,7 +97,8 @@ bool operator==(const BonePose& a, const BonePose& b) {
 }
 bool operator==(const SceneUpdate& a, const SceneUpdate& b) {
   return a.plan == b.plan && a.frame == b.frame && a.targetAccuracy == b.targetAccuracy &&
-         a.operations == b.operations && a.textures == b.textures && a.bonePoses == b.bonePoses;
+         a.operations == b.operations && a.textures == b.textures && a.bonePoses == b.bonePoses &&
+         a.unitsKappa == b.unitsKappa;
 }
 bool operator==(const FrameStats& a, const FrameStats& b) {
   return a.frame == b.frame && a.plan == b.plan && a.timestampNs == b.timestampNs &&

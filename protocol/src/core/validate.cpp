@@ -182,7 +182,8 @@ Status checkPointCount(const FieldPath& path, RepresentationKind kind, std::uint
   return Status();
 }
 
-// kappa of a hybrid request or result: 0 (request: the default) or in [1, kMaxKappa].
+// kappa of a hybrid request or result (or a SceneUpdate's units_kappa, checked
+// as a hybrid's): 0 (request: the default; update: no hybrids) or in [1, kMaxKappa].
 Status checkKappa(const FieldPath& path, RepresentationKind kind, double kappa, bool allowZero) {
   THINLOD_RETURN_IF_ERROR(checkFinite(path, kappa));
   if (kind != RepresentationKind::kHybrid) {
@@ -352,6 +353,8 @@ Status check(const FieldPath& path, const ViewerPose& m) {
 
 Status check(const FieldPath& path, const SceneUpdate& m) {
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("target_accuracy"), m.targetAccuracy));
+  THINLOD_RETURN_IF_ERROR(
+      checkKappa(path.child("units_kappa"), RepresentationKind::kHybrid, m.unitsKappa, true));
   THINLOD_RETURN_IF_ERROR(checkCount(path.child("textures"), m.textures.size(), kMaxSharedTextures));
   std::vector<std::uint64_t> textureIds;
   textureIds.reserve(m.textures.size());

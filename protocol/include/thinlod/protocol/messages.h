@@ -205,6 +205,10 @@ struct SceneUpdate {
   // The animated objects' poses for this frame (at most kMaxBonePoses, object
   // ids unique), applied after the operations.
   std::vector<BonePose> bonePoses;
+  // The kappa the plan's polygon budget counts hybrid points with (units =
+  // triangles + points / kappa): the backbone's --hybrid-kappa; 0 when it
+  // offers no hybrids. 0 or in [1, kMaxKappa].
+  double unitsKappa = 0.0;
 };
 
 struct FrameStats {
