@@ -804,6 +804,35 @@ Status checkObjStatementsForAssimp(const std::string& path, std::string_view tex
                         std::string(statement.substr(0, 32)) +
                         "' is not read (v vt vn f o g s mtllib usemtl only)");
     }
+    // Assimp reads a vertex of 3, 4 (x y z w) or 6 (x y z r g b) numbers and
+    // skips one of any other count without an error, so every later face
+    // named other vertices there than here; a face past its vertices then
+    // made it throw and leak the meshes it had built (fuzz finding 43: a
+    // 5-number vertex). Texture coordinates have 2 or 3 numbers there,
+    // normals 3.
+    if (statement == "v" || statement == "vt" || statement == "vn") {
+      std::string_view rest = tokenEnd == std::string_view::npos ? std::string_view()
+                                                                   : line.substr(tokenEnd);
+      rest = rest.substr(0, rest.find('#'));
+      std::size_t values = 0;
+      for (std::size_t i = 0; i < rest.size();) {
+        i = rest.find_first_not_of(" \t\r", i);
+        if (i == std::string_view::npos) break;
+        ++values;
+        i = rest.find_first_of(" \t\r", i);
+        if (i == std::string_view::npos) break;
+      }
+      const bool read = statement == "v"    ? values == 3 || values == 4 || values == 6
+                        : statement == "vt" ? values == 2 || values == 3
+                                            : values == 3;
+      if (!read) {
+        return Status(ErrorCode::kParseError,
+                      path + ":" + std::to_string(number) + ": OBJ '" + std::string(statement) +
+                          "' with " + std::to_string(values) + " values (Assimp reads " +
+                          (statement == "v" ? "3, 4 or 6" : statement == "vt" ? "2 or 3" : "3") +
+                          ")");
+      }
+    }
     return Status();
   });
 }

@@ -65,7 +65,9 @@ Status precheckFbx(const std::string& path, std::string_view bytes, const Import
 // line is blank, a comment or one of v vt vn f o g s mtllib usemtl, and
 // there is no NUL byte. Assimp dispatches on a line's first characters, so
 // a statement the mesh pre-check skips ("fox ...") was a face to it and its
-// number parsing read past the buffer (fuzz finding 34).
+// number parsing read past the buffer (fuzz finding 34). A v line holds
+// 3, 4 or 6 values, vt 2 or 3, vn 3: Assimp silently skips a vertex of
+// another count, and the faces after it named other vertices (finding 43).
 Status checkObjStatementsForAssimp(const std::string& path, std::string_view text);
 
 // RFC 4648 base64 with padding: A-Z a-z 0-9 + /, '=' only as the last one or
