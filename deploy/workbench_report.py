@@ -419,6 +419,9 @@ def write_doc(doc, out_dir, settings, metrics, table_text, plots):
 
 
 def main(argv):
+    if "-h" in argv or "--help" in argv:
+        print(__doc__)
+        return 0
     doc, from_time = None, None
     if "--from-time" in argv:
         i = argv.index("--from-time")

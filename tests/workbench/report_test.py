@@ -106,6 +106,20 @@ class HybridUnits(unittest.TestCase):
         self.assertEqual(m["polygons_max"], 180)
 
 
+class CommandLine(unittest.TestCase):
+    def test_help_prints_the_usage_and_succeeds(self):
+        done = subprocess.run([sys.executable, os.path.join(SOURCE, "deploy", "workbench_report.py"),
+                               "--help"], capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertIn("Usage: deploy/workbench_report.py RESULTS_DIR", done.stdout)
+
+    def test_a_missing_folder_is_a_usage_error(self):
+        done = subprocess.run([sys.executable, os.path.join(SOURCE, "deploy", "workbench_report.py")],
+                              capture_output=True, text=True)
+        self.assertEqual(done.returncode, 2)
+        self.assertIn("Usage:", done.stderr)
+
+
 class OwnAnswer(unittest.TestCase):
     """frames.csv's own_answer column: the share of frames drawn with their own pose's answer,
     and the answer wait in the mode cell."""
