@@ -566,6 +566,81 @@ TEST(SceneTextures, UnresolvableTexturesAreWarningsAndStayUntextured) {
   fs::remove_all(dir);
 }
 
+// Fuzz finding 44: Debian's Assimp asserts (and so aborts the process) when
+// a triangles, polylist or polygons element's count is not the number of
+// primitives its index lists hold; and the SEGV that led there came from two
+// float_arrays with one id (the accessor check took the second's count, Assimp
+// read the first). Both are refused before Assimp; lines and strips, which
+// Assimp does not assert on, are not counted.
+TEST(SceneImport, ColladaPrimitiveCountsAndArrayIdsAreCheckedBeforeAssimp) {
+  const std::string seeds = std::string(THINLOD_TEST_DATA_DIR) + "/../../fuzz/corpus/imported_scene/";
+  std::ifstream in(seeds + "instanced_triangle.dae");
+  const std::string seed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(seed.empty());
+  const std::string dir = testing::TempDir() + "/collada-counts-" + std::to_string(::getpid());
+  fs::create_directories(dir);
+  const std::string path = dir + "/model.dae";
+  auto import = [&](const std::string& text) {
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
+    return importScene(path);
+  };
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = seed;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  const std::string triangles =
+      "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+      "<p>0 1 2</p></triangles>";
+  ASSERT_NE(seed.find(triangles), std::string::npos);
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"<triangles count=\"1\"></triangles>", "declares count 1"},  // the minimized input
+      {"<triangles count=\"2\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<p>0 1 2</p></triangles>",
+       "declares count 2"},
+      {"<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<p>0 1 2 0</p></triangles>",
+       "declares count 1"},
+      // Two inputs at offsets 0 and 1: a triangle takes 6 indices.
+      {"<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<input semantic=\"NORMAL\" source=\"#tri-pos\" offset=\"1\"/><p>0 1 2</p></triangles>",
+       "of 2 inputs each"},
+      {"<polylist count=\"2\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<vcount>3</vcount><p>0 1 2</p></polylist>",
+       "declares count 2"},
+      {"<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<vcount>4</vcount><p>0 1 2</p></polylist>",
+       "declares count 1"},
+      {"<polygons count=\"2\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" offset=\"0\"/>"
+       "<p>0 1 2</p></polygons>",
+       "declares count 2"}};
+  for (const auto& [primitive, why] : refused) {
+    const Result<Scene> r = import(with(triangles, primitive));
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << primitive;
+    EXPECT_NE(r.status().message().find(why), std::string::npos)
+        << primitive << ": " << r.status().toString();
+  }
+  for (const std::string& primitive :
+       {triangles,
+        std::string("<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" "
+                    "offset=\"0\"/><vcount>3</vcount><p>0 1 2</p></polylist>"),
+        std::string("<polygons count=\"1\"><input semantic=\"VERTEX\" source=\"#tri-vtx\" "
+                    "offset=\"0\"/><p>0 1 2</p></polygons>")}) {
+    const Result<Scene> r = import(with(triangles, primitive));
+    EXPECT_TRUE(r.ok()) << primitive << ": " << r.status().toString();
+  }
+  // A second array with the first's id.
+  const Result<Scene> twice = import(with(
+      "</source>", "</source><source id=\"other\"><float_array id=\"tri-pos-array\" count=\"9\">"
+                   "0 0 0 0 0 0 0 0 0</float_array></source>"));
+  EXPECT_EQ(twice.status().code(), ErrorCode::kParseError);
+  EXPECT_NE(twice.status().message().find("a second data array with id \"tri-pos-array\""),
+            std::string::npos)
+      << twice.status().toString();
+  fs::remove_all(dir);
+}
+
 // The imported_scene fuzzer's hand-written seeds (fuzz/imported_scene.cpp)
 // get past the front door, so its campaign starts from files every reader
 // accepts: a Collada triangle instanced twice through library_nodes, and a

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 #include <vector>
@@ -221,22 +222,39 @@ bool isIndexList(std::string_view name) {
   return name == "p" || name == "vcount" || name == "v" || name == "h";
 }
 
-// Whitespace-separated decimal integers in [0, 2^31).
-bool allUnsignedIntegers(std::string_view text) {
+// Whitespace-separated decimal integers in [0, 2^31); their number and sum
+// are added to *count and *sum.
+bool allUnsignedIntegers(std::string_view text, std::uint64_t* count, std::uint64_t* sum) {
   std::size_t digits = 0;
   std::uint64_t value = 0;
+  auto finish = [&] {
+    if (digits == 0) return;
+    ++*count;
+    *sum += value;
+  };
   for (const char c : text) {
     if (c >= '0' && c <= '9') {
       value = value * 10 + static_cast<std::uint64_t>(c - '0');
       if (++digits > 10 || value >= (std::uint64_t{1} << 31)) return false;
     } else if (isXmlSpace(c)) {
+      finish();
       digits = 0;
       value = 0;
     } else {
       return false;
     }
   }
+  finish();
   return true;
+}
+
+// A primitive element whose declared count Assimp checks with an assert
+// (ColladaParser::ReadPrimitives: `actualPrimitives == numPrimitives`; the
+// Debian library is built with asserts on, so a mismatch aborted the whole
+// process: fuzz finding 44). lines, linestrips, trifans and tristrips are
+// exempt there (a SketchUp workaround) and here.
+bool isCountedPrimitive(std::string_view name) {
+  return name == "triangles" || name == "polylist" || name == "polygons";
 }
 
 bool isArrayElement(std::string_view name) {
@@ -281,6 +299,50 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     std::uint64_t count, stride;
   };
   std::vector<Accessor> accessors;
+  // The counted primitive being read (isCountedPrimitive): its declared
+  // count, its inputs' offsets (Assimp's numOffsets: the largest + 1) and
+  // what its index lists hold.
+  struct Primitive {
+    std::string_view name;
+    std::size_t depth = 0;  // open.size() inside it
+    std::uint64_t count = 0;
+    std::uint64_t offsets = 1;
+    std::uint64_t indices = 0;  // in its <p> lists
+    std::uint64_t lists = 0;    // <p> lists
+    std::uint64_t vcountEntries = 0;
+    std::uint64_t vcountSum = 0;
+    bool holes = false;  // a polygons' <ph>: not checked
+    std::size_t at = 0;
+  };
+  std::optional<Primitive> primitive;
+  auto checkPrimitive = [&](const Primitive& p) {
+    if (p.offsets > (std::uint64_t{1} << 16)) {
+      return Status(ErrorCode::kParseError, path + ": <" + std::string(p.name) + "> at byte " +
+                                                std::to_string(p.at) + ": an input offset of " +
+                                                std::to_string(p.offsets - 1));
+    }
+    // Division, not products: the declared numbers are the file's.
+    std::uint64_t actual = 0;
+    bool whole = true;  // the index lists hold whole primitives, nothing over
+    if (p.name == "triangles") {
+      actual = p.indices / (3 * p.offsets);
+      whole = p.indices % (3 * p.offsets) == 0;
+    } else if (p.name == "polylist") {
+      actual = p.vcountEntries;
+      whole = p.indices % p.offsets == 0 && p.indices / p.offsets == p.vcountSum;
+    } else {
+      actual = p.lists;
+    }
+    if (p.holes) return Status();
+    if (actual != p.count || !whole) {
+      return Status(ErrorCode::kParseError,
+                    path + ": <" + std::string(p.name) + "> at byte " + std::to_string(p.at) +
+                        " declares count " + std::to_string(p.count) + " but its index lists hold " +
+                        std::to_string(p.indices) + " indices for " + std::to_string(actual) +
+                        " primitives of " + std::to_string(p.offsets) + " inputs each");
+    }
+    return Status();
+  };
   auto unterminated = [&](const char* what, std::size_t at) {
     return Status(ErrorCode::kParseError, path + ": unterminated " + std::string(what) +
                                               " at byte " + std::to_string(at) +
@@ -338,6 +400,10 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
                                                   std::to_string(i));
       }
       open.pop_back();
+      if (primitive && primitive->name == name && primitive->depth == open.size() + 1) {
+        THINLOD_RETURN_IF_ERROR(checkPrimitive(*primitive));
+        primitive.reset();
+      }
       continue;
     }
     // One document element: Assimp reads the first and stops, while this
@@ -389,19 +455,57 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
       // the billions and asked for 3 GB (fuzz finding 35): index lists hold
       // unsigned integers only.
       const std::size_t textEnd = std::min(xml.find('<', i), xml.size());
-      if (!allUnsignedIntegers(xml.substr(i, textEnd - i))) {
+      std::uint64_t values = 0;
+      std::uint64_t sum = 0;
+      const bool inPrimitive = primitive && open.size() == primitive->depth;
+      if (!allUnsignedIntegers(xml.substr(i, textEnd - i), &values, &sum)) {
         return Status(ErrorCode::kParseError,
                       path + ": <" + std::string(name) + "> at byte " + std::to_string(i) +
                           " must hold unsigned integers (indices below 2^31) only");
       }
+      if (inPrimitive && name == "p") {
+        primitive->indices += values;
+        ++primitive->lists;
+      } else if (inPrimitive && name == "vcount") {
+        primitive->vcountEntries += values;
+        primitive->vcountSum += sum;
+      } else if (inPrimitive && name == "h") {
+        primitive->holes = true;
+      }
     } else if (isArrayElement(name)) {
+      // Two data arrays with one id: the accessor check took the second's
+      // count while Assimp read the first, past its end (fuzz finding 44's
+      // input; ids are unique in XML).
       const std::string_view id = attribute(attributes, "id");
-      if (!id.empty()) arrayCount[id] = number(attribute(attributes, "count"), 0);
+      if (!id.empty() && !arrayCount.emplace(id, number(attribute(attributes, "count"), 0)).second) {
+        return Status(ErrorCode::kParseError, path + ": a second data array with id \"" +
+                                                  std::string(id.substr(0, 64)) + "\" at byte " +
+                                                  std::to_string(i));
+      }
     } else if (name == "accessor") {
       std::string_view source = attribute(attributes, "source");
       if (!source.empty() && source.front() == '#') source.remove_prefix(1);
       accessors.push_back({source, number(attribute(attributes, "count"), 0),
                            number(attribute(attributes, "stride"), 1)});
+    }
+    if (isCountedPrimitive(name) && !primitive) {
+      Primitive p;
+      p.name = name;
+      p.depth = open.size() + 1;
+      p.count = number(attribute(attributes, "count"), 0);
+      p.at = i;
+      if (selfClosing) {
+        THINLOD_RETURN_IF_ERROR(checkPrimitive(p));
+      } else {
+        primitive = p;
+      }
+    } else if (name == "input" && primitive && open.size() == primitive->depth) {
+      const std::string_view offset = attribute(attributes, "offset");
+      if (!offset.empty()) {
+        primitive->offsets = std::max(primitive->offsets, number(offset, 0) + 1);
+      }
+    } else if (name == "ph" && primitive && open.size() == primitive->depth) {
+      primitive->holes = true;
     }
     if (selfClosing) continue;
     open.push_back({name, self});
