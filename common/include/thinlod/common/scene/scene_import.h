@@ -38,6 +38,9 @@
 // - Transforms must be translation * rotation * scale (glTF requires that);
 //   a sheared node matrix is kUnsupported. Cameras, lights, animations and
 //   skins are ignored here (skinned_import.h reads skins and clips).
+// - An assertion inside Assimp (Debian builds it with them on) fails the
+//   import with its message instead of aborting the process (the
+//   executable's Assimp::aiAssertViolation throws: assimp_import.cpp).
 // - Thread-safe: one Assimp::Importer per call, no shared state.
 #pragma once
 
