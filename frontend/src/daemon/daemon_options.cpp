@@ -40,7 +40,7 @@ void registerOptions(protocol::DaemonRuntime& runtime, DaemonOptions* o) {
   runtime.addOption("answer-wait-ms", &o->answerWaitMs,
                     "live (not lockstep): after sending a pose, wait up to this long for the "
                     "backbone's answer to it before drawing, so a frame can show the plan for "
-                    "its own pose; 0 = draw at once (the answer shows a frame later)");
+                    "its own pose; 0 = draw at once (an answer not there yet shows a frame later)");
   runtime.addOption("max-upload-bytes-per-frame", &o->maxUploadBytesPerFrame,
                     "representation bytes uploaded to the GPU per frame; 0 = unbounded");
   runtime.addOption("csv", &o->csvPath, "per-frame CSV output (empty: none)");

@@ -103,8 +103,8 @@ struct FrameRecord {
   double units = kMissing;
   // The backbone's answer to this frame's own pose (SceneUpdate.frame ==
   // frame) had arrived when the frame was drawn; false on a frame that sent
-  // no pose. Live without --answer-wait-ms nearly every frame shows the
-  // answer to an earlier pose (docs/frontend.md, "Answer wait").
+  // no pose. Live without --answer-wait-ms it depends on the planning time
+  // (docs/frontend.md, "Answer wait").
   bool ownAnswer = false;
   FrameQuality quality;  // snr_db, psnr_db, reference_ms, visible/missing, blank
 };
