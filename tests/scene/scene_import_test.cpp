@@ -42,6 +42,31 @@ std::string dataPath(const std::string& file) {
   return std::string(THINLOD_TEST_DATA_DIR) + "/import/" + file;
 }
 
+// One file in a directory of its own under TempDir() (per process: ctest runs
+// tests side by side), rewritten and imported by each import(text); the
+// directory goes with the object.
+class ScratchImport {
+ public:
+  ScratchImport(const std::string& directory, const std::string& file)
+      : dir_(testing::TempDir() + "/" + directory + "-" + std::to_string(::getpid())),
+        path_(dir_ + "/" + file) {
+    fs::create_directories(dir_);
+  }
+  ~ScratchImport() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  const std::string& path() const { return path_; }
+  Result<Scene> import(const std::string& text) const {
+    { std::ofstream(path_, std::ios::binary | std::ios::trunc) << text; }
+    return importScene(path_);
+  }
+
+ private:
+  std::string dir_;
+  std::string path_;
+};
+
 std::vector<const ShapeNode*> distinctShapes(const Scene& scene) {
   std::vector<const ShapeNode*> shapes;
   std::set<const Node*> seen;
@@ -339,13 +364,8 @@ TEST(SceneImport, PackageInvalidFilesAreRefusedCleanly) {
 // threw inside it. ASCII FBX is parsed by the pre-check's replay of
 // Assimp's tokenizer and grammar first; what it would throw on is refused.
 TEST(SceneImport, AsciiFbxThatAssimpsParserWouldThrowOnIsRefusedBeforeIt) {
-  const std::string dir = testing::TempDir() + "/fbx-precheck-" + std::to_string(::getpid());
-  fs::create_directories(dir);
-  const std::string path = dir + "/model.fbx";
-  auto import = [&](const std::string& text) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
-    return importScene(path);
-  };
+  const ScratchImport scratch("fbx-precheck", "model.fbx");
+  auto import = [&](const std::string& text) { return scratch.import(text); };
   std::ifstream in("/usr/share/assimp/models/FBX/cubes_with_names.fbx", std::ios::binary);
   const std::string cubes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(cubes.empty()) << "deploy/setup installs the Debian package assimp-testmodels";
@@ -379,7 +399,6 @@ TEST(SceneImport, AsciiFbxThatAssimpsParserWouldThrowOnIsRefusedBeforeIt) {
     EXPECT_NE(r.status().message().find(why), std::string::npos)
         << why << ": " << r.status().toString();
   }
-  fs::remove_all(dir);
 }
 
 TEST(SceneImport, ObjStatementsOutsideTheReadListAreRefusedBeforeAssimp) {
@@ -598,13 +617,8 @@ TEST(SceneImport, ColladaPrimitiveCountsAndArrayIdsAreCheckedBeforeAssimp) {
   std::ifstream in(seeds + "instanced_triangle.dae");
   const std::string seed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(seed.empty());
-  const std::string dir = testing::TempDir() + "/collada-counts-" + std::to_string(::getpid());
-  fs::create_directories(dir);
-  const std::string path = dir + "/model.dae";
-  auto import = [&](const std::string& text) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << text; }
-    return importScene(path);
-  };
+  const ScratchImport scratch("collada-counts", "model.dae");
+  auto import = [&](const std::string& text) { return scratch.import(text); };
   auto with = [&](const std::string& from, const std::string& to) {
     std::string text = seed;
     const std::size_t at = text.find(from);
@@ -659,7 +673,6 @@ TEST(SceneImport, ColladaPrimitiveCountsAndArrayIdsAreCheckedBeforeAssimp) {
   EXPECT_NE(twice.status().message().find("a second data array with id \"tri-pos-array\""),
             std::string::npos)
       << twice.status().toString();
-  fs::remove_all(dir);
 }
 
 // The imported_scene fuzzer's hand-written seeds (fuzz/imported_scene.cpp)
