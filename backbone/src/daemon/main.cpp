@@ -105,6 +105,10 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "result times (at least --generation-delay) instead of the fixed delay");
   runtime.addOption("fill-budget", &config.fillBudget,
                     "curves: spend what the uniform target leaves of the budget (=false: off)");
+  runtime.addOption("budget-reserve-share", &config.budgetReserveShare,
+                    "curves: share of each budget the uniform target leaves for keeping copies "
+                    "and for the budget fill, in [0, 1); more lowers the reported target and "
+                    "lets the fill spend more where the image gains most");
   runtime.addOption("minimal-distance", &config.minimalDistance,
                     "lower clamp of the viewer-object distance (m)");
   runtime.addOption("sync-wait-ms", &s.syncWaitMs,
