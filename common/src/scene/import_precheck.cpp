@@ -624,7 +624,15 @@ Status precheckSmd(const std::string& path, std::string_view bytes) {
     const std::size_t comment = line.find("//");
     if (comment != std::string_view::npos) line = line.substr(0, comment);
     if (!smdTokens(line, tokens)) return refuse("a quote is not closed");
-    if (tokens.empty()) return Status();
+    if (tokens.empty()) {
+      // Assimp's reader loops for good on a line of only spaces or tabs in
+      // the nodes section (fuzz finding 46; an empty line, or one starting
+      // with a comment, is fine there; `line` is cut at its comment).
+      if (section == Section::kNodes && !line.empty()) {
+        return refuse("a line of only white space in the nodes section");
+      }
+      return Status();
+    }
     if (!sawVersion) {
       if (tokens.size() != 2 || tokens[0] != "version" || tokens[1] != "1") {
         return refuse("the file must start with 'version 1'");
