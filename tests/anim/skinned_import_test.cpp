@@ -129,6 +129,8 @@ TEST(SkinnedImport, TruncatedOrMalformedSmdAndUntestedFormatsAreRefusedBeforeAss
         // Fuzz finding 46: a line of only white space among the nodes
         // (Assimp's reader looped for good on it).
         std::string(valid).replace(valid.find("1 \"arm\" 0\n"), 0, " \t\n"),
+        // Fuzz finding 47: the nodes' "end" after white space (the same loop).
+        std::string(valid).replace(valid.find("end\nskeleton"), 0, "\t"),
         // Fuzz finding 45: a form feed before a material name (Assimp read on
         // out of step and asked for 1.6 GB); any control character but a tab.
         std::string(valid).replace(valid.find("skin\n"), 5, "\fskin\n"),
