@@ -94,18 +94,22 @@ class Replay {
           fresh ? source_.lastArrivalNs().value_or(clock_.nowNs()) : clock_.nowNs();
       const std::int64_t sentNs = fresh ? sendPose(pose, i) : clock_.nowNs();
       absorb(link_.poll(std::chrono::milliseconds(0)));
-      if (options_.lockstep && poseSent_) {
-        waitUntil(sentNs + options_.lockstepTimeout.count() * 1'000'000LL,
+      // One wait for this pose's answer: lockstep's (a miss is reported) or
+      // the live answer wait's (a miss is only counted).
+      const std::chrono::milliseconds answerWait =
+          options_.lockstep ? options_.lockstepTimeout : options_.answerWait;
+      if (poseSent_ && (options_.lockstep || answerWait.count() > 0)) {
+        waitUntil(sentNs + answerWait.count() * 1'000'000LL,
                   [&] { return answered_[i] || !link_.connected(); });
         if (!answered_[i] && link_.connected() && !stop_()) {
-          record_.lockstepTimedOut = true;
-          ++result_.lockstepTimeouts;
-          observer_.onLockstepTimeout(i, (clock_.nowNs() - sentNs) / kNsPerMs);
+          if (options_.lockstep) {
+            record_.lockstepTimedOut = true;
+            ++result_.lockstepTimeouts;
+            observer_.onLockstepTimeout(i, (clock_.nowNs() - sentNs) / kNsPerMs);
+          } else {
+            ++result_.answerWaitsExpired;
+          }
         }
-      } else if (options_.answerWait.count() > 0 && poseSent_) {
-        waitUntil(sentNs + options_.answerWait.count() * 1'000'000LL,
-                  [&] { return answered_[i] || !link_.connected(); });
-        if (!answered_[i] && link_.connected() && !stop_()) ++result_.answerWaitsExpired;
       }
       record_.ownAnswer = poseSent_ && answered_[i];
       record_.waitMs = (clock_.nowNs() - sentNs) / kNsPerMs;
