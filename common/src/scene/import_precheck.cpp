@@ -321,6 +321,7 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
                                                 std::to_string(p.at) + ": an input offset of " +
                                                 std::to_string(p.offsets - 1));
     }
+    if (p.holes) return Status();
     // Division, not products: the declared numbers are the file's.
     std::uint64_t actual = 0;
     bool whole = true;  // the index lists hold whole primitives, nothing over
@@ -333,7 +334,6 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     } else {
       actual = p.lists;
     }
-    if (p.holes) return Status();
     if (actual != p.count || !whole) {
       return Status(ErrorCode::kParseError,
                     path + ": <" + std::string(p.name) + "> at byte " + std::to_string(p.at) +
@@ -469,8 +469,6 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
       } else if (inPrimitive && name == "vcount") {
         primitive->vcountEntries += values;
         primitive->vcountSum += sum;
-      } else if (inPrimitive && name == "h") {
-        primitive->holes = true;
       }
     } else if (isArrayElement(name)) {
       // Two data arrays with one id: the accessor check took the second's
