@@ -120,6 +120,23 @@ TEST(BudgetFill, ImageErrorFollowsProjectedSizeAndAccuracy) {
   EXPECT_TRUE(std::isinf(fillImageError(1.0, 10.0, 0.0, 1.0)));
 }
 
+// The shading term adds weight / sqrt(a) per projected area: it dominates at
+// high accuracy (a faceted curved surface still shades wrongly where its
+// silhouette is already right), so the fill prefers the large smooth object.
+TEST(BudgetFill, ShadingTermWeighsAccuracyBySquareRoot) {
+  EXPECT_DOUBLE_EQ(fillImageError(1.0, 10.0, 4.0, 1.0, 0.0), fillImageError(1.0, 10.0, 4.0, 1.0));
+  EXPECT_DOUBLE_EQ(fillImageError(1.0, 10.0, 4.0, 1.0, 2.0), 0.01 * (0.25 + 2.0 / 2.0));
+  EXPECT_DOUBLE_EQ(fillImageError(1.0, 10.0, 100.0, 0.5, 1.0), 0.5 * 0.01 * (0.01 + 0.1));
+  // Raising a from 100 to 400 on a near object gains more than raising a
+  // far one from 4 to 16 with the term, less without it.
+  const auto gain = [](double distance, double from, double to, double weight) {
+    return fillImageError(1.0, distance, from, 1.0, weight) -
+           fillImageError(1.0, distance, to, 1.0, weight);
+  };
+  EXPECT_LT(gain(1.0, 100.0, 400.0, 0.0), gain(4.0, 4.0, 16.0, 0.0));
+  EXPECT_GT(gain(1.0, 100.0, 400.0, 1.0), gain(4.0, 4.0, 16.0, 1.0));
+}
+
 // Random items (including free upgrades, link costs, extreme magnitudes):
 // the caps hold, no item ends with a larger error, and when no item can
 // take even its next-cheapest upgrade the room left is below that step.

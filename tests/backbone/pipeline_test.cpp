@@ -232,6 +232,14 @@ TEST(Config, RejectsInvalidValues) {
   c = SchedulerConfig{};
   c.maxSpeed = std::nan("");
   EXPECT_FALSE(validateConfig(c).ok());
+  for (double weight : {-0.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    c = SchedulerConfig{};
+    c.fillShadingWeight = weight;
+    EXPECT_NE(validateConfig(c).message().find("fillShadingWeight"), std::string::npos) << weight;
+  }
+  c = SchedulerConfig{};
+  c.fillShadingWeight = 2.0;
+  EXPECT_TRUE(validateConfig(c).ok());
 }
 
 TEST(DecisionRowCsv, HeaderAndRowHaveTheSameColumns) {

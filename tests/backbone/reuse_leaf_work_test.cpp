@@ -117,7 +117,7 @@ TEST(ReuseLeafWork, SamePlansAsTheReferencePathAlongFlights) {
 }
 
 // Randomized: scene shape (size, LOD share, fanout, radii, options), config
-// (paper or exact, merge factor, tolerance), budget kind (polygon, link,
+// (paper or exact, merge factor, tolerance, fill shading weight), budget kind (polygon, link,
 // both, fixed accuracy alone or capped) and a random walk of the viewer are
 // drawn from fixed seeds; the fast path must reach the same target and
 // choose the same representation for every object as the reference path.
@@ -145,6 +145,9 @@ TEST(ReuseLeafWork, RandomScenesGiveTheReferencePlans) {
     if (u(rng) < 0.3) config = withoutApproximations(config);
     if (u(rng) < 0.5) config.mergeDistanceFactor = 1.0 + 6.0 * u(rng);
     if (u(rng) < 0.3) config.curveTolerance = 0.0;
+    // The fill's shading term on every other seed (no draw: the other
+    // seeds' scenes and walks stay as they were).
+    if (seed % 2 == 0) config.fillShadingWeight = 1.0;
     Budget budget;
     const int kind = static_cast<int>(u(rng) * 5);  // polygon, link, both, fixed, fixed+polygon
     const double perObject = std::pow(10.0, 0.5 + 2.5 * u(rng));

@@ -109,6 +109,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "curves: share of each budget the uniform target leaves for keeping copies "
                     "and for the budget fill, in [0, 1); more lowers the reported target and "
                     "lets the fill spend more where the image gains most");
+  runtime.addOption("fill-shading-weight", &config.fillShadingWeight,
+                    "curves: weight of the shading term (1 / sqrt(accuracy)) in the budget fill's "
+                    "image error, next to the silhouette's 1 / accuracy (0: silhouette only)");
   runtime.addOption("minimal-distance", &config.minimalDistance,
                     "lower clamp of the viewer-object distance (m)");
   runtime.addOption("sync-wait-ms", &s.syncWaitMs,

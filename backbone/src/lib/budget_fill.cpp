@@ -37,10 +37,12 @@ bool finiteCost(const FillOption& o) {
 
 }  // namespace
 
-double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen) {
+double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen,
+                      double shadingWeight) {
   if (!(frameAccuracy > 0.0) || !(distance > 0.0)) return kInf;
   const double size = diameter / distance;
-  return onScreen * size * size / frameAccuracy;
+  const double perArea = 1.0 / frameAccuracy + shadingWeight / std::sqrt(frameAccuracy);
+  return onScreen * size * size * perArea;
 }
 
 std::vector<double> fillTriangleLadder(double limit) {
@@ -290,7 +292,8 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
     FillItem item;
     std::vector<OptionSource> itemSources;
     // The current pick first (its own cost, as the push-down charged it).
-    item.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, onScreen),
+    item.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, onScreen,
+                                           config.fillShadingWeight),
                             s.cost.triangles, s.cost.linkBytes, 1.0});
     itemSources.push_back({0, -1.0});
     const double floor = s.need * (1.0 - kAccuracyTolerance);
@@ -301,9 +304,9 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
         if (k.fixedTriangles - s.cost.triangles > roomTriangles ||
             k.fixedLinkBytes - s.cost.linkBytes > roomLink)
           continue;
-        item.options.push_back(
-            {fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy, onScreen),
-             k.fixedTriangles, k.fixedLinkBytes, 1.0});
+        item.options.push_back({fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy,
+                                               onScreen, config.fillShadingWeight),
+                                k.fixedTriangles, k.fixedLinkBytes, 1.0});
         itemSources.push_back({c, -1.0});
         continue;
       }
@@ -336,8 +339,9 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
         if (cost.triangles - s.cost.triangles > roomTriangles ||
             cost.linkBytes - s.cost.linkBytes > roomLink)
           continue;
-        item.options.push_back({fillImageError(s.diameter, nowDistance, at, onScreen),
-                                cost.triangles, cost.linkBytes, kNewGenerationGainScale});
+        item.options.push_back(
+            {fillImageError(s.diameter, nowDistance, at, onScreen, config.fillShadingWeight),
+             cost.triangles, cost.linkBytes, kNewGenerationGainScale});
         itemSources.push_back({c, at});
       }
     }
@@ -476,8 +480,9 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
     const double weight = cone.onScreenWeight(node.bounds);
     const std::size_t optionsBefore = w.items.options.size();
     // The current pick first (its own cost, as the push-down charged it).
-    w.items.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, weight),
-                               s.cost.triangles, s.cost.linkBytes, 1.0});
+    w.items.options.push_back(
+        {fillImageError(s.diameter, nowDistance, s.frameAccuracy, weight, config.fillShadingWeight),
+         s.cost.triangles, s.cost.linkBytes, 1.0});
     w.sources.push_back({0, -1.0});
     const double floor = s.need * (1.0 - kAccuracyTolerance);
     for (std::uint32_t c = 0; c < candidateCount; ++c) {
@@ -487,9 +492,9 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
         if (k.fixedTriangles - s.cost.triangles > roomTriangles ||
             k.fixedLinkBytes - s.cost.linkBytes > roomLink)
           continue;
-        w.items.options.push_back(
-            {fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy, weight),
-             k.fixedTriangles, k.fixedLinkBytes, 1.0});
+        w.items.options.push_back({fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy,
+                                                  weight, config.fillShadingWeight),
+                                   k.fixedTriangles, k.fixedLinkBytes, 1.0});
         w.sources.push_back({c, -1.0});
         continue;
       }
@@ -522,8 +527,9 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
         if (cost.triangles - s.cost.triangles > roomTriangles ||
             cost.linkBytes - s.cost.linkBytes > roomLink)
           continue;
-        w.items.options.push_back({fillImageError(s.diameter, nowDistance, at, weight),
-                                   cost.triangles, cost.linkBytes, kNewGenerationGainScale});
+        w.items.options.push_back(
+            {fillImageError(s.diameter, nowDistance, at, weight, config.fillShadingWeight),
+             cost.triangles, cost.linkBytes, kNewGenerationGainScale});
         w.sources.push_back({c, at});
       }
     }

@@ -91,8 +91,12 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
 // frame, relative to the diameter): the silhouette length in radians
 // (~ diameter / distance) times the angular error (1 / absolute accuracy =
 // diameter / (frameAccuracy * distance)), times `onScreen` (time-on-screen
-// weight): onScreen * (diameter / distance)^2 / frameAccuracy.
-double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen);
+// weight): onScreen * (diameter / distance)^2 / frameAccuracy; plus, with
+// `shadingWeight` (SchedulerConfig::fillShadingWeight), shadingWeight /
+// sqrt(frameAccuracy) per projected area for the shading of faceted curved
+// surfaces.
+double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen,
+                      double shadingWeight = 0.0);
 
 // Triangle counts of the ladder on which new representations are offered:
 // t_0 = 1, t_{k+1} = max(t_k + 1, floor(kFillLadderStep * t_k)) up to `limit`

@@ -47,6 +47,8 @@ Status validateConfig(const SchedulerConfig& c) {
   const char* o = "SchedulerConfig";
   if (c.fillRounds < 1 || c.fillRounds > 16)
     return invalidField(o, "fillRounds", "must be in 1..16");
+  if (!(c.fillShadingWeight >= 0.0) || !std::isfinite(c.fillShadingWeight))
+    return invalidField(o, "fillShadingWeight", "must be finite and >= 0");
   auto nonNegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!nonNegative(c.maxSpeed)) return invalidField(o, "maxSpeed", "must be finite and >= 0");
   if (!nonNegative(c.maxAngularSpeed))

@@ -90,6 +90,13 @@ struct SchedulerConfig {
   // (about 3.2x its triangles); further rounds start from the raised picks
   // while the previous one moved something, up to this many (1..16).
   int fillRounds = 3;
+  // Budget fill's image error per leaf: (size)^2 * (1 / a + w / sqrt(a)),
+  // size = diameter / distance. The first term is the silhouette (the
+  // geometric error the accuracy measures); the second, with this weight,
+  // stands for shading: a faceted curved surface turns its normals by about
+  // sqrt(2 d / R) for a deviation d on a radius R, so 1 / sqrt(a) in the
+  // leaf frame, over the whole projected area. 0: silhouette only.
+  double fillShadingWeight = 0.0;
 };
 
 Status validateConfig(const SchedulerConfig& config);
