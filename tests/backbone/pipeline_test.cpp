@@ -242,6 +242,32 @@ TEST(Config, RejectsInvalidValues) {
   EXPECT_TRUE(validateConfig(c).ok());
 }
 
+TEST(ObjectDecisionCsv, HeaderAndRowsHaveTheSameColumns) {
+  const std::string header = objectDecisionCsvHeader();
+  ObjectDecision keep;
+  keep.object = 7;
+  keep.action = ObjectAction::kKeep;
+  keep.option = 2;
+  keep.kind = OptionKind::kMeshedImpostor;
+  keep.source = CandidateSource::kFrontendCopy;
+  keep.relativeAccuracy = 57.5;
+  keep.absoluteAccuracy = std::numeric_limits<double>::infinity();
+  keep.triangles = 64.0;
+  keep.belowTarget = true;
+  ObjectDecision removal;  // no option: kind and source left empty
+  removal.object = 3;
+  for (const ObjectDecision& d : {keep, removal}) {
+    const std::string row = objectDecisionCsv(41, 4.1, d);
+    EXPECT_EQ(std::count(header.begin(), header.end(), ','),
+              std::count(row.begin(), row.end(), ','))
+        << row;
+    EXPECT_EQ(row.find('\n'), std::string::npos);
+  }
+  EXPECT_EQ(objectDecisionCsv(41, 4.1, keep),
+            "41,4.1,7,keep,2,meshed-impostor,frontend,57.5,inf,64,0,1");
+  EXPECT_EQ(objectDecisionCsv(41, 4.1, removal), "41,4.1,3,remove,-1,,,0,0,0,0,0");
+}
+
 TEST(DecisionRowCsv, HeaderAndRowHaveTheSameColumns) {
   DecisionRow r;
   r.frame = 12;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -75,6 +76,8 @@ class BackboneProcess {
         (dir_ / "ready.json").string(),
         "--decisions-csv",
         (dir_ / "decisions.csv").string(),
+        "--object-decisions-csv",
+        (dir_ / "object-decisions.csv").string(),
         "--transport.heartbeat_ms",
         "100",
         "--transport.liveness_misses",
@@ -123,6 +126,7 @@ class BackboneProcess {
   }
   std::string log() const { return readFile(dir_ / "backbone.log"); }
   std::string decisions() const { return readFile(dir_ / "decisions.csv"); }
+  std::string objectDecisions() const { return readFile(dir_ / "object-decisions.csv"); }
   bool alive() const { return !exited_ && kill(pid_, 0) == 0 && !reaped(); }
   // Exit status after `signal`, or -1 if it did not exit within the deadline.
   int stopWith(int signal) {
@@ -353,6 +357,25 @@ TEST(BackboneDaemonProcess, ServesPosesSurvivesBadBytesAndStopsOnSigterm) {
   // One decision row per pose after the header.
   const std::string csv = daemon.decisions();
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+  // One row per object decision of each pose's plan, frames 5 and 6 only,
+  // every row as wide as the header; frame 5 decided for objects 0..3.
+  std::istringstream objectRows(daemon.objectDecisions());
+  std::string line;
+  ASSERT_TRUE(std::getline(objectRows, line));
+  const auto columns = std::count(line.begin(), line.end(), ',');
+  std::set<std::string> objectsAtFive;
+  std::set<std::string> frames;
+  while (std::getline(objectRows, line)) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), columns) << line;
+    const std::string frame = line.substr(0, line.find(','));
+    frames.insert(frame);
+    if (frame == "5") {
+      const std::size_t at = line.find(',', line.find(',') + 1) + 1;
+      objectsAtFive.insert(line.substr(at, line.find(',', at) - at));
+    }
+  }
+  EXPECT_EQ(frames, (std::set<std::string>{"5", "6"}));
+  EXPECT_EQ(objectsAtFive, (std::set<std::string>{"0", "1", "2", "3"}));
   // The frontend hears the daemon's goodbye.
   ASSERT_TRUE(pumpUntil(step, [&] { return !(*frontend)->connected(); }));
 }

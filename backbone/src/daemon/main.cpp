@@ -69,6 +69,7 @@ struct Settings {
   int textureSize = static_cast<int>(CoreOptions{}.textureSize);
   std::string textureCodec = thinlod::textureCodecName(CoreOptions{}.textureCodec);
   std::string decisionsCsv;
+  std::string objectDecisionsCsv;
   std::string readyFile;
   std::string frontendAddress = protocol::kDefaultFrontendAddress;
   std::string simplifierAddress = protocol::kDefaultSimplifierAddress;
@@ -140,6 +141,9 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
                     "file of \"TIME_S RATE_BYTES_PER_S\" lines: the link's rate from each trace "
                     "time on (needs --budget-link for the time before; docs/backbone.md, Link)");
   runtime.addOption("decisions-csv", &s.decisionsCsv, "write one decision row per pose here");
+  runtime.addOption("object-decisions-csv", &s.objectDecisionsCsv,
+                    "write one row per object decision of every pose's final plan here (action, "
+                    "kind, source, accuracies, cost: why an object shows what it shows)");
   runtime.addOption("max-frontends", &s.maxFrontends,
                     "frontend sessions served at once, each with its own core (1..64); a further "
                     "frontend's poses are answered empty until one leaves");
@@ -233,8 +237,8 @@ class Daemon {
   // `first` measures the startup curves and serves the first session;
   // `makeCore` makes the cores of further concurrent sessions.
   Daemon(protocol::DaemonRuntime& runtime, const Settings& settings,
-         std::unique_ptr<BackboneCore> first, CoreFactory makeCore,
-         protocol::Endpoint& frontends, protocol::WorkerPool& workers, std::ofstream* csv,
+         std::unique_ptr<BackboneCore> first, CoreFactory makeCore, protocol::Endpoint& frontends,
+         protocol::WorkerPool& workers, std::ofstream* csv, std::ofstream* objectCsv,
          Clock::time_point processStart)
       : started_(processStart),
         runtime_(runtime),
@@ -242,7 +246,8 @@ class Daemon {
         makeCore_(std::move(makeCore)),
         frontends_(frontends),
         workers_(workers),
-        csv_(csv) {
+        csv_(csv),
+        objectCsv_(objectCsv) {
     cores_.push_back(std::move(first));
     poller_.add(frontends_);
     poller_.add(workers_.endpoint());
@@ -701,6 +706,14 @@ class Daemon {
       *csv_ << thinlod::backbone::decisionRowCsv(outcome.row) << "\n";
       csv_->flush();
     }
+    const thinlod::backbone::Plan* plan = core.latestPlan();
+    if (objectCsv_ != nullptr && outcome.planned && plan != nullptr) {
+      for (const thinlod::backbone::ObjectDecision& d : plan->decisions)
+        *objectCsv_ << thinlod::backbone::objectDecisionCsv(outcome.row.frame,
+                                                            outcome.row.timeSeconds, d)
+                    << "\n";
+      objectCsv_->flush();
+    }
   }
 
   void logRequests(const BackboneCore& core, std::uint64_t frame) {
@@ -734,6 +747,7 @@ class Daemon {
   protocol::Endpoint& frontends_;
   protocol::WorkerPool& workers_;
   std::ofstream* csv_;
+  std::ofstream* objectCsv_;
   protocol::Poller poller_;
   std::deque<std::pair<protocol::PeerId, protocol::ViewerPose>> poses_;
   std::map<std::uint64_t, protocol::Hello> hellos_;  // joined frontends by peer id
@@ -857,6 +871,17 @@ int main(int argc, char** argv) {
     }
   }
 
+  std::optional<std::ofstream> objectCsv;
+  if (!settings.objectDecisionsCsv.empty()) {
+    objectCsv.emplace(settings.objectDecisionsCsv, std::ios::trunc);
+    *objectCsv << thinlod::backbone::objectDecisionCsvHeader() << "\n";
+    objectCsv->flush();
+    if (!*objectCsv) {
+      spdlog::error("event=bad_options error=\"cannot write {}\"", settings.objectDecisionsCsv);
+      return 1;
+    }
+  }
+
   protocol::Endpoint::Options endpointOptions;
   endpointOptions.address = settings.frontendAddress;
   endpointOptions.name = "backbone";
@@ -893,6 +918,6 @@ int main(int argc, char** argv) {
     }
   }
   Daemon daemon(runtime, settings, std::move(core).value(), makeCore, **frontends, **workers,
-                csv ? &*csv : nullptr, processStart);
+                csv ? &*csv : nullptr, objectCsv ? &*objectCsv : nullptr, processStart);
   return daemon.run();
 }

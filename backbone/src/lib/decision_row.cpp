@@ -3,6 +3,11 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <string>
+
+#include "thinlod/backbone/pipeline.h"
+#include "thinlod/backbone/scheduler.h"
+#include "thinlod/backbone/scheduling_scene.h"
 
 namespace thinlod::backbone {
 namespace {
@@ -55,6 +60,36 @@ std::string decisionRowCsv(const DecisionRow& r) {
   }
   out += ',';
   appendNumber(out, r.schedulingMicroseconds);
+  return out;
+}
+
+std::string objectDecisionCsvHeader() {
+  return "frame,time_s,object,action,option,kind,source,relative_accuracy,absolute_accuracy,"
+         "triangles,link_bytes,below_target";
+}
+
+std::string objectDecisionCsv(std::uint64_t frame, double timeSeconds, const ObjectDecision& d) {
+  std::string out;
+  out.reserve(128);
+  appendCount(out, frame);
+  out += ',';
+  appendNumber(out, timeSeconds);
+  out += ',';
+  appendCount(out, d.object);
+  out += ',';
+  out += objectActionName(d.action);
+  out += ',';
+  // -1: no option (a removal); kind and source then say nothing.
+  out += std::to_string(d.option);
+  out += ',';
+  out += d.option >= 0 ? optionKindName(d.kind) : "";
+  out += ',';
+  out += d.option >= 0 ? candidateSourceName(d.source) : "";
+  for (double v : {d.relativeAccuracy, d.absoluteAccuracy, d.triangles, d.linkBytes}) {
+    out += ',';
+    appendNumber(out, v);
+  }
+  out += d.belowTarget ? ",1" : ",0";
   return out;
 }
 

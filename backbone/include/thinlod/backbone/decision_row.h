@@ -7,12 +7,17 @@
 //   order is decisionRowCsvHeader(). No I/O: the daemon writes the lines.
 // - Non-finite accuracies print as "inf" / "nan" so a row always has the
 //   same number of columns.
+// - objectDecisionCsv() is the per-object companion: one row per object
+//   decision of a plan (what was chosen for it, where from, at what
+//   accuracy and cost), columns in objectDecisionCsvHeader() order.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
 namespace thinlod::backbone {
+
+struct ObjectDecision;  // scheduler.h, which includes this header
 
 struct DecisionRow {
   std::uint64_t frame = 0;
@@ -37,5 +42,8 @@ struct DecisionRow {
 
 std::string decisionRowCsvHeader();
 std::string decisionRowCsv(const DecisionRow& row);
+
+std::string objectDecisionCsvHeader();
+std::string objectDecisionCsv(std::uint64_t frame, double timeSeconds, const ObjectDecision& d);
 
 }  // namespace thinlod::backbone
