@@ -690,6 +690,24 @@ TEST(SceneImport, ColladaPrimitiveCountsAndArrayIdsAreCheckedBeforeAssimp) {
   EXPECT_NE(twice.status().message().find("a second data array with id \"tri-pos-array\""),
             std::string::npos)
       << twice.status().toString();
+  // Fuzz finding 49: Assimp keeps library_nodes' top nodes and the visual
+  // scenes in one map by id (none: the empty id); a second with an id
+  // already there leaked the first. A second library node "part", a
+  // visual scene with a library node's id, two without ids: refused.
+  const std::vector<std::pair<std::string, std::string>> keys = {
+      {"</library_nodes>", "<node id=\"part\" name=\"again\"/></library_nodes>"},
+      {"<visual_scene id=\"scene\">", "<visual_scene id=\"part\">"},
+      {"</library_nodes>", "<node/><node name=\"b\"/></library_nodes>"}};
+  for (const auto& [from, to] : keys) {
+    const Result<Scene> r = import(with(from, to));
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << to;
+    EXPECT_NE(r.status().message().find("a second library node or visual scene"), std::string::npos)
+        << to << ": " << r.status().toString();
+  }
+  // One library node without an id is no clash (nested nodes are not keys).
+  const Result<Scene> oneWithoutId =
+      import(with("</library_nodes>", "<node name=\"b\"><node/><node/></node></library_nodes>"));
+  EXPECT_TRUE(oneWithoutId.ok()) << oneWithoutId.status().toString();
 }
 
 // The imported_scene fuzzer's hand-written seeds (fuzz/imported_scene.cpp)

@@ -293,6 +293,7 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
   std::set<std::string_view> ids;            // every element's id
   std::vector<InstanceUrl> instanceUrls;     // instance_* elements and their urls
   std::set<std::string_view> visualScenes;   // ids of <visual_scene>
+  std::set<std::string_view> libraryKeys;    // ids of library nodes and visual scenes
   std::map<std::string_view, std::uint64_t> arrayCount;
   struct Accessor {
     std::string_view source;
@@ -421,6 +422,20 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     }
     const std::uint32_t enclosing = open.empty() ? kNoNode : open.back().node;
     std::uint32_t self = enclosing;
+    // Assimp keeps library_nodes' top nodes and the visual scenes in one
+    // map by id (no id: the empty one), and a second entry with a key
+    // already there leaks the first (fuzz finding 49).
+    if (name == "visual_scene" ||
+        (name == "node" && !open.empty() && open.back().name == "library_nodes")) {
+      const std::string_view key = attribute(attributes, "id");
+      if (!libraryKeys.insert(key).second) {
+        return Status(ErrorCode::kParseError,
+                      path + ": <" + std::string(name) + "> at byte " + std::to_string(i) +
+                          (key.empty() ? std::string(" without an id")
+                                       : " with id \"" + std::string(key.substr(0, 64)) + "\"") +
+                          ": a second library node or visual scene with that id");
+      }
+    }
     if (name == "node") {
       self = static_cast<std::uint32_t>(children.size());
       children.emplace_back();
