@@ -860,27 +860,24 @@ int main(int argc, char** argv) {
       msBetween(processStart, loadStarted), msBetween(loadStarted, loaded),
       msBetween(loaded, Clock::now()));
 
+  // A CSV output named on the command line, its header written; false when
+  // it cannot be written (logged).
+  const auto openCsv = [](const std::string& path, const std::string& header,
+                          std::optional<std::ofstream>& out) {
+    if (path.empty()) return true;
+    out.emplace(path, std::ios::trunc);
+    *out << header << "\n";
+    out->flush();
+    if (*out) return true;
+    spdlog::error("event=bad_options error=\"cannot write {}\"", path);
+    return false;
+  };
   std::optional<std::ofstream> csv;
-  if (!settings.decisionsCsv.empty()) {
-    csv.emplace(settings.decisionsCsv, std::ios::trunc);
-    *csv << thinlod::backbone::decisionRowCsvHeader() << "\n";
-    csv->flush();
-    if (!*csv) {
-      spdlog::error("event=bad_options error=\"cannot write {}\"", settings.decisionsCsv);
-      return 1;
-    }
-  }
-
   std::optional<std::ofstream> objectCsv;
-  if (!settings.objectDecisionsCsv.empty()) {
-    objectCsv.emplace(settings.objectDecisionsCsv, std::ios::trunc);
-    *objectCsv << thinlod::backbone::objectDecisionCsvHeader() << "\n";
-    objectCsv->flush();
-    if (!*objectCsv) {
-      spdlog::error("event=bad_options error=\"cannot write {}\"", settings.objectDecisionsCsv);
-      return 1;
-    }
-  }
+  if (!openCsv(settings.decisionsCsv, thinlod::backbone::decisionRowCsvHeader(), csv) ||
+      !openCsv(settings.objectDecisionsCsv, thinlod::backbone::objectDecisionCsvHeader(),
+               objectCsv))
+    return 1;
 
   protocol::Endpoint::Options endpointOptions;
   endpointOptions.address = settings.frontendAddress;
