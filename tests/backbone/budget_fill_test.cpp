@@ -135,6 +135,11 @@ TEST(BudgetFill, ShadingTermWeighsAccuracyBySquareRoot) {
   };
   EXPECT_LT(gain(1.0, 100.0, 400.0, 0.0), gain(4.0, 4.0, 16.0, 0.0));
   EXPECT_GT(gain(1.0, 100.0, 400.0, 1.0), gain(4.0, 4.0, 16.0, 1.0));
+  // Meshes only: an impostor's texture carries its shading.
+  for (OptionKind kind : {OptionKind::kOriginalMesh, OptionKind::kSimplifiedMesh, OptionKind::kHybrid})
+    EXPECT_EQ(fillShadingWeight(kind, 1.5), 1.5);
+  for (OptionKind kind : {OptionKind::kMeshedImpostor, OptionKind::kSimpleImpostor})
+    EXPECT_EQ(fillShadingWeight(kind, 1.5), 0.0);
 }
 
 // Random items (including free upgrades, link costs, extreme magnitudes):

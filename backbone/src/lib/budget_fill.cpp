@@ -35,6 +35,12 @@ bool finiteCost(const FillOption& o) {
          std::isfinite(o.gainScale) && o.error >= 0.0 && o.gainScale > 0.0;
 }
 
+double shadingWeightFor(const LeafCandidate& candidate, const SchedulerConfig& config) {
+  const RepresentationOption* option = candidate.representation;
+  return option == nullptr ? config.fillShadingWeight
+                           : fillShadingWeight(option->kind, config.fillShadingWeight);
+}
+
 }  // namespace
 
 double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen,
@@ -43,6 +49,12 @@ double fillImageError(double diameter, double distance, double frameAccuracy, do
   const double size = diameter / distance;
   const double perArea = 1.0 / frameAccuracy + shadingWeight / std::sqrt(frameAccuracy);
   return onScreen * size * size * perArea;
+}
+
+double fillShadingWeight(OptionKind kind, double weight) {
+  // An impostor shows the shading captured with its texture: its error is
+  // the geometric (parallax) one alone.
+  return kind == OptionKind::kMeshedImpostor || kind == OptionKind::kSimpleImpostor ? 0.0 : weight;
 }
 
 std::vector<double> fillTriangleLadder(double limit) {
@@ -293,7 +305,7 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
     std::vector<OptionSource> itemSources;
     // The current pick first (its own cost, as the push-down charged it).
     item.options.push_back({fillImageError(s.diameter, nowDistance, s.frameAccuracy, onScreen,
-                                           config.fillShadingWeight),
+                                           shadingWeightFor(s.candidate, config)),
                             s.cost.triangles, s.cost.linkBytes, 1.0});
     itemSources.push_back({0, -1.0});
     const double floor = s.need * (1.0 - kAccuracyTolerance);
@@ -305,7 +317,7 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
             k.fixedLinkBytes - s.cost.linkBytes > roomLink)
           continue;
         item.options.push_back({fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy,
-                                               onScreen, config.fillShadingWeight),
+                                               onScreen, shadingWeightFor(k, config)),
                                 k.fixedTriangles, k.fixedLinkBytes, 1.0});
         itemSources.push_back({c, -1.0});
         continue;
@@ -340,7 +352,7 @@ FillOutcome fillReference(const SchedulingScene& scene, const SchedulerConfig& c
             cost.linkBytes - s.cost.linkBytes > roomLink)
           continue;
         item.options.push_back(
-            {fillImageError(s.diameter, nowDistance, at, onScreen, config.fillShadingWeight),
+            {fillImageError(s.diameter, nowDistance, at, onScreen, shadingWeightFor(k, config)),
              cost.triangles, cost.linkBytes, kNewGenerationGainScale});
         itemSources.push_back({c, at});
       }
@@ -481,7 +493,8 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
     const std::size_t optionsBefore = w.items.options.size();
     // The current pick first (its own cost, as the push-down charged it).
     w.items.options.push_back(
-        {fillImageError(s.diameter, nowDistance, s.frameAccuracy, weight, config.fillShadingWeight),
+        {fillImageError(s.diameter, nowDistance, s.frameAccuracy, weight,
+                        shadingWeightFor(s.candidate, config)),
          s.cost.triangles, s.cost.linkBytes, 1.0});
     w.sources.push_back({0, -1.0});
     const double floor = s.need * (1.0 - kAccuracyTolerance);
@@ -493,7 +506,7 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
             k.fixedLinkBytes - s.cost.linkBytes > roomLink)
           continue;
         w.items.options.push_back({fillImageError(s.diameter, nowDistance, k.maxRelativeAccuracy,
-                                                  weight, config.fillShadingWeight),
+                                                  weight, shadingWeightFor(k, config)),
                                    k.fixedTriangles, k.fixedLinkBytes, 1.0});
         w.sources.push_back({c, -1.0});
         continue;
@@ -528,7 +541,7 @@ FillOutcome fillFast(const SchedulingScene& scene, const SchedulerConfig& config
             cost.linkBytes - s.cost.linkBytes > roomLink)
           continue;
         w.items.options.push_back(
-            {fillImageError(s.diameter, nowDistance, at, weight, config.fillShadingWeight),
+            {fillImageError(s.diameter, nowDistance, at, weight, shadingWeightFor(k, config)),
              cost.triangles, cost.linkBytes, kNewGenerationGainScale});
         w.sources.push_back({c, at});
       }

@@ -97,6 +97,9 @@ std::vector<std::size_t> fillByGain(const std::vector<FillItem>& items, const Fi
 // surfaces.
 double fillImageError(double diameter, double distance, double frameAccuracy, double onScreen,
                       double shadingWeight = 0.0);
+// The shading weight for a representation kind: `weight` for meshes (original,
+// simplified, hybrid), 0 for impostors, whose texture carries the shading.
+double fillShadingWeight(OptionKind kind, double weight);
 
 // Triangle counts of the ladder on which new representations are offered:
 // t_0 = 1, t_{k+1} = max(t_k + 1, floor(kFillLadderStep * t_k)) up to `limit`
