@@ -23,6 +23,11 @@
                        Inline'd with their ImageTexture; the case runs with --models-dir
                        /usr/share/assimp/models (suite.json "models").
   textured-walk.trace  a walk past the two rows at 0.8 m/s, 10 s.
+  court.wrl            a sculpture court (made after session 16's tuning of the budget fill, to
+                       test it untouched): eight models on pedestals on a 4 m ring, six columns,
+                       a fountain of primitives in the middle, a 1.8 m bunny outside the ring.
+  court-walk.trace     120 poses 0.1 s apart: once around the court at 0.7 m/s, looking ahead
+                       with glances inwards and outwards (up to 2.8 rad/s).
   aerobic-class.wrl    the ASLOD paper's "aerobic class" (issue 18): three skinned, animated
                        Testwuson.X figures of assimp-testmodels 3 m apart, the outer two playing
                        Wuson_Run, the middle one Wuson_Walk (the backbone plays every clip on
@@ -324,6 +329,50 @@ def parts_fly(count=70, frames=100, dt=0.1):
     return poses
 
 
+class Court(Gallery):
+    """A sculpture court (made after the shading-fill tuning of session 16, to test it on a
+    scene it was not tuned on): eight models on pedestals on a ring of radius 4 m around
+    (6, 0, 6), six columns on a ring of 2.4 m, a fountain of primitives in the middle."""
+
+    def write(self, path):
+        self.pedestals = 0
+        cx, cz = 6.0, 6.0
+        ring = ("cheburashka", "spot", "nefertiti", "cow", "teapot", "fandisk", "suzanne", "horse")
+        for k, name in enumerate(ring):
+            a = 2 * math.pi * k / len(ring)
+            x, z = cx + 4.0 * math.cos(a), cz + 4.0 * math.sin(a)
+            # facing the centre: the model's +z towards (cx, cz)
+            yaw = math.degrees(math.atan2(cx - x, cz - z))
+            self.on_pedestal(name, x, z, yaw)
+        for k in range(6):
+            a = 2 * math.pi * (k + 0.5) / 6
+            column = ("DEF Column Shape { " + material((0.8, 0.8, 0.78)) +
+                      " geometry Cylinder { radius 0.18 height 2.6 } }") if k == 0 else "USE Column"
+            self.add(f"column {k} ({'DEF' if k == 0 else 'USE'})",
+                     f"Transform {{ translation {fmt(cx + 2.4 * math.cos(a), 1.3, cz + 2.4 * math.sin(a))} "
+                     f"children {column} }}", 1)
+        self.add("the fountain: a basin (cylinder), a sphere on a cone",
+                 f"Transform {{ translation {fmt(cx, 0.2, cz)} children [\n"
+                 "  Shape { " + material((0.5, 0.55, 0.6)) +
+                 " geometry Cylinder { radius 0.9 height 0.4 } }\n"
+                 "  Transform { translation 0 0.7 0 children Shape { " + material((0.3, 0.5, 0.7)) +
+                 " geometry Cone { bottomRadius 0.3 height 1.0 } } }\n"
+                 "  Transform { translation 0 1.35 0 children Shape { " + material((0.9, 0.85, 0.3)) +
+                 " geometry Sphere { radius 0.25 } } } ] }", 3)
+        bunny, _ = self.fitted("bunny", (cx + 7.0, 0.0, cz), -90)
+        self.add("a 1.8 m bunny outside the ring, facing the court", bunny, 1)
+        body = "".join(self.parts)
+        with open(path, "w") as f:
+            f.write("#VRML V2.0 utf8\n")
+            f.write("# Workbench sculpture court (made by deploy/make-suite.py; do not edit by hand).\n")
+            f.write(f"# A ring of radius 4 m around (6, 0, 6), y up; {self.objects} drawable objects.\n")
+            f.write("# Models are named by file name and found through --models-dir.\n\n")
+            f.write('Viewpoint { description "court" position 6 1.6 0.5 fieldOfView 0.9 }\n')
+            f.write("DirectionalLight { direction -0.4 -1.0 -0.3 intensity 0.9 ambientIntensity 0.3 }\n\n")
+            f.write(body)
+        return self.objects
+
+
 def write_trace(path, title, poses, fov_deg):
     """poses: [(t, eye, target)]."""
     with open(path, "w") as f:
@@ -519,13 +568,29 @@ def main():
                 f"walk between the textured rows at 0.8 m/s, {len(textured_walk)} poses",
                 textured_walk, 60)
 
+    # Sculpture court: once around between the columns and the pedestals (radius 3.2 m) at
+    # 0.7 m/s, looking at the sculptures ahead and glancing at the fountain and outwards.
+    court = Court(args.models_dir).write(os.path.join(args.out, "court.wrl"))
+    def court_pose(t):
+        a = -math.pi / 2 + 0.7 * t / 3.2
+        return (6.0 + 3.2 * math.cos(a), 1.6, 6.0 + 3.2 * math.sin(a)), a
+    glance = yaw_schedule([(0, 0), (3.0, 1.0, 70), (6.0, 1.2, -50), (9.5, 1.0, 0)])
+    court_walk = []
+    for i in range(120):
+        t = 0.1 * i
+        p, a = court_pose(t)
+        forward = math.degrees(-(a + math.pi / 2))  # the walking direction as a yaw
+        court_walk.append((round(t, 6), p, yaw_target(p, forward + glance(t), 0.2)))
+    write_trace(os.path.join(args.out, "court-walk.trace"),
+                f"walk around the sculpture court at 0.7 m/s, {len(court_walk)} poses", court_walk, 60)
+
     figures = write_aerobic(os.path.join(args.out, "aerobic-class.wrl"))
     aerobic = aerobic_walk()
     write_trace(os.path.join(args.out, "aerobic-class.trace"),
                 f"a walk into the aerobic class, {len(aerobic)} poses 0.1 s apart (max "
                 f"{max_speed(aerobic):.2f} m/s, {max_angular_speed(aerobic):.2f} rad/s)", aerobic, 60)
 
-    print(f"make-suite: textured {textured} objects; gallery {objects} objects, city {instances} instances, parts field "
+    print(f"make-suite: court {court} objects; textured {textured} objects; gallery {objects} objects, city {instances} instances, parts field "
           f"{parts} instances (parts-fly {len(fly)} poses, {max_speed(fly):.2f} m/s); traces: "
           f"paper-walk {len(walk)} ({max_speed(walk):.2f} m/s), gallery-tour {len(tour)} "
           f"({max_speed(tour):.2f} m/s), gallery-fast {len(fast)} ({max_speed(fast):.2f} m/s), "
