@@ -140,7 +140,9 @@ def run_metrics(run_dir, from_time=None):
         "name": meta["name"], "case": meta.get("case"), "scheduler": meta.get("scheduler"),
         "budget_polygons": budget,
         "mode": meta.get("mode") + (f" +{meta['answer_wait_ms']} ms" if meta.get("answer_wait_ms")
-                                    else "") if meta.get("mode") else None,
+                                    else "") + (f" +link {meta['budget_link_bytes_per_s']} B/s"
+                                                if meta.get("budget_link_bytes_per_s") else "")
+        if meta.get("mode") else None,
         "reference_mode": summary.get("reference_mode"),
         "frames": len(rows), "frames_scored": sum(1 for s in snr if not math.isnan(s)),
         "frames_not_kept": summary.get("frames_not_kept"),
