@@ -35,7 +35,7 @@ COLUMNS = [
     ("psnr_db_min", "PSNR min", 1),
     ("blank_frames", "blank", None), ("incomplete_frames", "incomplete", None),
     ("frames_over_budget", "over budget", None), ("polygons_max", "tris max", None),
-    ("units_max", "units max", 1),
+    ("units_max", "units max", 1), ("budget_used_pct", "used %", 0),
     ("link_kb_total", "link KB", 1), ("link_kb_worst_1s", "worst 1 s KB", 1),
     ("simplifier_requests", "requests", None),
     ("update_latency_ms_median", "update med ms", 0), ("update_latency_ms_p99", "update p99 ms", 0),
@@ -103,6 +103,18 @@ def first_complete(rows):
     return None, None
 
 
+def budget_used_pct(rows, units, complete_frame, budget):
+    """100 x the mean primitive units of the frames from `complete_frame` on (every frame when
+    it is None) over `budget`; None without a budget or a frame of known units."""
+    if not budget:
+        return None
+    start = 0
+    if complete_frame is not None:
+        start = next((i for i, r in enumerate(rows) if int(number(r["frame"])) == complete_frame), 0)
+    known = [u for u in units[start:] if not math.isnan(u)]
+    return 100.0 * sum(known) / len(known) / budget if known else None
+
+
 def jsonable(x):
     """None for NaN, strings for infinities (JSON has neither)."""
     if isinstance(x, float):
@@ -154,6 +166,9 @@ def run_metrics(run_dir, from_time=None):
         "incomplete_frames": sum(1 for r in rows if number(r.get("missing_objects")) > 0),
         "polygons_max": int(max(polygons)) if polygons else None,
         "units_max": max(known_units) if known_units else None,
+        # Mean units at the frontend over the budget, from the first complete frame on (before
+        # it the objects are still arriving), or over every frame when none is complete.
+        "budget_used_pct": budget_used_pct(rows, units, frame, budget),
         # Over the budget in units (triangles + points / kappa); frames whose units are unknown
         # (points at an unknown kappa) are counted apart, never as within it.
         "frames_over_budget": sum(1 for u in known_units if budget and u > budget),

@@ -94,8 +94,19 @@ class HybridUnits(unittest.TestCase):
         self.assertEqual(m["points_max"], 60)
         self.assertEqual(m["frames_over_budget"], 1)
         self.assertEqual(m["frames_units_unknown"], 1)
-        self.assertIn("| units max |", table)
-        self.assertIn("| 190 | 210.0 |", table)
+        self.assertIn("| units max | used % |", table)
+        self.assertIn("| 190 | 210.0 | 83 |", table)
+        # No complete frame in this fixture: the mean of every frame of known units,
+        # (100 + 210 + 190) / 3 of 200.
+        self.assertAlmostEqual(m["budget_used_pct"], 100.0 * 500.0 / 3.0 / 200.0)
+
+    def test_budget_used_counts_from_the_first_complete_frame(self):
+        rows = [{"frame": "0"}, {"frame": "1"}, {"frame": "2"}]
+        self.assertAlmostEqual(report.budget_used_pct(rows, [10.0, 180.0, 200.0], 1, 200), 95.0)
+        self.assertAlmostEqual(report.budget_used_pct(rows, [10.0, 180.0, 200.0], None, 200),
+                               65.0)
+        self.assertIsNone(report.budget_used_pct(rows, [10.0, 180.0, 200.0], 1, None))
+        self.assertIsNone(report.budget_used_pct(rows, [math.nan] * 3, None, 200))
 
     def test_from_time_leaves_out_the_frames_before_it(self):
         m, _ = self.report("--from-time", "2")
