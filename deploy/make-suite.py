@@ -31,7 +31,7 @@
   aerobic-class.wrl    the ASLOD paper's "aerobic class" (issue 18): three skinned, animated
                        Testwuson.X figures of assimp-testmodels 3 m apart, the outer two playing
                        Wuson_Run, the middle one Wuson_Walk (the backbone plays every clip on
-                       pose time: no phase offsets); --models-dir /usr/share/assimp/models/X.
+                       pose time, no animationOffset: the Run figures move in step); --models-dir /usr/share/assimp/models/X.
   aerobic-class.trace  120 poses 0.1 s apart: a walk at 0.8 m/s into the class, close to the
                        left figure (the right one leaves the view), then a turn of about 110
                        degrees to the right figure while walking towards it.

@@ -226,6 +226,34 @@ TEST(AnimatedInline, UnknownClipIsNotFoundNamingTheClips) {
   EXPECT_NE(past.status().message().find("clips"), std::string::npos) << past.status().toString();
 }
 
+// animationOffset shifts an instance's clip (pose time + offset), so two
+// instances of one clip need not move in step; it needs the clip it shifts,
+// a finite number, within a day.
+TEST(AnimatedInline, AnimationOffsetIsReadAndChecked) {
+  Result<Scene> scene = loadAnimated(
+      "url \"Testwuson.X\" animation \"Wuson_Run\" animationOffset 0.37", packageDir("X"));
+  ASSERT_TRUE(scene.ok()) << scene.status().toString();
+  const ShapeNode* shape = onlyShape(*scene);
+  ASSERT_NE(shape, nullptr);
+  EXPECT_FLOAT_EQ(shape->geometry.animationOffset, 0.37f);
+  Result<Scene> plain =
+      loadAnimated("url \"Testwuson.X\" animation \"Wuson_Run\"", packageDir("X"));
+  ASSERT_TRUE(plain.ok()) << plain.status().toString();
+  EXPECT_EQ(onlyShape(*plain)->geometry.animationOffset, 0.0f);
+  EXPECT_NE(plain->fingerprint, scene->fingerprint);  // a frontend with the other phase is told
+  for (const char* bad : {"url \"Testwuson.X\" animationOffset 0.5",
+                          "url \"Testwuson.X\" animation \"Wuson_Run\" animationOffset 1e6",
+                          "url \"Testwuson.X\" animation \"Wuson_Run\" animationOffset nan",
+                          "url \"Testwuson.X\" animation \"Wuson_Run\" animationOffset \"1\""}) {
+    Result<Scene> r = loadAnimated(bad, packageDir("X"));
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << bad << ": " << r.status().toString();
+  }
+  Result<Scene> noClip = loadAnimated("url \"Testwuson.X\" animationOffset 0.5", packageDir("X"));
+  EXPECT_NE(noClip.status().message().find("animationOffset needs animation"), std::string::npos)
+      << noClip.status().toString();
+}
+
 TEST(AnimatedInline, FileWithoutClipsIsRefused) {
   // WusonSMD.smd is skinned but has no clip.
   Result<Scene> scene = loadAnimated("url \"WusonSMD.smd\" animation \"#0\"", packageDir("SMD"));

@@ -25,7 +25,9 @@ using namespace testing;
 const std::string kWusonDir = "/usr/share/assimp/models/X";
 
 // Testwuson.X running (object 1) beside a static sphere (object 2).
-Result<std::unique_ptr<BackboneCore>> animatedCore(CoreOptions options) {
+// `inlineExtra`: more fields of the figure's Inline (e.g. an animationOffset).
+Result<std::unique_ptr<BackboneCore>> animatedCore(CoreOptions options,
+                                                   const std::string& inlineExtra = "") {
   EXPECT_TRUE(std::filesystem::exists(kWusonDir + "/Testwuson.X"))
       << "deploy/setup installs the Debian package assimp-testmodels";
   // One file per test and process: ctest runs this file's tests side by side,
@@ -37,7 +39,9 @@ Result<std::unique_ptr<BackboneCore>> animatedCore(CoreOptions options) {
           .string();
   std::ofstream(path) << "#VRML V2.0 utf8\n"
                          "Transform { scale 0.1 0.1 0.1 children [\n"
-                         "  Inline { url \"Testwuson.X\" animation \"Wuson_Run\" } ] }\n"
+                         "  Inline { url \"Testwuson.X\" animation \"Wuson_Run\" "
+                      << inlineExtra
+                      << " } ] }\n"
                          "Transform { translation 1 0 0 children [ Shape { geometry Sphere { "
                          "radius 0.2 } } ] }\n";
   scene::SceneLoadOptions load;
@@ -144,6 +148,36 @@ bool sendFigure(BackboneCore& core, FakeSimplifier& fake, int& step) {
     if (core.frontendMirror().trianglesOf(0) > 0.0) return true;
   }
   return false;
+}
+
+// An Inline's animationOffset: the figure's clip plays at pose time + offset.
+TEST(BackboneAnimationClock, AnimationOffsetShiftsTheClip) {
+  auto created = animatedCore(polygonBudget(5000), "animationOffset 0.25");
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  FakeSimplifier fake(core);
+  answer(core, fake, submitAll(core));
+  const glm::vec3 eye(0.3f, 0.3f, 2.0f), figure(0.0f, 0.2f, 0.0f);
+  for (int step = 0; step < 4 && !(core.frontendMirror().trianglesOf(0) > 0.0); ++step) {
+    ASSERT_TRUE(core.beginPose(poseAt(step, 0.1 * step, eye, figure)).ok());
+    answer(core, fake, submitAll(core));
+    ASSERT_TRUE(core.replan().ok());
+    core.finishPose();
+  }
+  ASSERT_GT(core.frontendMirror().trianglesOf(0), 0.0) << "the backbone never sent the figure";
+  const scene::SkinnedAnimation& animation = wuson(core);
+  for (const double t : {0.0, 0.4, 1.3}) {
+    const std::vector<protocol::BonePose> poses =
+        core.bonePosesAt(static_cast<std::int64_t>(std::llround(t * 1e9)));
+    ASSERT_EQ(poses.size(), 1u);
+    const std::vector<glm::mat4> shifted =
+        anim::paletteMatricesAt(animation.skeleton, animation.clip, animation.palette,
+                                t + double(0.25f), anim::ClipWrap::kLoop);
+    ASSERT_EQ(poses[0].matrices.size(), shifted.size());
+    for (std::size_t i = 0; i < shifted.size(); ++i)
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 3; ++r) ASSERT_EQ(poses[0].matrices[i][c][r], shifted[i][c][r]);
+  }
 }
 
 TEST(BackboneAnimationClock, ReachAndAccuracyAccountForTheMotion) {

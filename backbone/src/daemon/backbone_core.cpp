@@ -286,13 +286,16 @@ Status BackboneCore::initialize() {
   const double texelsPerDiagonal = double(options_.textureSize) / 3.5;
 
   animationOf_.assign(count, nullptr);
+  animationOffsetOf_.assign(count, 0.0f);
   motionRatio_.assign(count, 0.0);
   for (std::uint32_t k = 0; k < count; ++k) {
     const ObjectRecord& record = converted_.records[k];
     backbone::SceneObject& object = scene_.objects[k];
     object.firstOption = static_cast<std::uint32_t>(scene_.options.size());
-    if (!record.cluster && record.object != nullptr && record.object->shape != nullptr)
+    if (!record.cluster && record.object != nullptr && record.object->shape != nullptr) {
       animationOf_[k] = record.object->shape->geometry.animation.get();
+      animationOffsetOf_[k] = record.object->shape->geometry.animationOffset;
+    }
     if (animationOf_[k] != nullptr) {
       // Its leaf sphere encloses every pose (scene_objects.h); its
       // accuracies, measured against the bind mesh, shrink by the motion.
@@ -1314,8 +1317,9 @@ std::vector<protocol::BonePose> BackboneCore::bonePosesAt(std::int64_t poseNs) c
     if (animation == nullptr || !(mirror_.trianglesOf(k) > 0.0)) continue;
     protocol::BonePose pose;
     pose.objectId = converted_.records[k].id;
-    pose.matrices = anim::paletteMatricesAt(animation->skeleton, animation->clip,
-                                            animation->palette, seconds, anim::ClipWrap::kLoop);
+    pose.matrices =
+        anim::paletteMatricesAt(animation->skeleton, animation->clip, animation->palette,
+                                seconds + double(animationOffsetOf_[k]), anim::ClipWrap::kLoop);
     // deform() drops w, so the bottom row plays no part: the wire's affine
     // form is exact. Finite bones of a file can still overflow float in their
     // product: such a pose is not sent (the frontend keeps its last one).

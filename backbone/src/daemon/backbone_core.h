@@ -456,6 +456,7 @@ class BackboneCore {
   std::map<std::uint64_t, std::uint32_t> objectById_;  // wire object id -> object index
   // Per record: its Shape's skinned animation (null: static, a cluster).
   std::vector<const scene::SkinnedAnimation*> animationOf_;
+  std::vector<float> animationOffsetOf_;  // its Inline's animationOffset (s)
   // Per record: 2 m / L, its motion bound over its bind reference length
   // (0: static); accuracies convert by anim::animatedRelativeAccuracy.
   std::vector<double> motionRatio_;

@@ -1045,6 +1045,7 @@ class Parser {
     bool emptyAnimation = false;
     bool animation = false;
     std::optional<Token> regionsField;
+    std::optional<Token> offsetField;
     bool ok = parseBody(type, [&](std::string_view f, const Token& field) {
       if (f == "url") return parseMFString(&g->urls);
       // thinlod extension: the clip of a skinned, animated file to play.
@@ -1052,6 +1053,16 @@ class Parser {
         if (!parseString(&g->animationClip)) return false;
         emptyAnimation = g->animationClip.empty();
         animation = true;
+        return true;
+      }
+      // thinlod extension: the clip's phase (seconds added to pose time).
+      if (f == "animationOffset") {
+        if (!parseFloat(&g->animationOffset)) return false;
+        if (std::abs(g->animationOffset) > kMaxAnimationOffset) {
+          return fail(field, "Inline animationOffset must be within +-" +
+                                 std::to_string(static_cast<int>(kMaxAnimationOffset)) + " s");
+        }
+        offsetField = field;
         return true;
       }
       // thinlod extension: split the mesh into this many region objects
@@ -1074,6 +1085,9 @@ class Parser {
     if (g->urls.empty()) return fail(type, "Inline needs a url");
     if (emptyAnimation) {
       return fail(type, "Inline animation is empty; name a clip or \"#N\" for the N-th");
+    }
+    if (offsetField && !animation) {
+      return fail(*offsetField, "Inline animationOffset needs animation (the clip it shifts)");
     }
     if (regionsField && animation) {
       return fail(*regionsField, "Inline regions cannot be combined with animation");

@@ -126,7 +126,8 @@ Result<double> GlFrameProducer::renderReference(const Pose& pose,
     const scene::SkinnedAnimation* animation = reference_[i].animation;
     if (animation == nullptr) continue;
     referenceBones_[i] = anim::paletteMatricesAt(
-        animation->skeleton, animation->clip, animation->palette, pose.time, anim::ClipWrap::kLoop);
+        animation->skeleton, animation->clip, animation->palette,
+        pose.time + double(reference_[i].animationOffset), anim::ClipWrap::kLoop);
     reference_[i].object.bones = &referenceBones_[i];
     if (i < coverageList_.size()) coverageList_[i].bones = &referenceBones_[i];
   }

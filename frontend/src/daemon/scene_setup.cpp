@@ -86,6 +86,7 @@ Result<LoadedScene> loadFrontendScene(const std::string& scenePath, const std::s
     item.object.transform = object.objectToWorld;
     if (const auto& animation = object.shape->geometry.animation) {
       item.animation = animation.get();
+      item.animationOffset = object.shape->geometry.animationOffset;
       // The palette skin, kept alive by the scene's animation.
       item.object.skin =
           std::shared_ptr<const std::vector<anim::VertexSkin>>(animation, &animation->palette.skin);

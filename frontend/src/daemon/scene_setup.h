@@ -37,6 +37,7 @@ struct ReferenceItem {
   // object.bones (GlFrameProducer), so the reference moves as the frontend's
   // levels do. object.skin is its palette skin.
   const scene::SkinnedAnimation* animation = nullptr;
+  float animationOffset = 0.0f;  // its Inline's: the clip plays at pose time + this
 };
 
 struct LoadedScene {

@@ -116,12 +116,19 @@ struct Geometry {
   // then imports the file skinned and sets `animation` beside `mesh`.
   std::string animationClip;
   std::shared_ptr<const SkinnedAnimation> animation;
+  // An Inline's `animationOffset` (seconds, |offset| <= kMaxAnimationOffset):
+  // the clip is sampled at pose time + offset, so instances of one clip need
+  // not move in step. 0 without the field.
+  float animationOffset = 0.0f;
   // kMeshFile: an Inline's `regions N` (2..kMaxInlineRegions; 0: none).
   // collectSceneObjects makes the mesh N objects, one per region
   // (scene_objects.h; docs/regions.md, "In the running system").
   std::uint32_t regionCount = 0;
 };
 inline constexpr std::uint32_t kMaxInlineRegions = 1024;
+// A day: more is no phase a looped clip could need, and it keeps pose time +
+// offset exact enough in the double the clock uses.
+inline constexpr float kMaxAnimationOffset = 86400.0f;
 
 struct Node;
 using NodePtr = std::shared_ptr<Node>;
