@@ -157,6 +157,27 @@ class Gallery:
         self.parts.append(f"# {comment}\n{text}\n")
         self.objects += objects
 
+    def add_columns(self, centres, radius, height, rgb):
+        """Cylinders at `centres` (x, y, z): the first DEF'd Column, the others USE it."""
+        for i, centre in enumerate(centres):
+            column = ("DEF Column Shape { " + material(rgb) +
+                      f" geometry Cylinder {{ radius {radius:g} height {height:g} }} }}"
+                      if i == 0 else "USE Column")
+            self.add(f"column {i} ({'DEF' if i == 0 else 'USE'})",
+                     f"Transform {{ translation {fmt(*centre)} children {column} }}", 1)
+
+    def write_file(self, path, title, extent, viewpoint, light):
+        """The scene file: header lines, the Viewpoint and DirectionalLight given, the parts."""
+        with open(path, "w") as f:
+            f.write("#VRML V2.0 utf8\n")
+            f.write(f"# Workbench {title} (made by deploy/make-suite.py; do not edit by hand).\n")
+            f.write(f"# {extent}, y up; {self.objects} drawable objects.\n")
+            f.write("# Models are named by file name and found through --models-dir.\n\n")
+            f.write(viewpoint + "\n")
+            f.write(light + "\n\n")
+            f.write("".join(self.parts))
+        return self.objects
+
     def lod_statue(self, name, base, yaw_deg, far):
         """The paper's Figure 10: level 0 the Shape, level 1 a SimpleImposter of it (only
         beyond `far` metres), level 2 a MeshedImposter of it, everywhere. The imposter levels
@@ -203,29 +224,19 @@ class Gallery:
         self.add("a painting 2 cm thin on the back wall",
                  "Transform { translation 10 1.9 9.95 children Shape { " +
                  material((0.75, 0.2, 0.15)) + " geometry Box { size 2.4 1.4 0.02 } } }", 1)
-        for i, x in enumerate((2.5, 7.5, 12.5, 17.5)):
-            column = ("DEF Column Shape { " + material((0.85, 0.85, 0.8)) +
-                      " geometry Cylinder { radius 0.25 height 3 } }") if i == 0 else "USE Column"
-            self.add(f"column {i} ({'DEF' if i == 0 else 'USE'})",
-                     f"Transform {{ translation {fmt(x, 1.5, 5.0 + (1.2 if i % 2 else -1.2))} "
-                     f"children {column} }}", 1)
+        self.add_columns([(x, 1.5, 5.0 + (1.2 if i % 2 else -1.2))
+                          for i, x in enumerate((2.5, 7.5, 12.5, 17.5))], 0.25, 3, (0.85, 0.85, 0.8))
         self.add("a sculpture of primitives: a cone with a sphere on top",
                  "Transform { translation 13 0.6 5 children [\n"
                  "  Shape { " + material((0.2, 0.6, 0.35)) +
                  " geometry Cone { bottomRadius 0.45 height 1.2 } }\n"
                  "  Transform { translation 0 0.85 0 children Shape { " +
                  material((0.9, 0.8, 0.2)) + " geometry Sphere { radius 0.3 } } } ] }", 2)
-        body = "".join(self.parts)
-        with open(path, "w") as f:
-            f.write("#VRML V2.0 utf8\n")
-            f.write("# Workbench gallery (made by deploy/make-suite.py; do not edit by hand).\n")
-            f.write(f"# A hall x [0, 20], z [0, 10] m, y up; {self.objects} drawable objects.\n")
-            f.write("# Models are named by file name and found through --models-dir.\n\n")
-            f.write('Viewpoint { description "entrance" position 0.5 1.6 5 '
-                    'orientation 0 1 0 -1.5708 fieldOfView 0.9 }\n')
-            f.write("DirectionalLight { direction 0.3 -1.0 -0.5 intensity 0.9 ambientIntensity 0.3 }\n\n")
-            f.write(body)
-        return self.objects
+        return self.write_file(
+            path, "gallery", "A hall x [0, 20], z [0, 10] m",
+            'Viewpoint { description "entrance" position 0.5 1.6 5 '
+            'orientation 0 1 0 -1.5708 fieldOfView 0.9 }',
+            "DirectionalLight { direction 0.3 -1.0 -0.5 intensity 0.9 ambientIntensity 0.3 }")
 
 
 def write_city(path, seed=12, blocks=32):
@@ -344,13 +355,9 @@ class Court(Gallery):
             # facing the centre: the model's +z towards (cx, cz)
             yaw = math.degrees(math.atan2(cx - x, cz - z))
             self.on_pedestal(name, x, z, yaw)
-        for k in range(6):
-            a = 2 * math.pi * (k + 0.5) / 6
-            column = ("DEF Column Shape { " + material((0.8, 0.8, 0.78)) +
-                      " geometry Cylinder { radius 0.18 height 2.6 } }") if k == 0 else "USE Column"
-            self.add(f"column {k} ({'DEF' if k == 0 else 'USE'})",
-                     f"Transform {{ translation {fmt(cx + 2.4 * math.cos(a), 1.3, cz + 2.4 * math.sin(a))} "
-                     f"children {column} }}", 1)
+        ring_angles = [2 * math.pi * (k + 0.5) / 6 for k in range(6)]
+        self.add_columns([(cx + 2.4 * math.cos(a), 1.3, cz + 2.4 * math.sin(a)) for a in ring_angles],
+                         0.18, 2.6, (0.8, 0.8, 0.78))
         self.add("the fountain: a basin (cylinder), a sphere on a cone",
                  f"Transform {{ translation {fmt(cx, 0.2, cz)} children [\n"
                  "  Shape { " + material((0.5, 0.55, 0.6)) +
@@ -361,16 +368,10 @@ class Court(Gallery):
                  " geometry Sphere { radius 0.25 } } } ] }", 3)
         bunny, _ = self.fitted("bunny", (cx + 7.0, 0.0, cz), -90)
         self.add("a 1.8 m bunny outside the ring, facing the court", bunny, 1)
-        body = "".join(self.parts)
-        with open(path, "w") as f:
-            f.write("#VRML V2.0 utf8\n")
-            f.write("# Workbench sculpture court (made by deploy/make-suite.py; do not edit by hand).\n")
-            f.write(f"# A ring of radius 4 m around (6, 0, 6), y up; {self.objects} drawable objects.\n")
-            f.write("# Models are named by file name and found through --models-dir.\n\n")
-            f.write('Viewpoint { description "court" position 6 1.6 0.5 fieldOfView 0.9 }\n')
-            f.write("DirectionalLight { direction -0.4 -1.0 -0.3 intensity 0.9 ambientIntensity 0.3 }\n\n")
-            f.write(body)
-        return self.objects
+        return self.write_file(
+            path, "sculpture court", "A ring of radius 4 m around (6, 0, 6)",
+            'Viewpoint { description "court" position 6 1.6 0.5 fieldOfView 0.9 }',
+            "DirectionalLight { direction -0.4 -1.0 -0.3 intensity 0.9 ambientIntensity 0.3 }")
 
 
 def write_trace(path, title, poses, fov_deg):

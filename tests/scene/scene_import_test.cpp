@@ -419,55 +419,40 @@ TEST(SceneImport, ObjStatementsOutsideTheReadListAreRefusedBeforeAssimp) {
     ASSERT_FALSE(r.ok()) << extra;  // the NUL: the mesh pre-check's refusal comes first
     EXPECT_NE(r.status().message().find(path), std::string::npos) << r.status().toString();
   }
+  // `prefix` before the quad: refused as a parse error naming `why`, or read.
+  const auto importWith = [&](const std::string& prefix) {
+    { std::ofstream(path, std::ios::binary | std::ios::trunc) << prefix << quad; }
+    return importScene(path);
+  };
+  const auto expectRefused = [&](const std::string& prefix, const std::string& why) {
+    const Result<Scene> r = importWith(prefix);
+    ASSERT_FALSE(r.ok()) << prefix;
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << r.status().toString();
+    EXPECT_NE(r.status().message().find(why), std::string::npos) << r.status().toString();
+  };
   // Fuzz finding 43: Assimp skips a vertex of 5 (or 7) numbers without a
   // word, so the faces after it name other vertices; a face past the
   // vertices it read made it throw and leak. Only the counts it reads pass
   // (v 3, 4 or 6; vt 2 or 3; vn 3), wherever the line is. (Too few values
   // are the mesh pre-check's refusal already.)
-  for (const std::string& bad : {std::string("v 1 8 2 0 1\n"), std::string("v 1 8 2 0 1 0 1\n"),
-                                 std::string("vt 0 1 0 1\n"), std::string("vn 0 0 1 0\n"),
-                                 std::string("vn 0 0 1 # up\nvn 0 0 1 0\n")}) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << bad << quad; }
-    Result<Scene> r = importScene(path);
-    ASSERT_FALSE(r.ok()) << bad;
-    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << r.status().toString();
-    EXPECT_NE(r.status().message().find("values (Assimp reads"), std::string::npos)
-        << r.status().toString();
-  }
+  for (const char* bad : {"v 1 8 2 0 1\n", "v 1 8 2 0 1 0 1\n", "vt 0 1 0 1\n", "vn 0 0 1 0\n",
+                          "vn 0 0 1 # up\nvn 0 0 1 0\n"})
+    expectRefused(bad, "values (Assimp reads");
   // Fuzz finding 48: Assimp skips an indented statement line, so an
   // indented vertex is none there; a later face past the vertices it read
   // made it throw and leak the meshes of the materials before. Refused;
   // indented comments and blank lines stay harmless.
-  for (const std::string& bad :
-       {std::string(" v 1 8 2\n"), std::string("\tvt 0 1\n"), std::string("  usemtl red\n")}) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << bad << quad; }
-    Result<Scene> r = importScene(path);
-    ASSERT_FALSE(r.ok()) << bad;
-    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << r.status().toString();
-    EXPECT_NE(r.status().message().find("indented"), std::string::npos) << r.status().toString();
-  }
+  for (const char* bad : {" v 1 8 2\n", "\tvt 0 1\n", "  usemtl red\n"})
+    expectRefused(bad, "indented");
   // Fuzz finding 50: a vertical tab between a vertex's values (a separator
   // to Assimp, text to our count); no control character but tab and CR.
-  for (const std::string& bad : {std::string("v 1 6 \v3\n"), std::string("v 1 6 3\f\n"),
-                                 std::string("# a \x1b note\n"), std::string("# del \x7f\n")}) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << bad << quad; }
-    Result<Scene> r = importScene(path);
-    ASSERT_FALSE(r.ok()) << bad;
-    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << r.status().toString();
-    EXPECT_NE(r.status().message().find("a control character"), std::string::npos)
-        << r.status().toString();
-  }
-  for (const std::string& good : {std::string("  # note\n"), std::string(" \t\n"),
-                                  std::string("v 1 8 2\r\n"), std::string("v\t1\t8\t2\n")}) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << good << quad; }
-    Result<Scene> r = importScene(path);
-    EXPECT_TRUE(r.ok()) << good << ": " << r.status().toString();
-  }
-  // The counts Assimp reads, a trailing comment left out of the count.
-  for (const std::string& good : {std::string("v 1 8 2 1\n"), std::string("v 1 8 2 0 1 0\n"),
-                                  std::string("vt 0 1 0\n"), std::string("vn 0 0 1 # up\n")}) {
-    { std::ofstream(path, std::ios::binary | std::ios::trunc) << good << quad; }
-    Result<Scene> r = importScene(path);
+  for (const char* bad : {"v 1 6 \v3\n", "v 1 6 3\f\n", "# a \x1b note\n", "# del \x7f\n"})
+    expectRefused(bad, "a control character");
+  // Harmless white space and comments, and the counts Assimp reads (a
+  // trailing comment left out of the count).
+  for (const char* good : {"  # note\n", " \t\n", "v 1 8 2\r\n", "v\t1\t8\t2\n", "v 1 8 2 1\n",
+                           "v 1 8 2 0 1 0\n", "vt 0 1 0\n", "vn 0 0 1 # up\n"}) {
+    const Result<Scene> r = importWith(good);
     EXPECT_TRUE(r.ok()) << good << ": " << r.status().toString();
   }
   fs::remove_all(dir);
