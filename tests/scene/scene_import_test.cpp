@@ -701,6 +701,20 @@ TEST(SceneImport, ColladaPrimitiveCountsAndArrayIdsAreCheckedBeforeAssimp) {
     EXPECT_NE(r.status().message().find("a second library node or visual scene"), std::string::npos)
         << to << ": " << r.status().toString();
   }
+  // Fuzz finding 51: an accessor count with a trailing byte ("3x") was no
+  // number to the pre-check (so no check) and 3 to Assimp, which then read
+  // an array without a count: a null read. Counts, strides and offsets must
+  // be unsigned integers.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"count=\"3\" stride=\"3\"", "count=\"3x\" stride=\"3\""},
+           {"count=\"3\" stride=\"3\"", "count=\"3\" stride=\"-3\""},
+           {"offset=\"0\"", "offset=\"0.5\""},
+           {"<triangles count=\"1\">", "<triangles count=\"1 \">"}}) {
+    const Result<Scene> r = import(with(from, to));
+    EXPECT_EQ(r.status().code(), ErrorCode::kParseError) << to;
+    EXPECT_NE(r.status().message().find("is not an unsigned integer"), std::string::npos)
+        << to << ": " << r.status().toString();
+  }
   // One library node without an id is no clash (nested nodes are not keys).
   const Result<Scene> oneWithoutId =
       import(with("</library_nodes>", "<node name=\"b\"><node/><node/></node></library_nodes>"));

@@ -422,6 +422,19 @@ Status precheckCollada(const std::string& path, std::string_view bytes,
     }
     const std::uint32_t enclosing = open.empty() ? kNoNode : open.back().node;
     std::uint32_t self = enclosing;
+    // Counts, strides and offsets are unsigned integers. number() took "3x"
+    // for absent (its fallback) while Assimp read 3: an accessor of 3 over
+    // an array without a count passed here and Assimp read 9 values of an
+    // empty array (a null read; fuzz finding 51).
+    for (const char* key : {"count", "stride", "offset"}) {
+      const std::string_view value = attribute(attributes, key);
+      if (!value.empty() && value.find_first_not_of("0123456789") != std::string_view::npos) {
+        return Status(ErrorCode::kParseError, path + ": <" + std::string(name) + "> at byte " +
+                                                  std::to_string(i) + ": " + key + " \"" +
+                                                  std::string(value.substr(0, 32)) +
+                                                  "\" is not an unsigned integer");
+      }
+    }
     // Assimp keeps library_nodes' top nodes and the visual scenes in one
     // map by id (no id: the empty one), and a second entry with a key
     // already there leaks the first (fuzz finding 49).
