@@ -164,6 +164,9 @@ std::vector<NamedMessage> seedMessages() {
   result.accuracy = 44.0;
   result.curve = {{5.0, 12.0}, {20.0, 100.0}, {44.0, 500.0}, {90.0, 5804.0}};
   out.push_back({"simplify_result", result});
+  SimplifyResult moving = result;
+  moving.motionIncluded = true;  // a skinned object's level, measured under its clip
+  out.push_back({"simplify_result_motion_included", moving});
 
   SimplifyResult failed;
   failed.requestId = 6;

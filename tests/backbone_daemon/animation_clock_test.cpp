@@ -217,6 +217,31 @@ TEST(BackboneAnimationClock, ReachAndAccuracyAccountForTheMotion) {
   EXPECT_LT(shown.relativeAccuracy, rest);
 }
 
+// Accuracies the simplifier measured under the clip (motionIncluded) already
+// hold at every pose against the grown sphere: the backbone takes them as
+// they are, for the curve and for the copy it sends.
+TEST(BackboneAnimationClock, AccuraciesMeasuredUnderMotionAreTakenAsTheyAre) {
+  auto created = animatedCore(polygonBudget(5000));
+  ASSERT_TRUE(created.ok()) << created.status().toString();
+  BackboneCore& core = **created;
+  const scene::SceneObject& figure = core.sceneObjects().at(0);
+  ASSERT_GT(core.motionRatio(0), 0.0);
+  const backbone::SchedulingScene& scene = core.schedulingScene();
+  const std::uint32_t option = scene.objects[0].firstOption;
+  FakeSimplifier fake(core);
+  fake.motionIncluded = true;
+  answer(core, fake, submitAll(core));
+  const double full = double(figure.fullMesh->triangleCount());
+  // The fitted curve is conservative (accuracies at most the samples').
+  EXPECT_NEAR(scene.options[option].relativeTriangles.maxAccuracy(),
+              FakeSimplifier::meshAccuracy(full), 1e-9 * FakeSimplifier::meshAccuracy(full));
+  int step = 0;
+  ASSERT_TRUE(sendFigure(core, fake, step));
+  const backbone::RepresentationCopy& shown = scene.options[option].atFrontend;
+  ASSERT_TRUE(shown.present);
+  EXPECT_DOUBLE_EQ(shown.relativeAccuracy, FakeSimplifier::meshAccuracy(shown.triangles));
+}
+
 TEST(BackboneAnimationClock, AnUnplannedAnswerCarriesThePosesToo) {
   auto created = animatedCore(polygonBudget(5000));
   ASSERT_TRUE(created.ok()) << created.status().toString();

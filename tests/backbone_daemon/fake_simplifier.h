@@ -50,6 +50,10 @@ class FakeSimplifier {
   double inflation = 1.0;
   std::size_t texturebytes = 6000;
   double meshBytesPerTriangle = 1.5;
+  // Mesh results say their accuracies were measured under the object's
+  // motion (SimplifyResult::motionIncluded), as the simplifier does for a
+  // skinned object.
+  bool motionIncluded = false;
 
   static double meshAccuracy(double triangles) { return 3.0 * std::sqrt(triangles); }
 
@@ -80,6 +84,7 @@ class FakeSimplifier {
     triangles = std::max(1.0, std::floor(triangles * inflation));
     result.triangleCount = static_cast<std::uint32_t>(triangles);
     result.accuracy = accuracy;
+    result.motionIncluded = motionIncluded;
     result.mesh.assign(static_cast<std::size_t>(300 + meshBytesPerTriangle * triangles), 0x5a);
     return result;
   }

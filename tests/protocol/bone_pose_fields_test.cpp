@@ -159,3 +159,44 @@ TEST(BonePoseWireFields, TruncationsAndCorruptionsNeverCrash) {
 
 }  // namespace
 }  // namespace thinlod::protocol
+
+namespace thinlod::protocol {
+namespace {
+
+// SimplifyResult.motion_included (a skinned object's accuracies measured
+// under its clip): round trip, absent = false, Mesh results only, never on
+// an error result.
+TEST(MotionIncludedWireField, RoundTripAndRules) {
+  SimplifyResult result;
+  result.requestId = 5;
+  result.objectId = 6;
+  result.mesh = {1, 2, 3};
+  result.triangleCount = 1;
+  result.accuracy = 7.0;
+  result.curve = {{2.0, 1.0}, {7.0, 10.0}};
+  for (const bool included : {false, true}) {
+    result.motionIncluded = included;
+    ASSERT_TRUE(validate(Message(result)).ok());
+    Result<std::vector<std::uint8_t>> bytes = encode(Message(result));
+    ASSERT_TRUE(bytes.ok()) << bytes.status().toString();
+    Result<Message> decoded = decode(bytes->data(), bytes->size());
+    ASSERT_TRUE(decoded.ok()) << decoded.status().toString();
+    EXPECT_TRUE(*decoded == Message(result));
+    EXPECT_EQ(std::get<SimplifyResult>(*decoded).motionIncluded, included);
+  }
+  SimplifyResult hybrid = result;
+  hybrid.kind = RepresentationKind::kHybrid;
+  hybrid.kappa = 3.0;
+  hybrid.motionIncluded = true;
+  EXPECT_EQ(validate(Message(hybrid)).code(), ErrorCode::kInvalidArgument);
+  hybrid.motionIncluded = false;
+  EXPECT_TRUE(validate(Message(hybrid)).ok());
+  SimplifyResult failed;
+  failed.requestId = 5;
+  failed.status = Status(ErrorCode::kNotFound, "no");
+  failed.motionIncluded = true;
+  EXPECT_EQ(validate(Message(failed)).code(), ErrorCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace thinlod::protocol

@@ -820,6 +820,10 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
 
   if (request.purpose == RequestPurpose::kWarmup) return Status();  // the scene is loaded
   OptionState& state = optionStates_[request.option];
+  // What a level keeps while its object moves: measured by the simplifier
+  // under the clip (motionIncluded), else the bind-pose accuracy converted by
+  // the motion bound (the same as the bind-pose one when static).
+  const double motionRatio = result.motionIncluded ? 0.0 : motionRatio_[request.object];
   if (request.purpose == RequestPurpose::kCurve) {
     if (result.curve.empty()) return invalid(where + ": no curve samples");
     std::vector<AccuracySample> samples;
@@ -829,8 +833,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
       if (!std::isfinite(s.accuracy) || s.accuracy <= 0.0 || !std::isfinite(s.resources) ||
           s.resources < 0.0 || s.resources > double(protocol::kMaxTriangleCount))
         return invalid(where + ": curve[" + std::to_string(i) + "] is not a finite sample");
-      samples.push_back(
-          {anim::animatedRelativeAccuracy(s.accuracy, motionRatio_[request.object]), s.resources});
+      samples.push_back({anim::animatedRelativeAccuracy(s.accuracy, motionRatio), s.resources});
     }
     Result<AccuracyCurve> fitted = AccuracyCurve::fitConservative(samples, kMaxCurveSegments);
     if (!fitted.ok()) return invalid(where + ": curve: " + fitted.status().message());
@@ -846,9 +849,7 @@ Status BackboneCore::useSimplifyResult(const LedgerRequest& request,
   }
 
   learnMeshBytes(request.object, double(result.mesh.size()), units);
-  // What the level keeps while the object moves (the bind-pose accuracy when static).
-  const double relative =
-      anim::animatedRelativeAccuracy(result.accuracy, motionRatio_[request.object]);
+  const double relative = anim::animatedRelativeAccuracy(result.accuracy, motionRatio);
   if (request.requestedAccuracy > 0.0 && relative < request.requestedAccuracy * 0.99) {
     // Delivered less than the curve promised: shift the curve so the same
     // triangles are credited with what they reached.

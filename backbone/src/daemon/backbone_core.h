@@ -312,10 +312,11 @@ class BackboneCore {
   // Validity under motion: an animated object's leaf sphere encloses it at
   // every pose of its clip (its reference sphere grown by the clip's motion
   // bound m, scene_objects.h), and every accuracy the simplifier reports for
-  // it (curve samples, the estimate until then, delivered copies) is
-  // converted by anim::animatedRelativeAccuracy with motionRatio = 2 m / L:
-  // what the level keeps at any pose against that sphere. The whole clip
-  // bounds every planned lifetime's window. 0 for a static object.
+  // it at the bind pose (the estimate, a cold-start level) is converted by
+  // anim::animatedRelativeAccuracy with motionRatio = 2 m / L: what the
+  // level keeps at any pose against that sphere. Results measured under the
+  // clip (SimplifyResult::motionIncluded) are taken as they are. The whole
+  // clip bounds every planned lifetime's window. 0 for a static object.
   double motionRatio(std::uint32_t object) const {
     return object < motionRatio_.size() ? motionRatio_[object] : 0.0;
   }

@@ -357,6 +357,32 @@ double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip
   return worst;
 }
 
+double spectralNormBound(const glm::dmat3& l) {
+  // ||l||_2^2 is the largest eigenvalue of l^T l, at most its largest
+  // absolute row sum.
+  const glm::dmat3 g = glm::transpose(l) * l;
+  double worst = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    worst = std::max(worst, std::abs(g[0][r]) + std::abs(g[1][r]) + std::abs(g[2][r]));
+  }
+  return std::sqrt(worst);
+}
+
+double sampledMaxSkinningScale(const Skeleton& skeleton, const AnimationClip& clip,
+                               const SkinPalette& palette, std::size_t steps) {
+  double worst = 0.0;
+  steps = std::max<std::size_t>(steps, 1);
+  for (std::size_t i = 0; i <= steps; ++i) {
+    const double t = clip.duration * static_cast<double>(i) / static_cast<double>(steps);
+    for (const glm::mat4& m : paletteMatricesAt(skeleton, clip, palette, t, ClipWrap::kClamp)) {
+      const double norm = spectralNormBound(glm::dmat3(glm::dmat4(m)));
+      if (!std::isfinite(norm)) return std::numeric_limits<double>::infinity();
+      worst = std::max(worst, norm);
+    }
+  }
+  return worst;
+}
+
 double animatedRelativeAccuracy(double restAccuracy, double motionRatio) {
   if (!(motionRatio > 0.0)) return restAccuracy;
   return (1.0 + motionRatio) / (1.0 / restAccuracy + motionRatio);

@@ -179,7 +179,7 @@ std::pair<w::Body, fb::Offset<void>> build(fb::FlatBufferBuilder& b, const Simpl
   }
   auto t = w::CreateSimplifyResult(b, m.requestId, m.objectId, error, mesh, m.triangleCount,
                                    m.accuracy, curve, static_cast<w::RepresentationKind>(m.kind),
-                                   m.pointCount, m.kappa);
+                                   m.pointCount, m.kappa, m.motionIncluded);
   return {w::Body::SimplifyResult, t.Union()};
 }
 
@@ -548,6 +548,7 @@ Result<Message> fromWire(const FieldPath& path, const w::SimplifyResult* m) {
   out.kind = static_cast<RepresentationKind>(m->kind());
   out.pointCount = m->point_count();
   out.kappa = m->kappa();
+  out.motionIncluded = m->motion_included();
   THINLOD_RETURN_IF_ERROR(checkVectorCount(path.child("curve"), m->curve(), kMaxCurveSamples));
   if (const auto* curve = m->curve()) {
     out.curve.reserve(curve->size());

@@ -118,7 +118,7 @@ bool operator==(const SimplifyResult& a, const SimplifyResult& b) {
   return a.requestId == b.requestId && a.objectId == b.objectId && sameStatus(a.status, b.status) &&
          a.mesh == b.mesh && a.triangleCount == b.triangleCount && a.accuracy == b.accuracy &&
          sameCurve(a.curve, b.curve) && a.kind == b.kind && a.pointCount == b.pointCount &&
-         a.kappa == b.kappa;
+         a.kappa == b.kappa && a.motionIncluded == b.motionIncluded;
 }
 bool operator==(const ImpostorRequest& a, const ImpostorRequest& b) {
   return a.requestId == b.requestId && a.objectIds == b.objectIds && a.eye == b.eye &&

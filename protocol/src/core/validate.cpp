@@ -462,10 +462,10 @@ Status check(const FieldPath& path, const SimplifyResult& m) {
   THINLOD_RETURN_IF_ERROR(checkCount(path.child("curve"), m.curve.size(), kMaxCurveSamples));
   if (!m.status.ok()) {
     if (!m.mesh.empty() || !m.curve.empty() || m.triangleCount != 0 || m.accuracy != 0.0 ||
-        m.pointCount != 0 || m.kappa != 0.0) {
+        m.pointCount != 0 || m.kappa != 0.0 || m.motionIncluded) {
       return invalidField(path,
-                          "an error result must carry no mesh, curve, triangles, points, kappa "
-                          "or accuracy");
+                          "an error result must carry no mesh, curve, triangles, points, kappa, "
+                          "accuracy or motion_included");
     }
     return Status();
   }
@@ -475,6 +475,8 @@ Status check(const FieldPath& path, const SimplifyResult& m) {
   }
   THINLOD_RETURN_IF_ERROR(checkPointCount(path.child("point_count"), m.kind, m.pointCount));
   THINLOD_RETURN_IF_ERROR(checkKappa(path.child("kappa"), m.kind, m.kappa, false));
+  if (m.motionIncluded && m.kind != RepresentationKind::kMesh)
+    return invalidField(path.child("motion_included"), "applies to Mesh only");
   THINLOD_RETURN_IF_ERROR(checkNonNegative(path.child("accuracy"), m.accuracy));
   if (m.triangleCount > kMaxTriangleCount) {
     return tooLarge(

@@ -90,17 +90,6 @@ struct MotionFrame {
   double norm = 1.0;        // >= ||L||_2
 };
 
-// ||L||_2^2 is the largest eigenvalue of L^T L, at most its largest absolute
-// row sum (Gershgorin): exact for rotations, tight for similarities.
-double spectralNormBound(const glm::dmat3& l) {
-  const glm::dmat3 g = glm::transpose(l) * l;
-  double worst = 0.0;
-  for (int r = 0; r < 3; ++r) {
-    worst = std::max(worst, std::abs(g[0][r]) + std::abs(g[1][r]) + std::abs(g[2][r]));
-  }
-  return std::sqrt(worst);
-}
-
 // Frames of the candidate bones between the poses with skinning matrices
 // `from` and `to`: R_b = to_b * from_b^-1. Singular or non-finite ones are left
 // out; the identity is always a candidate.
@@ -114,7 +103,7 @@ std::vector<MotionFrame> motionFrames(const std::vector<glm::mat4>& from,
     if (!(std::abs(glm::determinant(linear)) > 1e-12)) continue;
     MotionFrame frame;
     frame.inverse = glm::inverse(r);
-    frame.norm = spectralNormBound(linear);
+    frame.norm = anim::spectralNormBound(linear);
     bool finite = std::isfinite(frame.norm);
     for (int c = 0; c < 4; ++c) {
       for (int k = 0; k < 4; ++k) finite = finite && std::isfinite(frame.inverse[c][k]);

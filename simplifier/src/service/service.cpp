@@ -4,16 +4,19 @@
 #include "thinlod/simplifier/service.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <mutex>
 #include <new>
 #include <system_error>
 #include <utility>
 
 #include "service_internal.h"
 #include "thinlod/common/codec/encoding.h"
+#include "thinlod/common/core/parallel_for.h"
 #include "thinlod/common/mesh/mesh_regions.h"
 #include "thinlod/common/scene/scene_parser.h"
 #include "thinlod/common/scene_render/scene_render.h"
@@ -59,6 +62,16 @@ MeshCurveOptions ServiceOptions::defaultCurveOptions() {
   return curve;
 }
 
+AnimatedErrorOptions ServiceOptions::defaultAnimatedErrorOptions() {
+  AnimatedErrorOptions animated;
+  // A quarter of the bench's surface samples and about half its poses:
+  // Testwuson.X's 12 rungs took 8.7 s on this machine's 2 cores under load
+  // (docs/animation.md, "Measured accuracy under motion"), once per clip.
+  animated.maxPoses = 33;
+  animated.surface.samplesPerMesh = 5000;
+  return animated;
+}
+
 SimplifierService::Impl::Impl(ServiceOptions o) : options(std::move(o)) {
   if (!options.sceneRoot.empty()) {
     std::error_code ec;
@@ -68,6 +81,7 @@ SimplifierService::Impl::Impl(ServiceOptions o) : options(std::move(o)) {
   if (!options.curveCacheDir.empty()) {
     curveCache = std::make_unique<MeshCurveCache>(options.curveCacheDir);
     hybridCurveCache = std::make_unique<HybridCurveCache>(options.curveCacheDir);
+    animatedBoundCache = std::make_unique<AnimatedBoundCache>(options.curveCacheDir);
   }
 }
 
@@ -305,11 +319,88 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   return Status();
 }
 
+Result<const std::vector<double>*> SimplifierService::Impl::animatedAccuracies(
+    MeshModel& model, const scene::SkinnedAnimation& animation, bool measureIfMissing) {
+  auto found = model.animatedAccuracies.find(&animation);
+  if (found != model.animatedAccuracies.end()) return &found->second;
+  if (!measureIfMissing && !curveWithoutMeasuring(model)) return nullptr;
+  THINLOD_RETURN_IF_ERROR(ensureCurve(model));
+  // Skeleton-bone skins (deformedLevelBound poses the skeleton, not the palette).
+  Result<std::vector<anim::VertexSkin>> levelSkins = tomSkin(
+      model.pm, *model.original, animation.skin, animation.skeleton.bones.size());
+  if (!levelSkins.ok()) return levelSkins.status();
+  AnimatedErrorOptions bound = options.animatedError;
+  bound.t0 = 0.0;
+  bound.t1 = animation.clip.duration;
+  bound.wrap = anim::ClipWrap::kClamp;  // the window is the whole clip, as motionBound's
+  auto measure = [&]() -> Result<std::vector<double>> {
+    const auto started = std::chrono::steady_clock::now();
+    std::vector<Result<AnimatedLevelError>> bounds(model.ladder.size(),
+                                                   Status(ErrorCode::kInternal, "not measured"));
+    std::atomic<std::size_t> done{0};
+    std::mutex progressMutex;
+    parallelFor(model.ladder.size(), options.curve.threads, [&](std::size_t i) {
+      const IndexedMesh level = model.pm.extract(model.ladder[i].requestedTriangles);
+      const std::vector<anim::VertexSkin> skin(
+          levelSkins->begin(),
+          levelSkins->begin() + static_cast<std::ptrdiff_t>(
+                                    std::min(level.vertexCount(), levelSkins->size())));
+      bounds[i] = deformedLevelBound(*model.original, animation.skin, animation.skeleton,
+                                     animation.clip, level, skin, bound);
+      const std::size_t finished = ++done;
+      std::lock_guard<std::mutex> lock(progressMutex);
+      progress("event=animated_curve_progress mesh_triangles=" +
+               std::to_string(model.pm.maxTriangles()) + " level=" + std::to_string(finished) +
+               "/" + std::to_string(model.ladder.size()) +
+               " triangles=" + std::to_string(level.triangleCount()) + " ms=" +
+               std::to_string(std::llround(std::chrono::duration<double, std::milli>(
+                                               std::chrono::steady_clock::now() - started)
+                                               .count())));
+    });
+    std::vector<double> errors;
+    errors.reserve(bounds.size());
+    for (const Result<AnimatedLevelError>& b : bounds) {
+      if (!b.ok()) return b.status();
+      errors.push_back(b->bound);
+    }
+    ++stats.animatedLaddersMeasured;
+    return errors;
+  };
+  Result<std::vector<double>> errors = Status(ErrorCode::kNotFound, "not measured");
+  if (animatedBoundCache) {
+    AnimatedLadderInputs inputs{*model.original, animation.skin, animation.skeleton,
+                                animation.clip, curveProducerFor(model.attributeWeight,
+                                                                 model.keepBoundary),
+                                {}, bound};
+    for (const LevelCredit& rung : model.ladder) {
+      inputs.rungTriangles.push_back(rung.requestedTriangles);
+    }
+    errors = animatedBoundCache->find(inputs);
+    if (errors.ok()) {
+      ++stats.animatedLaddersFromDisk;
+    } else if (measureIfMissing) {
+      errors = animatedBoundCache->getOrMeasure(inputs, measure);
+    }
+  } else if (measureIfMissing) {
+    errors = measure();
+  }
+  if (!errors.ok() && !measureIfMissing) return nullptr;
+  if (!errors.ok()) return errors.status();
+  const double scale = anim::sampledMaxSkinningScale(animation.skeleton, animation.clip,
+                                                     animation.palette, 128);
+  std::vector<double> accuracies = animatedLadderAccuracies(
+      model, *errors, animation.motionBound, scale, options.curve.minRelativeError);
+  return &model.animatedAccuracies.emplace(&animation, std::move(accuracies)).first->second;
+}
+
 Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
-    const protocol::SimplifyRequest& request, MeshModel& model) {
-  if (options.answerBeforeCurve &&
-      request.target == protocol::SimplifyRequest::Target::kTriangles && request.curvePoints == 0 &&
-      !curveWithoutMeasuring(model)) {
+    const protocol::SimplifyRequest& request, MeshModel& model,
+    const scene::SkinnedAnimation* animation) {
+  // An answer that must not wait for a whole ladder's measurement.
+  const bool coldAnswer = options.answerBeforeCurve &&
+                          request.target == protocol::SimplifyRequest::Target::kTriangles &&
+                          request.curvePoints == 0;
+  if (coldAnswer && !curveWithoutMeasuring(model)) {
     // Cold start: measure the one level asked for, not the whole ladder.
     const IndexedMesh mesh =
         model.pm.extract(std::min<std::size_t>(request.targetTriangles, model.pm.maxTriangles()));
@@ -321,14 +412,28 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
     return encodedMeshResult(mesh, model.delivered(d), model.skinOf(mesh), model.grid);
   }
   THINLOD_RETURN_IF_ERROR(ensureCurve(model));
+  // A skinned object's rungs are credited what they keep under its clip
+  // (a cold answer only when that is known; else the bind-pose credit, which
+  // the backbone converts by the motion bound).
+  const std::vector<double>* moving = nullptr;
+  if (animation != nullptr && options.measureAnimatedAccuracy) {
+    Result<const std::vector<double>*> measured =
+        animatedAccuracies(model, *animation, !coldAnswer);
+    if (!measured.ok()) return measured.status();
+    moving = *measured;
+  }
+  auto rungAccuracy = [&](std::size_t i) {
+    return moving != nullptr ? (*moving)[i]
+                             : model.delivered(model.ladder[i].relativeError).accuracy;
+  };
   const ProgressiveMesh& pm = model.pm;
   std::size_t target = pm.maxTriangles();
   if (request.target == protocol::SimplifyRequest::Target::kTriangles) {
     target = std::min<std::size_t>(request.targetTriangles, pm.maxTriangles());
   } else {
-    for (const LevelCredit& rung : model.ladder) {
-      if (model.delivered(rung.relativeError).accuracy >= request.targetAccuracy) {
-        target = rung.requestedTriangles;
+    for (std::size_t i = 0; i < model.ladder.size(); ++i) {
+      if (rungAccuracy(i) >= request.targetAccuracy) {
+        target = model.ladder[i].requestedTriangles;
         break;
       }
     }
@@ -339,17 +444,21 @@ Result<protocol::SimplifyResult> SimplifierService::Impl::simplifyMesh(
   const bool original = model.attributeWeight > 0.0f && target >= pm.maxTriangles() &&
                         model.original->triangleCount() == pm.maxTriangles();
   const IndexedMesh mesh = original ? *model.original : pm.extract(target);
-  const LevelCredit& credit = model.ladder[creditFor(model.ladder, mesh.triangleCount())];
+  const std::size_t rung = creditFor(model.ladder, mesh.triangleCount());
   Result<protocol::SimplifyResult> encoded =
-      encodedMeshResult(mesh, model.delivered(credit.relativeError),
+      encodedMeshResult(mesh, model.delivered(model.ladder[rung].relativeError),
                         original ? model.originalSkin : model.skinOf(mesh), model.grid);
   if (!encoded.ok()) return encoded.status();
   protocol::SimplifyResult result = std::move(encoded).value();
+  if (moving != nullptr) {
+    result.accuracy = rungAccuracy(rung);
+    result.motionIncluded = true;
+  }
   if (request.curvePoints > 0) {
     std::vector<AccuracySample> points;
-    for (const LevelCredit& rung : model.ladder) {
-      points.push_back(AccuracySample{model.delivered(rung.relativeError).accuracy,
-                                      static_cast<double>(rung.triangles)});
+    for (std::size_t i = 0; i < model.ladder.size(); ++i) {
+      points.push_back(
+          AccuracySample{rungAccuracy(i), static_cast<double>(model.ladder[i].triangles)});
     }
     result.curve = curveSamples(std::move(points), request.curvePoints);
   }
@@ -471,10 +580,12 @@ protocol::SimplifyResult SimplifierService::simplify(const protocol::SimplifyReq
                        : impl_->simplifyPrimitive(request, object->shape->geometry.primitive);
         } else {
           Result<MeshModel*> model = impl_->meshModelFor(*object, request.keepBoundary);
+          const scene::SkinnedAnimation* animation =
+              object->shape != nullptr ? object->shape->geometry.animation.get() : nullptr;
           result = !model.ok() ? Result<protocol::SimplifyResult>(model.status())
                    : request.representation == protocol::RepresentationKind::kHybrid
                        ? impl_->simplifyHybrid(request, **model)
-                       : impl_->simplifyMesh(request, **model);
+                       : impl_->simplifyMesh(request, **model, animation);
         }
       } else {
         result = Status(ErrorCode::kNotFound, "object " + std::to_string(request.objectId) +

@@ -19,6 +19,7 @@
 #include "thinlod/common/render/camera.h"
 #include "thinlod/common/scene/scene.h"
 #include "thinlod/common/scene/scene_objects.h"
+#include "thinlod/simplifier/animated_bound_cache.h"
 #include "thinlod/simplifier/hybrid_curve_cache.h"
 #include "thinlod/simplifier/hybrid_graph.h"
 #include "thinlod/simplifier/impostor.h"
@@ -129,6 +130,11 @@ struct MeshModel {
   // entries, and of every vertex of `original`. Empty: a static mesh.
   std::vector<anim::VertexSkin> tomSkin;
   std::vector<anim::VertexSkin> originalSkin;
+  // Per clip the model's object plays (objects sharing a mesh may play
+  // different clips): one relative accuracy per `ladder` rung that holds at
+  // every pose, against the reference sphere grown by the motion bound
+  // (animatedLadderAccuracies).
+  std::map<const scene::SkinnedAnimation*, std::vector<double>> animatedAccuracies;
   // The skin of `level` (a pm.extract: TOM vertices); empty when static.
   std::vector<anim::VertexSkin> skinOf(const IndexedMesh& level) const {
     if (tomSkin.empty()) return {};
@@ -145,6 +151,21 @@ struct MeshModel {
   };
   std::map<double, std::unique_ptr<Hybrid>> hybrids;
 };
+
+// The relative accuracy each rung of model.ladder keeps while its object
+// plays a clip (docs/animation.md, "Measured accuracy under motion"):
+// `bounds[i]` the rung's deformedLevelBound over the clip (mesh units),
+// `motionBound` m (SkinnedAnimation::motionBound), `skinningScale` how far
+// skinning stretches a bind-space quantization step
+// (anim::sampledMaxSkinningScale). Rung i is credited (L + 2m) / (e_i +
+// scale * q_i L), e_i the largest bound at it or any finer rung (floored at
+// minRelativeError L, as the rest credit), q_i its relative quantization,
+// or the bind-pose credit converted by anim::animatedRelativeAccuracy when
+// that is higher (both bound the same error); then no rung above a finer one.
+std::vector<double> animatedLadderAccuracies(const MeshModel& model,
+                                             const std::vector<double>& bounds,
+                                             double motionBound, double skinningScale,
+                                             double minRelativeError);
 
 // (accuracy, primitive units) of every rung of a hybrid ladder, the accuracy
 // credited as deliveredLevel(rung.relativeError).
@@ -202,6 +223,8 @@ struct SimplifierService::Impl {
   std::unique_ptr<MeshCurveCache> curveCache;
   // Measured hybrid ladders, same directory (null without curveCacheDir).
   std::unique_ptr<HybridCurveCache> hybridCurveCache;
+  // Skinned ladders' bounds under their clips, same directory.
+  std::unique_ptr<AnimatedBoundCache> animatedBoundCache;
   // Decoded scene textures by file (null: the file failed, logged once).
   std::map<std::string, std::shared_ptr<const RgbaImage>> textureFiles;
   // Rendering (created lazily on the calling thread; renderer before context).
@@ -235,8 +258,18 @@ struct SimplifierService::Impl {
   std::shared_ptr<const RgbaImage> textureOf(const scene::SceneObject& object,
                                              const IndexedMesh& mesh);
 
+  // `animation`: the object's clip when it is skinned (its rungs credited
+  // under motion, SimplifyResult::motionIncluded), else null.
   Result<protocol::SimplifyResult> simplifyMesh(const protocol::SimplifyRequest& request,
-                                                service_detail::MeshModel& model);
+                                                service_detail::MeshModel& model,
+                                                const scene::SkinnedAnimation* animation = nullptr);
+  // model.animatedAccuracies[&animation]: from memory, the cache directory,
+  // or (measureIfMissing) measured, every rung's deformedLevelBound over the
+  // whole clip on options.curve.threads. Null when not measuring and neither
+  // the rest ladder nor the bounds are known without measuring.
+  Result<const std::vector<double>*> animatedAccuracies(service_detail::MeshModel& model,
+                                                        const scene::SkinnedAnimation& animation,
+                                                        bool measureIfMissing);
   Result<protocol::SimplifyResult> simplifyHybrid(const protocol::SimplifyRequest& request,
                                                   service_detail::MeshModel& model);
   Result<protocol::SimplifyResult> simplifyPrimitive(const protocol::SimplifyRequest& request,

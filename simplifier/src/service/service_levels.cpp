@@ -99,6 +99,30 @@ std::size_t creditFor(const std::vector<LevelCredit>& ladder, std::size_t triang
   return best;
 }
 
+std::vector<double> animatedLadderAccuracies(const MeshModel& model,
+                                             const std::vector<double>& bounds,
+                                             double motionBound, double skinningScale,
+                                             double minRelativeError) {
+  const double length = model.diameter;
+  const double grown = length + 2.0 * motionBound;
+  const double motionRatio = 2.0 * motionBound / length;
+  const std::size_t n = std::min(bounds.size(), model.ladder.size());
+  std::vector<double> accuracies(n);
+  double worstFiner = 0.0;
+  for (std::size_t i = n; i-- > 0;) {
+    worstFiner = std::max({worstFiner, bounds[i], minRelativeError * length});
+    const double rest = model.ladder[i].relativeError;
+    const DeliveredLevel delivered = model.delivered(rest);
+    const double quantization = std::max(0.0, 1.0 / delivered.accuracy - rest);
+    const double measured = grown / (worstFiner + skinningScale * quantization * length);
+    const double converted = anim::animatedRelativeAccuracy(delivered.accuracy, motionRatio);
+    // NaN (a non-finite bound or scale) falls back to the conversion.
+    accuracies[i] = measured > converted ? measured : converted;
+    if (i + 1 < n) accuracies[i] = std::min(accuracies[i], accuracies[i + 1]);
+  }
+  return accuracies;
+}
+
 std::vector<AccuracySample> curveSamples(std::vector<AccuracySample> points, std::size_t count) {
   std::sort(points.begin(), points.end(), [](const AccuracySample& a, const AccuracySample& b) {
     return a.resources < b.resources || (a.resources == b.resources && a.accuracy > b.accuracy);

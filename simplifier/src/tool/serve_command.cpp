@@ -243,6 +243,11 @@ int runServe(const std::vector<std::string>& args) {
   runtime.addOption("answer-before-curve", &config.service.answerBeforeCurve,
                     "answer a mesh without a known curve from its one measured level (curve "
                     "requests still measure the whole curve); =false: measure the curve first");
+  runtime.addOption("animated-accuracy", &config.service.measureAnimatedAccuracy,
+                    "credit a skinned object's levels with their error measured under its clip "
+                    "(seconds per figure and clip, once: kept in the cache directory); =false: "
+                    "bind-pose accuracies, which the backbone converts by the clip's motion "
+                    "bound");
   runtime.addOption("curve-threads", &config.service.curve.threads,
                     "levels of a curve measured at once (0: one per hardware thread; the "
                     "curves are the same for any count; several workers on one host: 1)");

@@ -266,6 +266,11 @@ struct SimplifyResult {
   RepresentationKind kind = RepresentationKind::kMesh;  // as requested
   std::uint32_t pointCount = 0;                         // kHybrid
   double kappa = 0.0;                                   // kHybrid: units = tris + points / kappa
+  // A skinned object's Mesh: `accuracy` and `curve` hold at every pose of
+  // its clip against the reference sphere grown by the motion bound
+  // (measured by the simplifier, docs/animation.md); false: at the bind pose,
+  // the backbone converts them with anim::animatedRelativeAccuracy.
+  bool motionIncluded = false;
 };
 
 struct ImpostorRequest {

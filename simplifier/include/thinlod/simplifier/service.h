@@ -57,6 +57,7 @@
 #include "thinlod/common/render/offscreen_context.h"
 #include "thinlod/protocol/messages.h"
 #include "thinlod/simplifier/mesh_curve.h"
+#include "thinlod/simplifier/skinned_level.h"
 
 namespace thinlod::simplifier {
 
@@ -91,6 +92,16 @@ struct ServiceOptions {
   // false: measure the curve first (every credit from the ladder).
   bool answerBeforeCurve = false;
   MeshCurveOptions curve = defaultCurveOptions();
+  // How a skinned object's ladder is measured under its clip
+  // (deformedLevelBound per rung, docs/animation.md "Measured accuracy under
+  // motion"); the window is the whole clip (t0, t1 and wrap are set by the
+  // service). Coarser than the bench's defaults: a first request for a
+  // figure waits for every rung.
+  AnimatedErrorOptions animatedError = defaultAnimatedErrorOptions();
+  // false: a skinned object's levels carry their bind-pose accuracies and the
+  // backbone converts them by the clip's motion bound (4-17x looser on
+  // Testwuson.X); kept for comparison and for workers short of CPU.
+  bool measureAnimatedAccuracy = true;
   // Called (on the service's thread) with one log line per step of long work.
   std::function<void(const std::string&)> progress;
   // Hybrid requests (RepresentationKind::kHybrid, docs/hybrid.md): kappa when
@@ -99,6 +110,7 @@ struct ServiceOptions {
   double hybridTau = 1.0;
 
   static MeshCurveOptions defaultCurveOptions();
+  static AnimatedErrorOptions defaultAnimatedErrorOptions();
 };
 
 // Counters for tests and logs (monotone over the service's life).
@@ -116,6 +128,10 @@ struct ServiceStats {
   // measureHybridLevels ran (cache miss, refused file, or no cache directory).
   std::uint64_t hybridCurvesMeasured = 0;
   std::uint64_t hybridCurvesFromDisk = 0;  // the ladder read from the curve cache directory
+  // A skinned object's ladder measured under its clip (one per mesh and
+  // clip), or read from the curve cache directory.
+  std::uint64_t animatedLaddersMeasured = 0;
+  std::uint64_t animatedLaddersFromDisk = 0;
 };
 
 class SimplifierService {

@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <string>
@@ -151,6 +152,21 @@ std::vector<glm::mat4> paletteMatricesAt(const Skeleton& skeleton, const Animati
 double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip& clip,
                                    const std::vector<glm::vec3>& positions,
                                    const std::vector<VertexSkin>& skin, std::size_t steps);
+
+// An upper bound of the spectral norm ||l||_2 (how far l can stretch a
+// vector): the square root of the largest absolute row sum of l^T l
+// (Gershgorin), exact for rotations, tight for similarities.
+double spectralNormBound(const glm::dmat3& l);
+
+// The largest spectralNormBound of a palette bone's skinning matrix (its
+// linear part) at `steps` + 1 evenly spaced times in [0, duration] (steps >=
+// 1): a bind-space displacement of length q (a quantization step) moves at
+// most this factor times q at a pose, as a skinned vertex's displacement is
+// a convex combination of its bones' images of it. Sampled like
+// sampledMaxDeviationFromBind, so measured, not proven, between samples.
+// +infinity when a matrix is not finite.
+double sampledMaxSkinningScale(const Skeleton& skeleton, const AnimationClip& clip,
+                               const SkinPalette& palette, std::size_t steps);
 
 // The relative accuracy (Pasman & Jansen's a = L / error) a representation
 // keeps while its object moves (docs/animation.md, "Served"): credited
