@@ -18,6 +18,7 @@ Prints Markdown. Standard library, plus matplotlib for the plots.
 """
 import argparse
 import csv
+import json
 import math
 import os
 import statistics
@@ -67,7 +68,7 @@ def per_object(objects_rows):
 def run_stats(run_dir):
     frames = read_rows(os.path.join(run_dir, "frames.csv"))
     objects = per_object(read_rows(os.path.join(run_dir, "objects.csv")))
-    budget = int(run_dir.rstrip("/").rsplit("-", 1)[1])
+    budget = run_meta(run_dir)["budget_polygons"]
     col = lambda key: [number(r[key]) for r in frames]
     tris, render = col("polygons"), col("render_ms")
     steady = [number(r["render_ms"]) for r in frames
@@ -144,12 +145,23 @@ def fmt(x, digits=1):
     return f"{x:,.{digits}f}" if digits else f"{int(round(x)):,}"
 
 
+def run_meta(run_dir):
+    """deploy/compare's run.json (scheduler, budget, settings), or the folder name's parts
+    (aerobic-class-SCHEDULER-BUDGET) for a hand-made run folder without one."""
+    path = os.path.join(run_dir, "run.json")
+    if os.path.exists(path):
+        with open(path) as f:
+            return json.load(f)
+    scheduler, budget = os.path.basename(run_dir.rstrip("/"))[len("aerobic-class-"):].rsplit("-", 1)
+    return {"scheduler": scheduler, "budget_polygons": int(budget)}
+
+
 def runs_of(root):
     found = {}
     for d in sorted(os.listdir(root)):
         path = os.path.join(root, d)
         if d.startswith("aerobic-class-") and os.path.exists(os.path.join(path, "objects.csv")):
-            found[d[len("aerobic-class-"):].rsplit("-", 1)[0]] = path
+            found[run_meta(path)["scheduler"]] = path
     return found
 
 
