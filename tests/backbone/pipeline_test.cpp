@@ -55,6 +55,30 @@ TEST(Culling, RotationWidensTheCone) {
             Visibility::kCulled);
 }
 
+// Deferred visibility: a view-cone horizon shorter than the reach horizon
+// narrows the cone only (the balls keep their radii); a longer one changes
+// nothing. An object the viewer could turn to within the lifetime but not
+// within the shorter time is culled.
+TEST(Culling, AShorterViewConeHorizonNarrowsOnlyTheCone) {
+  SchedulerConfig c = exactConfig();
+  c.maxAngularSpeed = 1.0;
+  c.plannedLifetime = 1.0;
+  c.linkDelay = 0.05;
+  c.generationDelay = 0.1;
+  const ViewerState v = viewerAt({0, 0, 0}, {0, 0, -1});
+  const PredictedRegion paper = predictRegion(v, c);
+  c.viewConeHorizon = 0.3;
+  const PredictedRegion deferred = predictRegion(v, c);
+  EXPECT_NEAR(paper.viewHalfAngle - deferred.viewHalfAngle, 1.15 - 0.3, 1e-12);
+  EXPECT_EQ(deferred.reachRadius, paper.reachRadius);
+  EXPECT_EQ(deferred.keepRadius, paper.keepRadius);
+  const Sphere side{{50, 0, -10}, 1.0};  // ~79 degrees off axis
+  EXPECT_NE(classifySphere(paper, side), Visibility::kCulled);
+  EXPECT_EQ(classifySphere(deferred, side), Visibility::kCulled);
+  c.viewConeHorizon = 5.0;  // longer than the reach horizon: the paper's cone
+  EXPECT_EQ(predictRegion(v, c).viewHalfAngle, paper.viewHalfAngle);
+}
+
 TEST(Culling, FarPlaneCulls) {
   SchedulerConfig c = exactConfig();
   c.maxViewDistance = 100.0;
@@ -239,6 +263,13 @@ TEST(Config, RejectsInvalidValues) {
   }
   c = SchedulerConfig{};
   c.fillShadingWeight = 2.0;
+  EXPECT_TRUE(validateConfig(c).ok());
+  for (double horizon : {0.0, -1.0, std::nan("")}) {
+    c = SchedulerConfig{};
+    c.viewConeHorizon = horizon;
+    EXPECT_NE(validateConfig(c).message().find("viewConeHorizon"), std::string::npos) << horizon;
+  }
+  c.viewConeHorizon = 0.25;
   EXPECT_TRUE(validateConfig(c).ok());
 }
 

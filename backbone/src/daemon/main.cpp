@@ -76,6 +76,7 @@ struct Settings {
   int attemptTimeoutMs = 30000;
   int maxAttempts = 3;
   bool measuredGenerationDelay = false;
+  double viewConeHorizon = 0.0;  // s; 0: the reach horizon (SchedulerConfig's infinity)
   int maxFrontends = 8;
   protocol::TransportOptions transport;
 };
@@ -104,6 +105,11 @@ void addOptions(protocol::DaemonRuntime& runtime, Settings& s) {
   runtime.addOption("measured-generation-delay", &s.measuredGenerationDelay,
                     "plan with the 90th percentile of the last 32 plan requests' submission-to-"
                     "result times (at least --generation-delay) instead of the fixed delay");
+  runtime.addOption("view-cone-horizon", &s.viewConeHorizon,
+                    "widen the view cone by --max-angular-speed times this many seconds when "
+                    "shorter than the reach horizon (0: the reach horizon, the paper); objects "
+                    "outside are deferred: culled until the viewer could turn to them before a "
+                    "later request arrives (docs/scheduling.md, \"Deferred visibility\")");
   runtime.addOption("fill-budget", &config.fillBudget,
                     "curves: spend what the uniform target leaves of the budget (=false: off)");
   runtime.addOption("budget-reserve-share", &config.budgetReserveShare,
@@ -163,6 +169,10 @@ thinlod::Result<CoreOptions> coreOptions(const Settings& s) {
   if (s.budgetPolygons > 0.0) o.budget.maxTriangles = s.budgetPolygons;
   if (s.budgetLink > 0.0) o.budget.maxLinkBytesPerSecond = s.budgetLink;
   if (s.accuracy > 0.0) o.budget.fixedAccuracy = s.accuracy;
+  if (!(s.viewConeHorizon >= 0.0))  // NaN too
+    return Status(thinlod::ErrorCode::kInvalidArgument,
+                  "--view-cone-horizon must be >= 0 s (0: the reach horizon)");
+  if (s.viewConeHorizon > 0.0) o.config.viewConeHorizon = s.viewConeHorizon;
   if (s.budgetFrameMs > 0.0) o.budget.maxFrameSeconds = s.budgetFrameMs * 1e-3;
   if (!s.frameCost.empty()) {
     // The default for frontends whose Hello carries no constants of their own.

@@ -56,6 +56,8 @@ Status validateConfig(const SchedulerConfig& c) {
   if (!std::isfinite(c.plannedLifetime) || c.plannedLifetime <= 0.0)
     return invalidField(o, "plannedLifetime", "must be finite and > 0");
   if (!nonNegative(c.linkDelay)) return invalidField(o, "linkDelay", "must be finite and >= 0");
+  if (!(c.viewConeHorizon > 0.0))
+    return invalidField(o, "viewConeHorizon", "must be > 0 (infinity: the reach horizon)");
   if (!nonNegative(c.generationDelay))
     return invalidField(o, "generationDelay", "must be finite and >= 0");
   if (!nonNegative(c.keepSlack)) return invalidField(o, "keepSlack", "must be finite and >= 0");
@@ -113,7 +115,8 @@ PredictedRegion predictRegion(const ViewerState& viewer, const SchedulerConfig& 
   const double th = std::tan(viewer.horizontalFov / 2);
   const double tv = std::tan(viewer.verticalFov / 2);
   const double frustumHalf = std::atan(std::sqrt(th * th + tv * tv));
-  region.viewHalfAngle = std::min(kPi, frustumHalf + config.maxAngularSpeed * horizon);
+  region.viewHalfAngle =
+      std::min(kPi, frustumHalf + config.maxAngularSpeed * std::min(horizon, config.viewConeHorizon));
   region.maxViewDistance = config.maxViewDistance;
   return region;
 }

@@ -12,7 +12,8 @@
 //   keepRadius = maxSpeed * (linkDelay + generationDelay + keepSlack) before
 //   a replacement requested now could arrive (a displayed copy is kept while
 //   it stays valid over that smaller ball). The view cone is the frustum's
-//   bounding cone widened by maxAngularSpeed * the same time as reachRadius.
+//   bounding cone widened by maxAngularSpeed * the same time as reachRadius
+//   (or viewConeHorizon when shorter).
 // - classifySphere is conservative: kCulled only when no point of the sphere
 //   can be seen from anywhere in the region; kInside only when all of it is
 //   seen from everywhere in it.
@@ -47,6 +48,14 @@ struct SchedulerConfig {
   double linkDelay = 0.05;       // s
   double generationDelay = 0.1;  // s
   double keepSlack = 0.0;        // s added to the keep horizon
+  // The view cone is widened by maxAngularSpeed times min(this, the reach
+  // horizon). Infinity (the paper): every object the viewer could turn to
+  // within a representation's planned lifetime is planned now. A shorter
+  // time defers an object the viewer cannot turn to before a representation
+  // requested at a later step could arrive (keep horizon plus one planning
+  // step, docs/scheduling.md "Deferred visibility"): it is culled, its copy
+  // removed, until it enters the narrower cone.
+  double viewConeHorizon = std::numeric_limits<double>::infinity();  // s
   double minimalDistance = 0.1;  // m, lower clamp of D
   double maxViewDistance = std::numeric_limits<double>::infinity();  // m
   // Curve propagation: a group converts relative -> absolute once when
