@@ -310,10 +310,12 @@ int main(int argc, char** argv) {
                "worst_ratio,worst_excess_mrad\n");
   for (auto& [key, s] : summaries) {
     std::sort(s.ratios.begin(), s.ratios.end());
-    auto at = [&](double q) {
-      return s.ratios.empty()
+    // C++17 lambdas cannot capture a structured binding (clang refuses it).
+    const std::vector<double>& ratios = s.ratios;
+    auto at = [&ratios](double q) {
+      return ratios.empty()
                  ? 0.0
-                 : s.ratios[std::min(s.ratios.size() - 1, std::size_t(q * s.ratios.size()))];
+                 : ratios[std::min(ratios.size() - 1, std::size_t(q * ratios.size()))];
     };
     std::fprintf(stderr, "%s,%d,%d,%.1f,%.3f,%.3f,%.3f,%.3f\n", key.c_str(), s.checks, s.exceeds,
                  s.checks ? 100.0 * s.exceeds / s.checks : 0.0, at(0.5), at(0.9), s.worstRatio,
