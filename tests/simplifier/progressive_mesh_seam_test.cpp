@@ -317,5 +317,31 @@ TEST(ProgressiveMeshSeams, OnlyVerticesWithEqualAttributesAreWelded) {
   EXPECT_EQ(buildOrDie(c).vertexCount(), 5u);
 }
 
+// BuildOptions::weldKeys (a skinned mesh's skins): coincident vertices whose
+// keys differ stay apart, as seam sides, with or without preserveSeams;
+// equal keys weld as before; a key per vertex or none.
+TEST(ProgressiveMeshSeams, VerticesWithDifferentWeldKeysStayApart) {
+  IndexedMesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  m.indices = {0, 1, 2, 3, 4, 5};
+  EXPECT_EQ(buildOrDie(m).vertexCount(), 4u);
+  BuildOptions keyed;
+  keyed.weldKeys = {7, 8, 9, 8, 7, 3};  // corner 3 welds onto 1, corner 5 stays apart
+  EXPECT_EQ(buildOrDie(m, keyed).vertexCount(), 5u);
+  keyed.preserveSeams = false;
+  EXPECT_EQ(buildOrDie(m, keyed).vertexCount(), 5u);
+  const ProgressiveMesh pm = buildOrDie(m, keyed);
+  const IndexedMesh full = pm.extract(pm.maxTriangles());
+  EXPECT_EQ(full.triangleCount(), 2u);
+  // The two vertices at (0, 1, 0) are both there, at exactly that place.
+  int atCorner = 0;
+  for (const glm::vec3& p : full.positions) atCorner += p == glm::vec3(0, 1, 0);
+  EXPECT_EQ(atCorner, 2);
+  keyed.weldKeys.pop_back();
+  Result<ProgressiveMesh> wrongSize = ProgressiveMesh::build(m, keyed);
+  EXPECT_EQ(wrongSize.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(wrongSize.status().message().find("weld keys"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace thinlod::simplifier

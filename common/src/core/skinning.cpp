@@ -3,11 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
 #include <limits>
 #include <queue>
 #include <utility>
+
+#include "thinlod/common/core/hash.h"
 
 namespace thinlod::anim {
 namespace {
@@ -355,6 +358,20 @@ double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip
     }
   }
   return worst;
+}
+
+std::vector<std::uint64_t> skinWeldKeys(const std::vector<VertexSkin>& skin) {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(skin.size());
+  for (const VertexSkin& s : skin) {
+    const bool rigid = s.rigid();
+    const std::uint32_t boneB = rigid ? s.boneA : s.boneB;
+    std::uint32_t weightBits = 0;
+    if (!rigid) std::memcpy(&weightBits, &s.weightB, sizeof weightBits);
+    keys.push_back(fnv1a64(&weightBits, sizeof weightBits,
+                           fnv1a64(&boneB, sizeof boneB, fnv1a64(&s.boneA, sizeof s.boneA))));
+  }
+  return keys;
 }
 
 double spectralNormBound(const glm::dmat3& l) {

@@ -85,7 +85,13 @@ Result<ProgressiveMesh> ProgressiveMesh::build(const IndexedMesh& mesh,
                       " vertex constraints for " + std::to_string(mesh.positions.size()) +
                       " vertices");
   }
-  Result<qem::CleanMesh> cleaned = qem::cleanMesh(mesh, options.weldEpsilon, options.preserveSeams);
+  if (!options.weldKeys.empty() && options.weldKeys.size() != mesh.positions.size()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "build options: " + std::to_string(options.weldKeys.size()) +
+                      " weld keys for " + std::to_string(mesh.positions.size()) + " vertices");
+  }
+  Result<qem::CleanMesh> cleaned =
+      qem::cleanMesh(mesh, options.weldEpsilon, options.preserveSeams, options.weldKeys);
   if (!cleaned.ok()) return cleaned.status();
   const qem::CleanMesh& clean = cleaned.value();
   const qem::VertexAttributes attributes = attributesFor(mesh, clean, options);

@@ -211,7 +211,8 @@ bool sameSeamAttributes(const IndexedMesh& mesh, std::uint32_t a, std::uint32_t 
 
 }  // namespace
 
-Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool splitSeams) {
+Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool splitSeams,
+                            const std::vector<std::uint64_t>& weldKeys) {
   THINLOD_RETURN_IF_ERROR(mesh.validate("input mesh"));
   if (mesh.indices.empty()) {
     return Status(ErrorCode::kInvalidArgument, "input mesh: has no triangles");
@@ -256,15 +257,19 @@ Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool spl
     if (!referenced[v]) continue;
     const glm::vec3& p = mesh.positions[v];
     std::uint32_t near = kEmpty;
+    const bool keyed = !weldKeys.empty();
     std::uint32_t target =
-        splitSeams ? grid.find(
-                         p, epsilon, clean.positions,
-                         [&](std::uint32_t c) {
-                           return sameSeamAttributes(mesh, clean.sourceVertex[c],
-                                                     static_cast<std::uint32_t>(v));
-                         },
-                         &near)
-                   : grid.find(p, epsilon, clean.positions, [](std::uint32_t) { return true; });
+        splitSeams || keyed
+            ? grid.find(
+                  p, epsilon, clean.positions,
+                  [&](std::uint32_t c) {
+                    const std::uint32_t source = clean.sourceVertex[c];
+                    return (!keyed || weldKeys[source] == weldKeys[v]) &&
+                           (!splitSeams ||
+                            sameSeamAttributes(mesh, source, static_cast<std::uint32_t>(v)));
+                  },
+                  &near)
+            : grid.find(p, epsilon, clean.positions, [](std::uint32_t) { return true; });
     if (target == kEmpty) {
       target = static_cast<std::uint32_t>(clean.positions.size());
       if (near != kEmpty) {

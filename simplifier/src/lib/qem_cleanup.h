@@ -35,7 +35,10 @@ struct CleanMesh {
 // weldEpsilon is relative to the bounding-box diagonal of the input.
 // splitSeams: weld only vertices whose uv and colour agree too (uv within
 // 1e-6, colour exactly); a triangle with two corners at one place is dropped
-// as degenerate either way.
-Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool splitSeams = false);
+// as degenerate either way. weldKeys (empty, or one per input vertex; the
+// caller checks the size): vertices whose keys differ are never welded and
+// split like a seam, with or without splitSeams.
+Result<CleanMesh> cleanMesh(const IndexedMesh& mesh, float weldEpsilon, bool splitSeams = false,
+                            const std::vector<std::uint64_t>& weldKeys = {});
 
 }  // namespace thinlod::simplifier::qem

@@ -166,7 +166,8 @@ void SimplifierService::Impl::dropUnusedModels() {
 
 Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const IndexedMesh> mesh,
                                                        float attributeWeight, bool keepBoundary,
-                                                       const std::string& what) {
+                                                       const std::string& what,
+                                                       std::vector<std::uint64_t> weldKeys) {
   auto model = std::make_unique<MeshModel>();
   // Builds of large meshes take a second or more: say so in the log.
   constexpr std::size_t kReportBuildsFrom = 20000;
@@ -179,6 +180,8 @@ Result<MeshModel*> SimplifierService::Impl::buildModel(std::shared_ptr<const Ind
   build.attributeWeight = attributeWeight;
   model->attributeWeight = attributeWeight;
   model->keepBoundary = keepBoundary;
+  model->skinSeams = !weldKeys.empty();
+  build.weldKeys = std::move(weldKeys);
   if (keepBoundary) {
     // A region object's borders (and the mesh's outer border) stay where
     // they are at every level: independent levels of neighbouring regions
@@ -217,8 +220,14 @@ Result<MeshModel*> SimplifierService::Impl::meshModelFor(const scene::SceneObjec
   const bool textured = object.shape != nullptr && !object.shape->appearance.texturePath.empty() &&
                         !object.fullMesh->uvs.empty();
   const std::string what = "object " + std::to_string(object.id);
-  Result<MeshModel*> built = buildModel(
-      object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, keepBoundary, what);
+  // A skinned mesh's vertices at one place with different skins part when it
+  // moves: never weld them (docs/animation.md, "Levels of a skinned mesh").
+  const scene::SkinnedAnimation* animation =
+      object.shape != nullptr ? object.shape->geometry.animation.get() : nullptr;
+  Result<MeshModel*> built =
+      buildModel(object.fullMesh, textured ? options.texturedAttributeWeight : 0.0f, keepBoundary,
+                 what, animation != nullptr ? anim::skinWeldKeys(animation->skin)
+                                            : std::vector<std::uint64_t>{});
   if (built.ok() && keepBoundary && object.regionCount > 0 && object.shape != nullptr &&
       object.shape->geometry.mesh) {
     // Every region of the mesh on one quantization grid: the border
@@ -268,7 +277,7 @@ bool SimplifierService::Impl::curveWithoutMeasuring(MeshModel& model) {
   if (!curveCache || model.cacheLookedUp) return false;
   model.cacheLookedUp = true;
   Result<MeshCurves> curves =
-      curveCache->find(*model.original, curveProducerFor(model.attributeWeight, model.keepBoundary),
+      curveCache->find(*model.original, model.producer(),
                        model.pm, options.curve);
   if (!curves.ok() || curves->levels.empty()) return false;
   ++stats.curvesFromDisk;
@@ -298,7 +307,7 @@ Status SimplifierService::Impl::ensureCurve(MeshModel& model) {
   if (curveCache) {
     const int hitsBefore = curveCache->stats().hits;
     curves = curveCache->getOrMeasure(*model.original,
-                                      curveProducerFor(model.attributeWeight, model.keepBoundary),
+                                      model.producer(),
                                       minTriangles, model.pm.maxTriangles(), extract, curveOptions);
     if (curves.ok()) {
       if (curveCache->stats().hits > hitsBefore) {
@@ -369,8 +378,7 @@ Result<const std::vector<double>*> SimplifierService::Impl::animatedAccuracies(
   Result<std::vector<double>> errors = Status(ErrorCode::kNotFound, "not measured");
   if (animatedBoundCache) {
     AnimatedLadderInputs inputs{*model.original, animation.skin, animation.skeleton,
-                                animation.clip, curveProducerFor(model.attributeWeight,
-                                                                 model.keepBoundary),
+                                animation.clip, model.producer(),
                                 {}, bound};
     for (const LevelCredit& rung : model.ladder) {
       inputs.rungTriangles.push_back(rung.requestedTriangles);

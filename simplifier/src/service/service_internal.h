@@ -36,7 +36,9 @@ inline constexpr const char* kCurveProducer = "qem-service v1 boundaries=1 flips
 // ServiceOptions::texturedAttributeWeight) and of a mesh built with its open
 // boundary kept (SimplifyRequest::keepBoundary, region objects): another
 // progressive mesh each, so another cache key.
-std::string curveProducerFor(float attributeWeight, bool keepBoundary = false);
+// skinSeams: built with the skins as weld keys (a skinned object's model).
+std::string curveProducerFor(float attributeWeight, bool keepBoundary = false,
+                             bool skinSeams = false);
 // Share of a level's error budget that Draco quantization may add.
 inline constexpr double kQuantizationBudget = 0.1;
 
@@ -117,6 +119,12 @@ struct MeshModel {
   float attributeWeight = 0.0f;  // BuildOptions::attributeWeight pm was built with
   // pm keeps every open-boundary vertex (kKeep): SimplifyRequest::keepBoundary.
   bool keepBoundary = false;
+  // pm was built with the object's skins as weld keys (a skinned object).
+  bool skinSeams = false;
+  // The curve producer of pm's settings (curve and bound cache keys).
+  std::string producer() const {
+    return curveProducerFor(attributeWeight, keepBoundary, skinSeams);
+  }
   // A region object's levels (keepBoundary, from a scene): its whole mesh's grid.
   PositionGrid grid;
   DeliveredLevel delivered(double relativeError) const {
@@ -163,9 +171,8 @@ struct MeshModel {
 // or the bind-pose credit converted by anim::animatedRelativeAccuracy when
 // that is higher (both bound the same error); then no rung above a finer one.
 std::vector<double> animatedLadderAccuracies(const MeshModel& model,
-                                             const std::vector<double>& bounds,
-                                             double motionBound, double skinningScale,
-                                             double minRelativeError);
+                                             const std::vector<double>& bounds, double motionBound,
+                                             double skinningScale, double minRelativeError);
 
 // (accuracy, primitive units) of every rung of a hybrid ladder, the accuracy
 // credited as deliveredLevel(rung.relativeError).
@@ -241,9 +248,11 @@ struct SimplifierService::Impl {
                                                   bool keepBoundary = false);
   Result<service_detail::MeshModel*> meshModelForSource(const protocol::Bytes& bytes,
                                                         bool keepBoundary = false);
+  // weldKeys: BuildOptions::weldKeys (a skinned object's skins; empty otherwise).
   Result<service_detail::MeshModel*> buildModel(std::shared_ptr<const IndexedMesh> mesh,
                                                 float attributeWeight, bool keepBoundary,
-                                                const std::string& what);
+                                                const std::string& what,
+                                                std::vector<std::uint64_t> weldKeys = {});
   Status ensureCurve(service_detail::MeshModel& model);
   // The curve from memory or the cache file only (never measured): true when
   // model.ladder is ready afterwards.

@@ -25,10 +25,11 @@ DeliveredLevel deliveredLevel(double relativeError) {
   return out;
 }
 
-std::string curveProducerFor(float attributeWeight, bool keepBoundary) {
+std::string curveProducerFor(float attributeWeight, bool keepBoundary, bool skinSeams) {
   std::string producer = kCurveProducer;
   if (attributeWeight > 0.0f) producer += " attributes=" + std::to_string(attributeWeight);
   if (keepBoundary) producer += " keep_boundary=1";
+  if (skinSeams) producer += " skin_seams=1";
   return producer;
 }
 

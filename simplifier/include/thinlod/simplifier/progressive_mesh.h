@@ -68,6 +68,12 @@ struct BuildOptions {
   // sides meet, and seam ends, never move. false: weld by position only
   // (one side's attributes win, as before). Normals never split a vertex.
   bool preserveSeams = true;
+  // Empty, or one per input vertex: vertices whose keys differ are never
+  // welded; at one place they stay two sides of a seam, as above (whatever
+  // preserveSeams says). A skinned mesh passes its vertices' skins
+  // (anim::skinWeldKeys), so no vertex of a level takes another's skin.
+  // Another size: kInvalidArgument.
+  std::vector<std::uint64_t> weldKeys;
   std::size_t stopAtTriangles = 0;  // stop once at most this many triangles remain
   // Empty (every vertex kFree) or one per input vertex; a welded group takes
   // the constraint of its first input vertex. Another size: kInvalidArgument.

@@ -153,6 +153,12 @@ double sampledMaxDeviationFromBind(const Skeleton& skeleton, const AnimationClip
                                    const std::vector<glm::vec3>& positions,
                                    const std::vector<VertexSkin>& skin, std::size_t steps);
 
+// One weld key per vertex (simplifier BuildOptions::weldKeys): equal for
+// vertices whose skins deform them alike (same bones and weight; a rigid
+// vertex's unused second bone and weight ignored), different otherwise
+// (a 64-bit hash: a collision could only let two such vertices weld).
+std::vector<std::uint64_t> skinWeldKeys(const std::vector<VertexSkin>& skin);
+
 // An upper bound of the spectral norm ||l||_2 (how far l can stretch a
 // vector): the square root of the largest absolute row sum of l^T l
 // (Gershgorin), exact for rotations, tight for similarities.
