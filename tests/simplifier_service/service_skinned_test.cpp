@@ -34,11 +34,18 @@ std::string writeWusonScene() {
   return path;
 }
 
+// Fewer surface samples and poses than the service's defaults for the
+// curve and the ladder's bounds under the clip: the tests check skins,
+// credits and the guarantee, and must fit the sanitizer build's time limit
+// (deploy/test-sanitize: Debug, ASan + UBSan, about 20x slower).
 ServiceOptions wusonOptions() {
   ServiceOptions options;
   options.modelSearchPaths = {kWusonDir};
   options.sceneRoot = scratchDir();
   options.curveCacheDir = scratchDir() + "/curves";
+  options.curve.error.samplesPerMesh = 4000;
+  options.animatedError.maxPoses = 17;
+  options.animatedError.surface.samplesPerMesh = 1500;
   return options;
 }
 
